@@ -1,0 +1,90 @@
+#include "swish/core/mesh.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <tuple>
+
+#include "swish/core/error.hpp"
+
+namespace swish {
+
+void Mesh::validate(const std::string& what, size_t jointCount) const {
+  const size_t n = vertexCount();
+  if (n == 0) throw Error(what + ": mesh has no vertices");
+  if (!positions.allFinite()) throw Error(what + ": mesh has non-finite vertex positions");
+  if (normals.rows() != 0 && size_t(normals.rows()) != n)
+    throw Error(what + ": " + std::to_string(normals.rows()) + " normals for " + std::to_string(n) + " vertices");
+  if (tangents.rows() != 0 && size_t(tangents.rows()) != n)
+    throw Error(what + ": " + std::to_string(tangents.rows()) + " tangents for " + std::to_string(n) + " vertices");
+  if (uvs.rows() != 0 && size_t(uvs.rows()) != n)
+    throw Error(what + ": " + std::to_string(uvs.rows()) + " UVs for " + std::to_string(n) + " vertices");
+  if (uvs.rows() != 0 && !uvs.allFinite()) throw Error(what + ": mesh has non-finite UVs");
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (triangles(t, k) >= n)
+        throw Error(what + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(triangles(t, k)) +
+                    " but the mesh has " + std::to_string(n) + " vertices");
+  if (!skin.weights.empty() || !skin.joints.empty()) {
+    if (skin.influences < 1 || skin.influences > kMaxInfluences)
+      throw Error(what + ": " + std::to_string(skin.influences) + " influences per vertex (1.." +
+                  std::to_string(kMaxInfluences) + " supported)");
+    const size_t need = n * size_t(skin.influences);
+    if (skin.weights.size() != need || skin.joints.size() != need)
+      throw Error(what + ": skin has " + std::to_string(skin.weights.size()) + " weights and " +
+                  std::to_string(skin.joints.size()) + " joint indices, expected " + std::to_string(need));
+    for (size_t v = 0; v < n; ++v) {
+      double sum = 0;
+      for (int k = 0; k < skin.influences; ++k) {
+        const float w = skin.weights[v * skin.influences + k];
+        if (!std::isfinite(w) || w < 0.f)
+          throw Error(what + ": vertex " + std::to_string(v) + " has an invalid skin weight");
+        if (jointCount && skin.joints[v * skin.influences + k] >= jointCount)
+          throw Error(what + ": vertex " + std::to_string(v) + " is weighted to joint " +
+                      std::to_string(skin.joints[v * skin.influences + k]) + " of " + std::to_string(jointCount));
+        sum += w;
+      }
+      if (std::abs(sum - 1.0) > 1e-3)
+        throw Error(what + ": skin weights of vertex " + std::to_string(v) + " sum to " + std::to_string(sum) +
+                    ", not 1");
+    }
+  }
+}
+
+std::vector<uint32_t> weldByPosition(const Points3f& p) {
+  std::map<std::tuple<uint32_t, uint32_t, uint32_t>, uint32_t> first;
+  std::vector<uint32_t> weld(size_t(p.rows()));
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    uint32_t b[3];
+    for (int k = 0; k < 3; ++k) {
+      float f = p(i, k) == 0.f ? 0.f : p(i, k);  // -0 == +0
+      std::memcpy(&b[k], &f, 4);
+    }
+    auto [it, inserted] = first.try_emplace({b[0], b[1], b[2]}, uint32_t(i));
+    weld[size_t(i)] = it->second;
+  }
+  return weld;
+}
+
+VertexTriangleAdjacency buildVertexTriangleAdjacency(const Triangles& tris, size_t n,
+                                                     const std::vector<uint32_t>* weld) {
+  // Count per representative, then expand to every vertex of the group.
+  auto rep = [&](uint32_t v) { return weld ? (*weld)[v] : v; };
+  std::vector<std::vector<uint32_t>> perRep(n);
+  for (Eigen::Index t = 0; t < tris.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      auto& list = perRep[rep(tris(t, k))];
+      if (list.empty() || list.back() != uint32_t(t)) list.push_back(uint32_t(t));
+    }
+  VertexTriangleAdjacency a;
+  a.offsets.resize(n + 1, 0);
+  for (size_t v = 0; v < n; ++v) a.offsets[v + 1] = a.offsets[v] + uint32_t(perRep[rep(uint32_t(v))].size());
+  a.triangles.reserve(a.offsets[n]);
+  for (size_t v = 0; v < n; ++v) {
+    const auto& l = perRep[rep(uint32_t(v))];
+    a.triangles.insert(a.triangles.end(), l.begin(), l.end());
+  }
+  return a;
+}
+
+}  // namespace swish

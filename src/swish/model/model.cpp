@@ -1,0 +1,90 @@
+#include "swish/model/model.hpp"
+
+#include <cmath>
+
+#include "swish/core/error.hpp"
+
+namespace swish {
+
+namespace {
+std::string n2s(size_t v) { return std::to_string(v); }
+}  // namespace
+
+void Model::validate(const std::string& what) const {
+  auto fail = [&](const std::string& part, const std::string& problem) {
+    throw Error(what + ": " + part + ": " + problem);
+  };
+  skeleton.validate(what + ": skeleton");
+  if (skeleton.inverseBind.size() != skeleton.size())
+    fail("skeleton", "needs one inverse bind matrix per joint");
+  if (inputJoints.empty()) fail("input joints", "none given");
+  for (uint32_t j : inputJoints)
+    if (j >= skeleton.size()) fail("input joints", "index " + n2s(j) + " >= joint count " + n2s(skeleton.size()));
+
+  // MLP shape chain: Theta -> ... -> Lambda.
+  if (mlp.layers.empty()) fail("mlp", "has no layers");
+  for (size_t l = 0; l < mlp.layers.size(); ++l) {
+    const auto& L = mlp.layers[l];
+    if (L.weight.rows() == 0 || L.weight.cols() == 0) fail("mlp", "layer " + n2s(l) + " is empty");
+    if (L.bias.size() != L.weight.rows()) fail("mlp", "layer " + n2s(l) + " bias size differs from its output size");
+    if (l > 0 && L.weight.cols() != mlp.layers[l - 1].weight.rows())
+      fail("mlp", "layer " + n2s(l) + " input size " + n2s(L.weight.cols()) + " != previous output size " +
+                      n2s(mlp.layers[l - 1].weight.rows()));
+    if (!L.weight.allFinite() || !L.bias.allFinite()) fail("mlp", "layer " + n2s(l) + " has non-finite values");
+  }
+  if (mlp.inputSize() != thetaSize())
+    fail("mlp", "input size " + n2s(mlp.inputSize()) + " != 6 x " + n2s(inputJoints.size()) + " input joints");
+  if (mlp.outputSize() != lambdaSize())
+    fail("mlp", "output size " + n2s(mlp.outputSize()) + " != " + n2s(meshComponents()) + " mesh components + " +
+                    n2s(normalCodeDims()) + " normal-code dimensions");
+  auto checkNorm = [&](const Normalisation& nrm, int size, const char* name) {
+    if (nrm.mean.size() != size || nrm.scale.size() != size)
+      fail(name, "size " + n2s(nrm.mean.size()) + "/" + n2s(nrm.scale.size()) + ", expected " + n2s(size));
+    if (!nrm.mean.allFinite() || !nrm.scale.allFinite()) fail(name, "has non-finite values");
+    for (Eigen::Index i = 0; i < nrm.scale.size(); ++i)
+      if (!(nrm.scale[i] > 0.f)) fail(name, "scale " + n2s(i) + " is not positive");
+  };
+  checkNorm(inputNorm, thetaSize(), "input normalisation");
+  checkNorm(outputNorm, lambdaSize(), "output normalisation");
+
+  // Mesh and its PCA.
+  gameMesh.validate(what + ": game mesh", skeleton.size());
+  const size_t n = gameMesh.vertexCount();
+  if (gameMesh.triangleCount() == 0) fail("game mesh", "has no triangles");
+  if (gameMesh.skin.weights.empty()) fail("game mesh", "has no skin weights");
+  if (size_t(gameMesh.uvs.rows()) != n) fail("game mesh", "needs one UV per vertex");
+  if (size_t(gameMesh.normals.rows()) != n || size_t(gameMesh.tangents.rows()) != n)
+    fail("game mesh", "needs rest normals and tangents for every vertex");
+  if (size_t(meshPca.mean.size()) != 3 * n)
+    fail("mesh pca", "mean has " + n2s(meshPca.mean.size()) + " values for " + n2s(n) + " vertices (3 each)");
+  if (size_t(meshPca.basis.rows()) != 3 * n)
+    fail("mesh pca", "basis has " + n2s(meshPca.basis.rows()) + " rows for " + n2s(n) + " vertices (3 each)");
+  if (!meshPca.mean.allFinite() || !meshPca.basis.allFinite()) fail("mesh pca", "has non-finite values");
+
+  // Normal-map database.
+  const auto& db = normalMaps;
+  if (!db.empty()) {
+    if (db.width == 0 || db.height == 0 || db.width % 4 || db.height % 4)
+      fail("normal maps", "size " + n2s(db.width) + "x" + n2s(db.height) + " is not a positive multiple of 4");
+    if (db.width > 16384 || db.height > 16384) fail("normal maps", "larger than 16384 texels a side");
+    if (db.codebookSize == 0 || db.codebookSize > 65536)
+      fail("normal maps", "codebook size " + n2s(db.codebookSize) + " outside 1..65536");
+    if (db.codebook.size() != size_t(db.codebookSize) * 32)
+      fail("normal maps", "codebook holds " + n2s(db.codebook.size()) + " bytes, expected " +
+                              n2s(size_t(db.codebookSize) * 32));
+    if (db.indices.size() != size_t(db.mapCount()) * db.blocksPerMap())
+      fail("normal maps", "holds " + n2s(db.indices.size()) + " block indices, expected " +
+                              n2s(size_t(db.mapCount()) * db.blocksPerMap()));
+    for (size_t i = 0; i < db.indices.size(); ++i)
+      if (db.indices[i] >= db.codebookSize)
+        fail("normal maps", "block index " + n2s(i) + " = " + n2s(db.indices[i]) + " >= codebook size " +
+                                n2s(db.codebookSize));
+    if (!db.keys.allFinite()) fail("normal maps", "keys have non-finite values");
+  } else if (db.codeDims() != 0) {
+    fail("normal maps", "keys have dimensions but no maps");
+  }
+  if (!(temporalFilter.timeConstantSeconds >= 0.f) || !std::isfinite(temporalFilter.timeConstantSeconds))
+    fail("temporal filter", "time constant must be finite and >= 0");
+}
+
+}  // namespace swish

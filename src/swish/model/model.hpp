@@ -1,0 +1,90 @@
+#pragma once
+// The Model: everything the run time needs for one garment on one body, as plain data. Written by the
+// bake, read from a .swish file (model_file.hpp), consumed by the runtime. No Vulkan, no I/O here.
+//
+// Per frame (paper section 2.3):
+//   Theta  = 6D rotations of inputJoints, in order            (size 6 * inputJoints.size())
+//   Lambda = denormalise(MLP(normalise(Theta)))               (size meshComponents + normalCodeDims)
+//   mesh weights = Lambda[0 .. K), normal code = Lambda[K .. K + C)
+//   pre-skin shape = meshPca.mean + meshPca.basis * weights  ->  linear blend skinning
+//   normal map = database map whose key is nearest the code  ->  VQ decode -> temporal blend
+#include <string>
+#include <vector>
+
+#include "swish/core/mesh.hpp"
+#include "swish/core/skeleton.hpp"
+#include "swish/core/types.hpp"
+
+namespace swish {
+
+// x_normalised = (x - mean) / scale, elementwise. scale > 0.
+struct Normalisation {
+  VecXf mean;
+  VecXf scale;
+};
+
+struct MlpLayer {
+  MatXf weight;  // out x in
+  VecXf bias;    // out
+};
+
+// Every layer but the last is followed by SELU; the last is linear.
+struct Mlp {
+  std::vector<MlpLayer> layers;
+  int inputSize() const { return layers.empty() ? 0 : int(layers.front().weight.cols()); }
+  int outputSize() const { return layers.empty() ? 0 : int(layers.back().weight.rows()); }
+};
+
+// PCA of game-mesh shapes in pre-skinning space. Vertex v, axis a lives at row 3*v + a.
+struct MeshPca {
+  VecXf mean;   // 3N
+  MatXf basis;  // 3N x K, one column per component
+  int components() const { return int(basis.cols()); }
+};
+
+// The k-means normal-map database, compressed with vector quantisation of 4x4 blocks.
+// Map texel (x, y) of map m: block b = (y/4) * (width/4) + (x/4), entry e = indices[m * blocksPerMap + b],
+// texel t = (y%4)*4 + (x%4); X = codebook[(e*16 + t)*2 + 0] / 127, Y = codebook[(e*16 + t)*2 + 1] / 127
+// (snorm8, clamped to [-1, 1]); Z = sqrt(max(0, 1 - X^2 - Y^2)). Tangent space.
+struct NormalMapDatabase {
+  uint32_t width = 0, height = 0;   // multiples of 4
+  MatXf keys;                       // mapCount x codeDims: each map's normal-map PCA code
+  uint32_t codebookSize = 0;        // entries; indices are 16-bit so at most 65536
+  std::vector<int8_t> codebook;     // codebookSize * 16 texels * 2 channels
+  std::vector<uint16_t> indices;    // mapCount * blocksPerMap()
+
+  uint32_t mapCount() const { return uint32_t(keys.rows()); }
+  uint32_t codeDims() const { return uint32_t(keys.cols()); }
+  uint32_t blocksPerMap() const { return (width / 4) * (height / 4); }
+  bool empty() const { return mapCount() == 0; }
+};
+
+struct TemporalFilterParams {
+  // Exponential blend of the newly selected map into the per-character map: each frame the new map
+  // gets weight 1 - exp(-dt / timeConstant). 0 disables filtering (the selection shows at once).
+  float timeConstantSeconds = 0.1f;
+};
+
+struct Model {
+  Skeleton skeleton;                 // the character's skeleton (for FK and skinning)
+  std::vector<uint32_t> inputJoints; // skeleton joint indices forming Theta, in this order
+  Normalisation inputNorm;           // over Theta
+  Normalisation outputNorm;          // over Lambda
+  Mlp mlp;
+  MeshPca meshPca;
+  Mesh gameMesh;                     // rest positions, triangles, UVs, skin, rest normals+tangents
+  NormalMapDatabase normalMaps;      // may be empty (a model without normal maps)
+  TemporalFilterParams temporalFilter;
+  std::string metadata = "{}";       // free-form JSON: bake settings, errors measured at bake time
+
+  int thetaSize() const { return int(inputJoints.size()) * 6; }
+  int meshComponents() const { return meshPca.components(); }
+  int normalCodeDims() const { return int(normalMaps.codeDims()); }
+  int lambdaSize() const { return meshComponents() + normalCodeDims(); }
+
+  // Checks every size, index and value the runtime relies on; throws Error naming `what` and the
+  // part that is wrong. Loaders call it; so should anything that builds a Model by hand.
+  void validate(const std::string& what = "model") const;
+};
+
+}  // namespace swish

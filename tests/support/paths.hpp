@@ -1,0 +1,19 @@
+#pragma once
+// Where tests find data that lives outside the project.
+#include <filesystem>
+#include <string>
+
+namespace swish::test {
+
+// ../shared/assets beside the project (the CC0 test character). Tests that need it skip when absent:
+//   if (!std::filesystem::exists(sharedAsset("tshirt_lo.glb"))) GTEST_SKIP() << "...";
+inline std::filesystem::path sharedAsset(const std::string& name) {
+  return std::filesystem::path(SWISH_SHARED_ASSETS_DIR) / name;
+}
+inline std::filesystem::path sourceDir() { return SWISH_SOURCE_DIR; }
+// The CMU clips of Debian's assimp-testmodels package.
+inline std::filesystem::path debianMocap(const std::string& name) {
+  return std::filesystem::path("/usr/share/assimp/models/BVH") / name;
+}
+
+}  // namespace swish::test

@@ -1,0 +1,117 @@
+#include "support/random_model.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "swish/core/mesh_frames.hpp"
+
+namespace swish::test {
+
+uint64_t testSeed(uint64_t fallback) {
+  if (const char* s = std::getenv("SWISH_TEST_SEED")) return std::strtoull(s, nullptr, 0);
+  return fallback;
+}
+
+static Quatf randomRotation(Rng& rng, float maxAngle) {
+  Vec3f axis(float(rng.normal()), float(rng.normal()), float(rng.normal()));
+  if (axis.norm() < 1e-6f) axis = Vec3f::UnitY();
+  return Quatf(Eigen::AngleAxisf(rng.uniformf(-maxAngle, maxAngle), axis.normalized()));
+}
+
+Pose makeRandomPose(Rng& rng, const Skeleton& sk, float maxAngle) {
+  Pose p = sk.restPose();
+  for (auto& q : p.local) q = (q * randomRotation(rng, maxAngle)).normalized();
+  return p;
+}
+
+Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
+  Model m;
+  // Skeleton: joint i's parent is a random earlier joint, offsets ~10 cm.
+  for (uint32_t i = 0; i < s.joints; ++i) {
+    Joint j;
+    j.name = "joint" + std::to_string(i);
+    j.parent = i == 0 ? -1 : int(rng.below(i));
+    j.rest.translation = i == 0 ? Vec3f(0, 1, 0) : Vec3f(rng.uniformf(-.1f, .1f), rng.uniformf(.05f, .15f), rng.uniformf(-.05f, .05f));
+    j.rest.rotation = Quatf::Identity();
+    m.skeleton.joints.push_back(j);
+  }
+  m.skeleton.computeInverseBindFromRest();
+  for (uint32_t i = 0; i < s.inputJoints; ++i) m.inputJoints.push_back(i % s.joints);
+
+  // Mesh: vertices on a grid of cols x rows (the last row may be partial), triangles between full cells.
+  const uint32_t n = s.vertices;
+  const uint32_t cols = std::max<uint32_t>(1, uint32_t(std::ceil(std::sqrt(double(n)))));
+  Mesh& g = m.gameMesh;
+  g.positions.resize(n, 3);
+  g.uvs.resize(n, 2);
+  for (uint32_t v = 0; v < n; ++v) {
+    const float x = float(v % cols), y = float(v / cols);
+    g.positions.row(v) << 0.02f * x + rng.uniformf(-.002f, .002f), 1.f + 0.02f * y, rng.uniformf(-.01f, .01f);
+    g.uvs.row(v) << (x + .5f) / float(cols), (y + .5f) / float(cols);
+  }
+  std::vector<std::array<uint32_t, 3>> tris;
+  for (uint32_t v = 0; v < n; ++v) {
+    const uint32_t x = v % cols;
+    if (x + 1 >= cols || v + cols + 1 >= n) continue;
+    tris.push_back({v, v + 1, v + cols});
+    tris.push_back({v + 1, v + cols + 1, v + cols});
+  }
+  if (tris.empty()) tris.push_back({0, 0, 0});  // a degenerate triangle keeps tiny meshes valid
+  g.triangles.resize(Eigen::Index(tris.size()), 3);
+  for (size_t t = 0; t < tris.size(); ++t) g.triangles.row(Eigen::Index(t)) << tris[t][0], tris[t][1], tris[t][2];
+  g.skin.influences = int(s.influences);
+  for (uint32_t v = 0; v < n; ++v) {
+    float sum = 0;
+    std::vector<float> w(s.influences);
+    for (auto& x : w) sum += (x = float(rng.uniform(0.05, 1.0)));
+    for (uint32_t k = 0; k < s.influences; ++k) {
+      g.skin.joints.push_back(uint16_t(rng.below(s.joints)));
+      g.skin.weights.push_back(w[k] / sum);
+    }
+  }
+  const auto topo = buildFrameTopology(g.triangles, g.positions);
+  computeVertexFrames(g.positions, g.uvs, g.triangles, topo, g.normals, g.tangents);
+
+  // PCA: mean = rest positions, basis columns of a few millimetres.
+  m.meshPca.mean = Eigen::Map<const VecXf>(g.positions.data(), 3 * n);
+  m.meshPca.basis.resize(3 * n, s.meshComponents);
+  for (Eigen::Index i = 0; i < m.meshPca.basis.size(); ++i) m.meshPca.basis.data()[i] = float(rng.normal(0, 0.003));
+
+  // Normal-map database.
+  auto& db = m.normalMaps;
+  if (s.normalMaps > 0) {
+    db.width = db.height = s.mapSize;
+    db.keys.resize(s.normalMaps, s.codeDims);
+    for (Eigen::Index i = 0; i < db.keys.size(); ++i) db.keys.data()[i] = float(rng.normal());
+    db.codebookSize = s.codebookSize;
+    db.codebook.resize(size_t(s.codebookSize) * 32);
+    for (auto& c : db.codebook) c = int8_t(int(rng.below(181)) - 90);  // |X|,|Y| <= 0.71 keeps Z real
+    db.indices.resize(size_t(s.normalMaps) * db.blocksPerMap());
+    for (auto& i : db.indices) i = uint16_t(rng.below(s.codebookSize));
+  }
+
+  // MLP.
+  const int in = m.thetaSize(), out = int(s.meshComponents + (s.normalMaps ? s.codeDims : 0));
+  int prev = in;
+  for (uint32_t l = 0; l <= s.hiddenLayers; ++l) {
+    const int width = l == s.hiddenLayers ? out : int(s.hiddenWidth);
+    MlpLayer L;
+    L.weight.resize(width, prev);
+    L.bias.resize(width);
+    const double sd = 1.0 / std::sqrt(double(prev));  // LeCun normal, as SELU wants
+    for (Eigen::Index i = 0; i < L.weight.size(); ++i) L.weight.data()[i] = float(rng.normal(0, sd));
+    for (Eigen::Index i = 0; i < L.bias.size(); ++i) L.bias[i] = float(rng.normal(0, 0.1));
+    m.mlp.layers.push_back(std::move(L));
+    prev = width;
+  }
+  m.inputNorm.mean = VecXf::Zero(in);
+  m.inputNorm.scale = VecXf::Constant(in, 0.5f);
+  m.outputNorm.mean = VecXf::Zero(out);
+  m.outputNorm.scale = VecXf::Ones(out);
+  m.metadata = R"({"generator":"makeRandomModel"})";
+  m.validate("random model");
+  return m;
+}
+
+}  // namespace swish::test
