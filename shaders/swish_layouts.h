@@ -1,0 +1,120 @@
+// Buffer layouts and push-constant blocks shared by the GLSL compute shaders and the C++ passes
+// (src/swish/gpu/*). Included by both: GLSL sees SWISH_ADDRESS as uvec2 (GL_EXT_buffer_reference_uvec2,
+// so no shaderInt64 is needed), C++ sees an 8-byte aligned pair of words holding a VkDeviceAddress.
+// Every struct is laid out with std430 / push-constant rules; C++ checks the sizes with static_asserts.
+//
+// Data layouts (all tightly packed 32-bit words unless said otherwise):
+//   positions/normals : float[instance][vertex][3]   (same as swish::Points3f rows, one block per instance)
+//   tangents          : float[instance][vertex][4]   (xyz tangent, w = bitangent sign)
+//   PCA mean          : float[3N];  PCA basis: float[k][3N] (column-major 3N x K, as Eigen stores MeshPca::basis)
+//   mesh weights      : float[instance][K]
+//   skin matrices     : mat4[instance][joint], column-major (as Eigen stores Mat4f)
+//   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
+//   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
+//   VQ codebook       : int8[entry][16 texels][2] read as uint words (2 texels per word)
+//   VQ indices        : uint16[map][block] read as uint words (2 indices per word, little-endian)
+//   decoded maps      : uint16[slot][height][width] read as uint words: per texel low byte = X, high byte = Y
+//                       (snorm8, exactly the codebook bytes: decoding is a lossless gather)
+#ifndef SWISH_LAYOUTS_H
+#define SWISH_LAYOUTS_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace swish::gpu::layout {
+using uint = uint32_t;
+struct alignas(8) Address {
+  uint32_t lo = 0, hi = 0;
+  static Address of(uint64_t a) { return {uint32_t(a), uint32_t(a >> 32)}; }
+};
+#define SWISH_ADDRESS Address
+#else
+#define SWISH_ADDRESS uvec2
+#endif
+
+// Weights of this many (instance, component) pairs are staged in shared memory at a time by deform.comp.
+#define SWISH_DEFORM_SHARED_WEIGHTS 4096
+// Largest K the deform kernel accepts (its per-thread basis registers are sized by K).
+#define SWISH_MAX_MESH_COMPONENTS 256
+
+// deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances.
+struct DeformParams {
+  SWISH_ADDRESS mean;           // float[3N]
+  SWISH_ADDRESS basis;          // float[K][3N]
+  SWISH_ADDRESS weights;        // float[instanceCount][K]
+  SWISH_ADDRESS skinMatrices;   // mat4[instanceCount][jointCount]
+  SWISH_ADDRESS skinJoints;     // uint[N][influences]
+  SWISH_ADDRESS skinWeights;    // float[N][influences]
+  SWISH_ADDRESS positionsOut;   // float[instanceCount][N][3]
+  uint vertexCount;
+  uint instanceCount;
+  uint jointCount;
+  uint pad0;
+};
+
+// tangent_frames.comp: normals and tangents of deformed meshes, one thread per (vertex, instance).
+struct TangentFramesParams {
+  SWISH_ADDRESS positions;         // float[instanceCount][N][3]
+  SWISH_ADDRESS uvs;               // float[N][2] (ignored when hasUvs == 0)
+  SWISH_ADDRESS triangles;         // uint[T][3]
+  SWISH_ADDRESS normalOffsets;     // uint[N+1]  (welded adjacency)
+  SWISH_ADDRESS normalTriangles;   // uint[]
+  SWISH_ADDRESS tangentOffsets;    // uint[N+1]  (own triangles)
+  SWISH_ADDRESS tangentTriangles;  // uint[]
+  SWISH_ADDRESS normalsOut;        // float[instanceCount][N][3]
+  SWISH_ADDRESS tangentsOut;       // float[instanceCount][N][4]
+  uint vertexCount;
+  uint instanceCount;
+  uint hasUvs;
+  uint pad0;
+};
+
+// vq_decode.comp: decodes database maps into decoded slots, one thread per texel pair.
+struct VqDecodeParams {
+  SWISH_ADDRESS codebook;     // uint words of int8[entry][16][2]
+  SWISH_ADDRESS indices;      // uint words of uint16[map][block]
+  SWISH_ADDRESS slotMaps;     // uint[slotCount]: database map decoded into each slot
+  SWISH_ADDRESS decodedOut;   // uint words of uint16[slot][height][width]
+  uint width;
+  uint height;
+  uint slotCount;
+  uint codebookSize;          // entries; larger indices decode to 0 (the CPU reference does the same)
+};
+
+// One character of normal_map_blend.comp.
+struct NormalMapBlendCharacter {
+  uint decodedSlot;   // slot of the decoded map this character selected this frame
+  float alpha;        // weight of the new map: out = mix(prev, decoded, alpha)
+};
+
+// normal_map_blend.comp: temporal blend into the per-character layers of an RG16_SNORM 2D array image.
+struct NormalMapBlendParams {
+  SWISH_ADDRESS decoded;      // as VqDecodeParams::decodedOut
+  SWISH_ADDRESS characters;   // NormalMapBlendCharacter[characterCount]
+  uint width;
+  uint height;
+  uint characterCount;
+  uint pad0;
+};
+
+// copy_vec4.comp (benchmark baseline): out[i] = in[i] for vec4 i < count.
+struct CopyVec4Params {
+  SWISH_ADDRESS src;
+  SWISH_ADDRESS dst;
+  uint count;
+  uint pad0;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(Address) == 8);
+static_assert(sizeof(DeformParams) == 7 * 8 + 16);
+static_assert(sizeof(TangentFramesParams) == 9 * 8 + 16);
+static_assert(sizeof(VqDecodeParams) == 4 * 8 + 16);
+static_assert(sizeof(NormalMapBlendCharacter) == 8);
+static_assert(sizeof(NormalMapBlendParams) == 2 * 8 + 16);
+static_assert(sizeof(CopyVec4Params) == 2 * 8 + 8);
+static_assert(sizeof(TangentFramesParams) <= 128, "push constants: 128 bytes are all Vulkan guarantees");
+}  // namespace swish::gpu::layout
+#undef SWISH_ADDRESS
+#endif
+
+#endif  // SWISH_LAYOUTS_H

@@ -1,0 +1,100 @@
+#version 460
+// Normals and tangents of deformed meshes: one thread per (vertex, instance), GATHERING over the
+// precomputed vertex -> triangle adjacency (welded for normals, own triangles for tangents), so no
+// float atomics are needed and every sum runs in the same order as the CPU definition,
+// core/mesh_frames.cpp (computeVertexFrames), which runtime/reference_tangent_frames.cpp calls.
+// Every formula below is written out in that file's operation order; `precise` forbids FMA contraction.
+#extension GL_GOOGLE_include_directive : require
+#include "swish_buffers.glsl"
+#include "swish_layouts.h"
+
+layout(local_size_x_id = 0) in;
+layout(push_constant) uniform Push { TangentFramesParams p; };
+
+// Eigen's cross product, component by component.
+vec3 crossCpu(vec3 a, vec3 b) {
+  precise vec3 c = vec3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+  return c;
+}
+float dotCpu(vec3 a, vec3 b) {
+  precise float d = (a.x * b.x + a.y * b.y) + a.z * b.z;
+  return d;
+}
+float normCpu(vec3 a) { return sqrt(dotCpu(a, a)); }
+bool isFinite(float x) { return !isnan(x) && !isinf(x); }
+
+// core/mesh_frames.cpp anyPerpendicular: normalize(cross(n, e)), e the axis least aligned with n
+// (Eigen's normalized(): unchanged when the squared norm is 0).
+vec3 anyPerpendicular(vec3 n) {
+  const vec3 a = abs(n);
+  vec3 e = (a.x <= a.y && a.x <= a.z) ? vec3(1, 0, 0) : (a.y <= a.z ? vec3(0, 1, 0) : vec3(0, 0, 1));
+  precise vec3 c = crossCpu(n, e);
+  const float z = dotCpu(c, c);
+  if (z > 0.0) c = c / sqrt(z);
+  return c;
+}
+
+FloatsIn positions;
+uint base;  // first float of this instance's positions
+vec3 corner(UintsIn tris, uint t, uint k) {
+  const uint i = base + 3u * tris.v[3u * t + k];
+  return vec3(positions.v[i], positions.v[i + 1u], positions.v[i + 2u]);
+}
+
+void main() {
+  const uint v = gl_GlobalInvocationID.x;
+  const uint instance = gl_GlobalInvocationID.y;
+  if (v >= p.vertexCount || instance >= p.instanceCount) return;
+  positions = FloatsIn(p.positions);
+  base = instance * p.vertexCount * 3u;
+  UintsIn tris = UintsIn(p.triangles);
+
+  UintsIn nOff = UintsIn(p.normalOffsets);
+  UintsIn nTri = UintsIn(p.normalTriangles);
+  precise vec3 nsum = vec3(0.0);
+  for (uint i = nOff.v[v]; i < nOff.v[v + 1u]; ++i) {
+    const uint t = nTri.v[i];
+    precise vec3 p0 = corner(tris, t, 0u);
+    precise vec3 e1 = corner(tris, t, 1u) - p0;
+    precise vec3 e2 = corner(tris, t, 2u) - p0;
+    nsum = nsum + crossCpu(e1, e2);
+  }
+  const float nl = normCpu(nsum);
+  precise vec3 nrm = nl > 0.0 ? nsum / nl : vec3(0, 0, 1);
+
+  precise vec3 tsum = vec3(0.0), bsum = vec3(0.0);
+  if (p.hasUvs != 0u) {
+    FloatsIn uvs = FloatsIn(p.uvs);
+    UintsIn tOff = UintsIn(p.tangentOffsets);
+    UintsIn tTri = UintsIn(p.tangentTriangles);
+    for (uint i = tOff.v[v]; i < tOff.v[v + 1u]; ++i) {
+      const uint t = tTri.v[i];
+      precise vec3 p0 = corner(tris, t, 0u);
+      precise vec3 e1 = corner(tris, t, 1u) - p0;
+      precise vec3 e2 = corner(tris, t, 2u) - p0;
+      const uint c0 = tris.v[3u * t], c1 = tris.v[3u * t + 1u], c2 = tris.v[3u * t + 2u];
+      const vec2 uv0 = vec2(uvs.v[2u * c0], uvs.v[2u * c0 + 1u]);
+      precise vec2 d1 = vec2(uvs.v[2u * c1], uvs.v[2u * c1 + 1u]) - uv0;
+      precise vec2 d2 = vec2(uvs.v[2u * c2], uvs.v[2u * c2 + 1u]) - uv0;
+      precise float r = d1.x * d2.y - d2.x * d1.y;
+      if (r == 0.0 || !isFinite(r)) continue;
+      tsum = tsum + (e1 * d2.y - e2 * d1.y) / r;
+      bsum = bsum + (e2 * d1.x - e1 * d2.x) / r;
+    }
+  }
+  precise vec3 tan = tsum - nrm * dotCpu(nrm, tsum);
+  const float tl = normCpu(tan);
+  tan = (tl > 1e-20 && isFinite(tl)) ? tan / tl : anyPerpendicular(nrm);
+  const float w = dotCpu(crossCpu(nrm, tan), bsum) < 0.0 ? -1.0 : 1.0;
+
+  FloatsOut normalsOut = FloatsOut(p.normalsOut);
+  FloatsOut tangentsOut = FloatsOut(p.tangentsOut);
+  const uint o = instance * p.vertexCount + v;
+  normalsOut.v[3u * o] = nrm.x;
+  normalsOut.v[3u * o + 1u] = nrm.y;
+  normalsOut.v[3u * o + 2u] = nrm.z;
+  tangentsOut.v[4u * o] = tan.x;
+  tangentsOut.v[4u * o + 1u] = tan.y;
+  tangentsOut.v[4u * o + 2u] = tan.z;
+  tangentsOut.v[4u * o + 3u] = w;
+}

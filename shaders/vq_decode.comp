@@ -1,0 +1,28 @@
+#version 460
+// VQ decode of the normal-map database maps selected this frame: each selected map is decoded ONCE
+// into its own slot, however many characters chose it. One thread per pair of horizontally adjacent
+// texels: they lie in the same 4x4 block, so their 4 bytes (X0 Y0 X1 Y1) are one word of the codebook
+// entry and decoding is a lossless word copy (conforms exactly to runtime/reference_vq_decode.cpp).
+#extension GL_GOOGLE_include_directive : require
+#include "swish_buffers.glsl"
+#include "swish_layouts.h"
+
+layout(local_size_x_id = 0) in;
+layout(push_constant) uniform Push { VqDecodeParams p; };
+
+void main() {
+  const uint pairsPerMap = p.width * p.height / 2u;
+  const uint pair = gl_GlobalInvocationID.x;
+  const uint slot = gl_GlobalInvocationID.y;
+  if (pair >= pairsPerMap || slot >= p.slotCount) return;
+  const uint x = (2u * pair) % p.width, y = (2u * pair) / p.width;
+  const uint map = UintsIn(p.slotMaps).v[slot];
+  const uint block = (y / 4u) * (p.width / 4u) + x / 4u;
+  const uint indexPos = map * (p.width / 4u) * (p.height / 4u) + block;
+  const uint indexWord = UintsIn(p.indices).v[indexPos / 2u];
+  const uint entry = (indexPos % 2u == 0u) ? (indexWord & 0xFFFFu) : (indexWord >> 16);
+  const uint texel = (y % 4u) * 4u + x % 4u;  // even: x is even
+  uint word = 0u;
+  if (entry < p.codebookSize) word = UintsIn(p.codebook).v[(entry * 16u + texel) / 2u];
+  UintsOut(p.decodedOut).v[slot * pairsPerMap + pair] = word;
+}

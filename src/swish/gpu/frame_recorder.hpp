@@ -1,0 +1,75 @@
+#pragma once
+// Records one frame of swish's GPU work for a batch of instances of one model into a command buffer
+// the caller owns (the caller submits; nothing here submits frame work):
+//   deform (all instances, one dispatch) -> barrier -> tangent frames (one dispatch)
+//   VQ decode (each selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch)
+// with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
+// uses slot f % framesInFlight and its blend reads the previous slot's normal maps.
+//
+// Caller contract: before record(f), wait for the fence of the submission that used slot
+// f % framesInFlight last (frame f - framesInFlight); submit frames in order on one queue. After
+// the frame's submission, a renderer consuming the outputs needs a barrier from
+// COMPUTE_SHADER/SHADER_WRITE to its stage (vertex input for the buffers, fragment shader reads for
+// the normal maps).
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "swish/gpu/deform_pass.hpp"
+#include "swish/gpu/frame_resources.hpp"
+#include "swish/gpu/normal_map_blend_pass.hpp"
+#include "swish/gpu/tangent_frames_pass.hpp"
+#include "swish/gpu/vq_decode_pass.hpp"
+#include "swish/runtime/reference_frame.hpp"
+
+namespace swish::gpu {
+
+class Context;
+class GpuModel;
+
+struct FrameRecorderOptions {
+  uint32_t framesInFlight = 2;
+  bool tangentFrames = true;  // normals + tangents pass
+  bool normalMaps = true;     // VQ decode + blend (ignored for a model without a database)
+};
+
+// GPU time of each pass of one frame, in milliseconds (NaN: not run, or no timestamps on the device).
+struct StageTimes {
+  double deformMs, tangentFramesMs, vqDecodeMs, normalBlendMs, totalMs;
+};
+
+class FrameRecorder {
+ public:
+  FrameRecorder(Context& ctx, const GpuModel& model, uint32_t instanceCapacity, const FrameRecorderOptions& options = {});
+  FrameRecorder(const FrameRecorder&) = delete;
+  FrameRecorder& operator=(const FrameRecorder&) = delete;
+
+  uint32_t framesInFlight() const { return uint32_t(frames_.size()); }
+  uint32_t instanceCapacity() const { return capacity_; }
+  uint32_t slotOf(uint64_t frameIndex) const { return uint32_t(frameIndex % frames_.size()); }
+  const FrameResources& frame(uint32_t slot) const { return frames_.at(slot); }
+
+  // Writes `inputs` into frame frameIndex's slot and records its passes into `cmd` (begun by the caller).
+  void record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& inputs);
+
+  // After the fence of that frame's submission.
+  StageTimes stageTimes(uint32_t slot) const;
+  // Reads every output of a slot back (waits), in the reference's form, for comparisons and tools.
+  runtime::ReferenceFrameOutputs download(uint32_t slot) const;
+  // Sets a slot's normal maps (e.g. the previous frame's state in a test); waits.
+  void uploadNormalMaps(uint32_t slot, const std::vector<runtime::BlendedNormalMap>& maps);
+
+ private:
+  Context* ctx_;
+  const GpuModel* model_;
+  uint32_t capacity_;
+  bool tangentFrames_, normalMaps_;
+  DeformPass deform_;
+  TangentFramesPass tangentFramesPass_;
+  VqDecodePass decode_;
+  NormalMapBlendPass blend_;  // declared before frames_: their descriptor sets come from its pool
+  std::vector<FrameResources> frames_;
+};
+
+}  // namespace swish::gpu

@@ -1,0 +1,29 @@
+#include "swish/gpu/frame_resources.hpp"
+
+#include "shaders/swish_layouts.h"
+#include "swish/core/types.hpp"
+#include "swish/gpu/context.hpp"
+#include "swish/gpu/gpu_model.hpp"
+
+namespace swish::gpu {
+
+FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bool withFrames, bool withMaps, uint32_t slot) {
+  const std::string tag = m.name() + " frame " + std::to_string(slot) + ": ";
+  const VkDeviceSize n = m.vertexCount(), c = std::max(1u, cap);
+  meshWeights = Buffer(ctx, c * m.kernelMeshComponents() * sizeof(float), MemoryKind::HostVisible, tag + "mesh weights");
+  skinMatrices = Buffer(ctx, c * m.jointCount() * sizeof(Mat4f), MemoryKind::HostVisible, tag + "skin matrices");
+  positions = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "positions");
+  if (withFrames) {
+    normals = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "normals");
+    tangents = Buffer(ctx, c * n * 4 * sizeof(float), MemoryKind::DeviceLocal, tag + "tangents");
+  }
+  if (withMaps) {
+    decodeSlotMaps = Buffer(ctx, c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode slot maps");
+    blendCharacters = Buffer(ctx, c * sizeof(layout::NormalMapBlendCharacter), MemoryKind::HostVisible, tag + "blend characters");
+    decodedMaps = Buffer(ctx, c * m.mapWidth() * m.mapHeight() * 2, MemoryKind::DeviceLocal, tag + "decoded maps");
+    normalMaps = NormalMapImages(ctx, m.mapWidth(), m.mapHeight(), uint32_t(c));
+  }
+  timestamps = TimestampQueries(ctx, 5);
+}
+
+}  // namespace swish::gpu

@@ -1,0 +1,51 @@
+#pragma once
+// The GPU resources of ONE frame in flight of a FrameRecorder: the per-frame inputs (host-visible,
+// written by the CPU each frame), the outputs (device-local: deformed positions, normals, tangents,
+// the decoded-map slots and the per-character normal maps) and the frame's timestamp queries.
+// A frame in flight owns its outputs: while the host renderer still reads frame f's outputs, frame
+// f + 1 writes another FrameResources.
+//
+// Output layouts for a renderer (one vertex stream per attribute, instance i at byte offset
+// i * vertexCount * stride): positions and normals R32G32B32_SFLOAT (stride 12), tangents
+// R32G32B32A32_SFLOAT (stride 16, w = bitangent sign); UVs are the model's (GpuModel::uvs).
+// Every buffer has STORAGE | VERTEX | TRANSFER usage; normal maps are described in normal_map_images.hpp.
+#include <cstdint>
+
+#include "swish/gpu/buffer.hpp"
+#include "swish/gpu/normal_map_images.hpp"
+#include "swish/gpu/timestamp_queries.hpp"
+#include "swish/gpu/vk_unique.hpp"
+
+namespace swish::gpu {
+
+class Context;
+class GpuModel;
+
+struct FrameResources {
+  FrameResources() = default;
+  // withNormalMaps: allocate the decode slots and per-character images (the model must have a database).
+  FrameResources(Context& ctx, const GpuModel& model, uint32_t instanceCapacity, bool withTangentFrames, bool withNormalMaps,
+                 uint32_t slot);
+
+  // Inputs, written by FrameRecorder::record.
+  Buffer meshWeights;      // float[instances][K]
+  Buffer skinMatrices;     // mat4[instances][joints]
+  Buffer decodeSlotMaps;   // uint[slots]
+  Buffer blendCharacters;  // layout::NormalMapBlendCharacter[instances]
+  // Outputs.
+  Buffer positions;        // float[instances][N][3]
+  Buffer normals;          // float[instances][N][3]
+  Buffer tangents;         // float[instances][N][4]
+  Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8), scratch of the normal-map passes
+  NormalMapImages normalMaps;  // one layer per instance
+  VkUnique<VkDescriptorSet> blendBinding;  // prev frame's normalMaps -> this frame's normalMaps
+  TimestampQueries timestamps;
+
+  // What the last record() into this frame did (for readback and timings).
+  uint32_t instanceCount = 0;
+  uint32_t decodedSlotCount = 0;
+  bool recordedTangentFrames = false;
+  bool recordedNormalMaps = false;
+};
+
+}  // namespace swish::gpu

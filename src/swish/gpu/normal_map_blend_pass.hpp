@@ -1,0 +1,48 @@
+#pragma once
+// The normal-map blend pass (shaders/normal_map_blend.comp): the temporal filter's blend of each
+// character's newly selected, decoded map into its normal map, out = mix(prev, decoded, alpha), for all
+// characters in one dispatch (one layer of a NormalMapImages array per character).
+//
+// prev and out are bound through a descriptor set made by makeBinding(); they may be the same images
+// (one frame in flight). Records one dispatch (never submits). The caller places
+// computeToComputeBarrier after the VQ decode pass and before this one (which also orders this
+// frame's read of `prev` after the previous frame's write of it on the same queue), and a barrier
+// COMPUTE_SHADER/SHADER_WRITE -> its own stage/SHADER_READ before sampling `out`.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+
+#include "swish/gpu/compute_pipeline.hpp"
+#include "swish/gpu/vk_unique.hpp"
+
+namespace swish::gpu {
+
+class NormalMapImages;
+
+class NormalMapBlendPass {
+ public:
+  static constexpr uint32_t kWorkgroupSize = 8;  // 8x8 texels
+
+  struct Args {
+    VkDeviceAddress decoded = 0;     // VqDecodePass output
+    VkDeviceAddress characters = 0;  // layout::NormalMapBlendCharacter[characterCount]
+    uint32_t width = 0, height = 0;
+    uint32_t characterCount = 0;     // <= layers of the bound images
+  };
+
+  NormalMapBlendPass() = default;
+  // maxBindings: how many descriptor sets makeBinding() may hand out over the pass's life.
+  NormalMapBlendPass(Context& ctx, uint32_t maxBindings);
+
+  // A descriptor set binding `prev` (read) and `out` (written); freed when the returned handle dies.
+  VkUnique<VkDescriptorSet> makeBinding(const NormalMapImages& prev, const NormalMapImages& out) const;
+  void record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& args) const;
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkUnique<VkDescriptorSetLayout> setLayout_;
+  VkUnique<VkDescriptorPool> pool_;
+  ComputePipeline pipeline_;
+};
+
+}  // namespace swish::gpu

@@ -1,0 +1,112 @@
+#include "swish/gpu/normal_map_images.hpp"
+
+#include "swish/gpu/context.hpp"
+#include "swish/gpu/vk_check.hpp"
+
+namespace swish::gpu {
+
+NormalMapImages::NormalMapImages(Context& ctx, uint32_t width, uint32_t height, uint32_t layers)
+    : width_(width), height_(height), layers_(layers) {
+  if (!ctx.supportsNormalMaps())
+    throw Error("Vulkan device '" + ctx.deviceName() +
+                "' cannot store normal maps: it lacks storage images of R16G16_SNORM (shaderStorageImageExtendedFormats)");
+  if (width == 0 || height == 0 || layers == 0) throw Error("normal-map images: width, height and layers must be > 0");
+  const VkDevice dev = ctx.device();
+  VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  ici.imageType = VK_IMAGE_TYPE_2D;
+  ici.format = kFormat;
+  ici.extent = {width, height, 1};
+  ici.mipLevels = 1;
+  ici.arrayLayers = layers;
+  ici.samples = VK_SAMPLE_COUNT_1_BIT;
+  ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ici.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+              VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  ici.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImage img;
+  SWISH_VK(vkCreateImage(dev, &ici, nullptr, &img));
+  image_ = VkUnique<VkImage>(img, [dev](VkImage h) { vkDestroyImage(dev, h, nullptr); });
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(dev, img, &req);
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  VkDeviceMemory mem;
+  SWISH_VK(vkAllocateMemory(dev, &mai, nullptr, &mem));
+  memory_ = VkUnique<VkDeviceMemory>(mem, [dev](VkDeviceMemory h) { vkFreeMemory(dev, h, nullptr); });
+  SWISH_VK(vkBindImageMemory(dev, img, mem, 0));
+  VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  vci.image = img;
+  vci.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
+  vci.format = kFormat;
+  vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, layers};
+  VkImageView view;
+  SWISH_VK(vkCreateImageView(dev, &vci, nullptr, &view));
+  view_ = VkUnique<VkImageView>(view, [dev](VkImageView h) { vkDestroyImageView(dev, h, nullptr); });
+
+  ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = 0;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = img;
+    b.subresourceRange = vci.subresourceRange;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &b);
+    const VkClearColorValue zero{};
+    vkCmdClearColorImage(cmd, img, VK_IMAGE_LAYOUT_GENERAL, &zero, 1, &vci.subresourceRange);
+    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0, nullptr);
+  });
+}
+
+namespace {
+void copyBarrier(VkCommandBuffer cmd, VkAccessFlags src, VkPipelineStageFlags srcStage, VkAccessFlags dst,
+                 VkPipelineStageFlags dstStage) {
+  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  mb.srcAccessMask = src;
+  mb.dstAccessMask = dst;
+  vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+}
+}  // namespace
+
+std::vector<int16_t> NormalMapImages::download(Context& ctx) const {
+  const size_t count = size_t(width_) * height_ * layers_ * 2;
+  Buffer staging(ctx, count * sizeof(int16_t), MemoryKind::HostVisible, "normal-map readback");
+  ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    copyBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy c{};
+    c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers_};
+    c.imageExtent = {width_, height_, 1};
+    vkCmdCopyImageToBuffer(cmd, image(), VK_IMAGE_LAYOUT_GENERAL, staging.handle(), 1, &c);
+    computeToHostBarrier(cmd);
+  });
+  std::vector<int16_t> out(count);
+  std::memcpy(out.data(), staging.data(), count * sizeof(int16_t));
+  return out;
+}
+
+void NormalMapImages::upload(Context& ctx, const std::vector<int16_t>& texels) {
+  const size_t count = size_t(width_) * height_ * layers_ * 2;
+  if (texels.size() != count)
+    throw Error("normal-map upload: " + std::to_string(texels.size()) + " values given, " + std::to_string(count) + " expected");
+  Buffer staging(ctx, count * sizeof(int16_t), MemoryKind::HostVisible, "normal-map upload");
+  std::memcpy(staging.data(), texels.data(), count * sizeof(int16_t));
+  ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    copyBarrier(cmd, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy c{};
+    c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers_};
+    c.imageExtent = {width_, height_, 1};
+    vkCmdCopyBufferToImage(cmd, staging.handle(), image(), VK_IMAGE_LAYOUT_GENERAL, 1, &c);
+    copyBarrier(cmd, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+  });
+}
+
+}  // namespace swish::gpu

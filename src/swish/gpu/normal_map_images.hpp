@@ -1,0 +1,50 @@
+#pragma once
+// The per-character normal maps of one frame in flight: a 2D array image, one layer per character,
+// format VK_FORMAT_R16G16_SNORM (tangent-space X and Y; renderers reconstruct Z as
+// sqrt(max(0, 1 - X^2 - Y^2))). Why RG16_SNORM: the temporal filter accumulates small steps every
+// frame, which 8 bits would stall and half floats would round coarsely near +-1; it is a storage
+// format lavapipe and desktop GPUs support (checked: Context::supportsNormalMaps). 2 channels keep
+// 360x360 maps at 0.5 MB per character.
+//
+// Layout: VK_IMAGE_LAYOUT_GENERAL for its whole life (set at creation, contents cleared to 0).
+// Usage: storage (the blend pass), sampled (the host renderer), transfer src/dst (readback, clears).
+// A renderer sampling it after swish's blend pass needs a barrier: compute shader write ->
+// its own stage's shader read, on the queue family of the Context.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "swish/gpu/buffer.hpp"
+#include "swish/gpu/vk_unique.hpp"
+
+namespace swish::gpu {
+
+class Context;
+
+class NormalMapImages {
+ public:
+  static constexpr VkFormat kFormat = VK_FORMAT_R16G16_SNORM;
+
+  NormalMapImages() = default;
+  NormalMapImages(Context& ctx, uint32_t width, uint32_t height, uint32_t layers);
+
+  VkImage image() const { return image_.get(); }
+  VkImageView arrayView() const { return view_.get(); }  // all layers, for the blend pass
+  uint32_t width() const { return width_; }
+  uint32_t height() const { return height_; }
+  uint32_t layers() const { return layers_; }
+
+  // Reads every layer back as int16 pairs (X, Y), layer-major then row-major. Waits.
+  std::vector<int16_t> download(Context& ctx) const;
+  // Overwrites every layer (same layout as download). Waits.
+  void upload(Context& ctx, const std::vector<int16_t>& texels);
+
+ private:
+  VkUnique<VkImage> image_;
+  VkUnique<VkDeviceMemory> memory_;
+  VkUnique<VkImageView> view_;
+  uint32_t width_ = 0, height_ = 0, layers_ = 0;
+};
+
+}  // namespace swish::gpu

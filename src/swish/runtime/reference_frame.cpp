@@ -1,0 +1,58 @@
+#include "swish/runtime/reference_frame.hpp"
+
+#include <span>
+
+#include "swish/core/error.hpp"
+#include "swish/core/mesh_frames.hpp"
+#include "swish/runtime/reference_pca.hpp"
+#include "swish/runtime/reference_skinning.hpp"
+#include "swish/runtime/reference_tangent_frames.hpp"
+
+namespace swish::runtime {
+
+void FrameKernelInputs::validate(const Model& m) const {
+  const size_t n = instanceCount, k = size_t(m.meshComponents()), j = m.skeleton.size();
+  if (meshWeights.size() != n * k)
+    throw Error("frame inputs: " + std::to_string(meshWeights.size()) + " mesh weights for " + std::to_string(n) +
+                " instances x " + std::to_string(k) + " components");
+  if (skinMatrices.size() != n * j)
+    throw Error("frame inputs: " + std::to_string(skinMatrices.size()) + " skinning matrices for " + std::to_string(n) +
+                " instances x " + std::to_string(j) + " joints");
+  if (selectedMaps.empty()) return;
+  if (m.normalMaps.empty()) throw Error("frame inputs: normal maps selected but the model has no normal-map database");
+  if (selectedMaps.size() != n || blendAlpha.size() != n)
+    throw Error("frame inputs: " + std::to_string(selectedMaps.size()) + " selected maps and " + std::to_string(blendAlpha.size()) +
+                " blend weights for " + std::to_string(n) + " instances");
+  for (size_t i = 0; i < n; ++i)
+    if (selectedMaps[i] >= m.normalMaps.mapCount())
+      throw Error("frame inputs: instance " + std::to_string(i) + " selected map " + std::to_string(selectedMaps[i]) +
+                  " of a database of " + std::to_string(m.normalMaps.mapCount()));
+}
+
+ReferenceFrameOutputs referenceFrame(const Model& m, const FrameKernelInputs& in, const std::vector<BlendedNormalMap>& prev) {
+  in.validate(m);
+  const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
+  const MeshFrameTopology topo = buildFrameTopology(m.gameMesh.triangles, m.gameMesh.positions);
+  ReferenceFrameOutputs out;
+  for (uint32_t i = 0; i < in.instanceCount; ++i) {
+    const Points3f pre = referencePcaReconstruct(m.meshPca, std::span(in.meshWeights).subspan(i * k, k));
+    const std::vector<Mat4f> mats(in.skinMatrices.begin() + i * j, in.skinMatrices.begin() + (i + 1) * j);
+    out.positions.push_back(referenceSkin(pre, m.gameMesh.skin, mats));
+    ReferenceTangentFrames f = referenceTangentFrames(out.positions.back(), m.gameMesh, topo);
+    out.normals.push_back(std::move(f.normals));
+    out.tangents.push_back(std::move(f.tangents));
+  }
+  if (!in.selectedMaps.empty()) {
+    if (!prev.empty() && prev.size() != in.instanceCount)
+      throw Error("reference frame: " + std::to_string(prev.size()) + " previous maps for " + std::to_string(in.instanceCount) + " instances");
+    const auto& db = m.normalMaps;
+    for (uint32_t i = 0; i < in.instanceCount; ++i) {
+      BlendedNormalMap map = prev.empty() ? BlendedNormalMap::zeros(db.width, db.height) : prev[i];
+      referenceNormalBlend(map, referenceVqDecode(db, in.selectedMaps[i]), in.blendAlpha[i]);
+      out.normalMaps.push_back(std::move(map));
+    }
+  }
+  return out;
+}
+
+}  // namespace swish::runtime

@@ -1,0 +1,37 @@
+#pragma once
+// The inputs of one frame of the GPU kernels for a batch of instances of one model, and the CPU
+// reference of the whole frame: PCA reconstruction -> skinning -> normals and tangents per instance;
+// VQ decode of each selected map -> temporal blend into each character's normal map. The GPU frame
+// (gpu/frame_recorder.hpp) must reproduce every output within the per-kernel tolerances.
+#include <cstdint>
+#include <vector>
+
+#include "swish/model/model.hpp"
+#include "swish/runtime/reference_normal_blend.hpp"
+
+namespace swish::runtime {
+
+struct FrameKernelInputs {
+  uint32_t instanceCount = 0;
+  std::vector<float> meshWeights;      // instanceCount x K, instance-major (the MLP's mesh weights)
+  std::vector<Mat4f> skinMatrices;     // instanceCount x jointCount (Skeleton::skinningMatrices per instance)
+  std::vector<uint32_t> selectedMaps;  // instanceCount database maps, or empty: no normal-map work this frame
+  std::vector<float> blendAlpha;       // instanceCount weights of the new map (the temporal filter's alpha)
+
+  // Throws Error naming the problem if sizes or map indices do not fit `model`.
+  void validate(const Model& model) const;
+};
+
+struct ReferenceFrameOutputs {
+  std::vector<Points3f> positions;              // per instance, skinned
+  std::vector<Points3f> normals;                // per instance
+  std::vector<Points4f> tangents;               // per instance
+  std::vector<BlendedNormalMap> normalMaps;     // per instance (empty when no maps were selected)
+};
+
+// prevMaps: each character's normal map after the previous frame (empty: all zeros, as the GPU images
+// start).
+ReferenceFrameOutputs referenceFrame(const Model& model, const FrameKernelInputs& inputs,
+                                     const std::vector<BlendedNormalMap>& prevMaps = {});
+
+}  // namespace swish::runtime

@@ -1,0 +1,21 @@
+#include "swish/runtime/reference_pca.hpp"
+
+#include "swish/core/error.hpp"
+
+namespace swish::runtime {
+
+Points3f referencePcaReconstruct(const MeshPca& pca, std::span<const float> weights) {
+  const Eigen::Index k = pca.components();
+  if (Eigen::Index(weights.size()) != k)
+    throw Error("PCA reconstruction: " + std::to_string(weights.size()) + " weights for " + std::to_string(k) + " components");
+  const Eigen::Index n = pca.mean.size() / 3;
+  Points3f out(n, 3);
+  for (Eigen::Index row = 0; row < 3 * n; ++row) {
+    float x = pca.mean[row];
+    for (Eigen::Index c = 0; c < k; ++c) x += pca.basis(row, c) * weights[size_t(c)];
+    out.data()[row] = x;  // row-major N x 3: element (v, a) lives at 3v + a, as in the mean
+  }
+  return out;
+}
+
+}  // namespace swish::runtime
