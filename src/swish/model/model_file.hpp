@@ -1,0 +1,97 @@
+#pragma once
+// The .swish model file: everything the run time needs for one garment, in one checked binary file.
+//
+// ==================================== Layout, format version 1.0 ====================================
+// All integers are unsigned little-endian unless marked i32 (two's complement). f32 is IEEE-754
+// binary32, little-endian, bit pattern kept exactly. There is no padding or alignment anywhere: fields
+// follow each other byte after byte. Matrices are column-major (Eigen's order) unless said otherwise.
+//
+// File header, 32 bytes:
+//   0   u8[8]  magic: 0x89 'S' 'W' 'I' 'S' 'H' 0x0D 0x0A  (0x89 and CR LF catch text-mode mangling)
+//   8   u16    major version = 1. A reader refuses a larger major version.
+//   10  u16    minor version = 0. Minor versions only ADD sections; a reader skips tags it does not
+//              know when the file's minor version is newer than its own, and refuses them otherwise.
+//   12  u32    section count
+//   16  u64    total file size in bytes, header included (catches truncation before anything else)
+//   24  u32    reserved, 0
+//   28  u32    CRC-32 (zlib's, see crc32.hpp) of bytes 0..27
+// Then `section count` sections back to back, ending exactly at the end of the file:
+//   0   u8[4]  tag, ASCII
+//   4   u64    payload size in bytes
+//   12  u32    CRC-32 of the payload
+//   16  u8[payload size] payload; every payload must be read to its last byte (trailing bytes = error)
+//
+// Sections of version 1.0: each exactly once, all required, any order (the writer uses this one).
+//   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
+//          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
+//          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
+//   "INPJ" input joints: u32 n, u32[n] skeleton joint indices. Theta = their 6D rotations in order.
+//   "NRMI" input normalisation over Theta:   u32 n, f32[n] mean, f32[n] scale. x' = (x - mean) / scale.
+//   "NRMO" output normalisation over Lambda: u32 n, f32[n] mean, f32[n] scale.
+//   "MLP " u32 layer count; per layer: u32 out, u32 in, f32[out*in] weight (column-major, out x in),
+//          f32[out] bias. SELU follows every layer but the last.
+//   "MPCA" mesh PCA in pre-skinning space: u32 R (= 3 x vertex count), u32 K components, f32[R] mean,
+//          f32[R*K] basis column-major (component after component). Row 3v+a is vertex v, axis a.
+//   "MESH" game mesh: u32 N vertices, u32 T triangles, u32 attribute flags (bit 0 normals, bit 1
+//          tangents, bit 2 UVs; other bits must be 0), f32[3N] positions (x y z per vertex), then
+//          if flagged f32[3N] rest normals, f32[4N] rest tangents (x y z, w = bitangent sign),
+//          f32[2N] UVs; then u32[3T] triangle vertex indices.
+//   "SKIN" skin weights: u32 I influences per vertex (0..8; 0 means no skin, and then N is 0), u32 N
+//          vertices, u16[N*I] joint indices (vertex after vertex), f32[N*I] weights.
+//   "NMDB" normal-map database: u32 width, u32 height (multiples of 4; both 0 with no maps), u32 M
+//          maps, u32 C code dimensions, u32 E codebook entries, f32[M*C] keys (map after map),
+//          i8[E*32] codebook (entry after entry; 16 texels of a 4x4 block row-major, X then Y,
+//          snorm8), u16[M * (width/4) * (height/4)] block indices (map after map, blocks row-major).
+//          M = 0 is a model without normal maps. Decoding: see NormalMapDatabase in model.hpp.
+//   "TFLT" temporal filter: f32 time constant in seconds (0 = no filtering).
+//   "META" free-form metadata, UTF-8 JSON text, the whole payload, no terminator.
+// After parsing, Model::validate checks every index and size the run time relies on.
+// =====================================================================================================
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "swish/model/model.hpp"
+
+namespace swish {
+
+constexpr uint16_t kModelFileMajorVersion = 1;
+constexpr uint16_t kModelFileMinorVersion = 0;
+constexpr std::array<uint8_t, 8> kModelFileMagic = {0x89, 'S', 'W', 'I', 'S', 'H', 0x0D, 0x0A};
+constexpr size_t kModelFileHeaderBytes = 32;
+constexpr size_t kModelSectionHeaderBytes = 16;
+
+// The model as bytes of the current format version. Validates the model first (Error if invalid).
+std::vector<uint8_t> serializeModel(const Model& model);
+// Parses and validates; `sourceName` (usually the file name) starts every error message.
+Model deserializeModel(std::span<const uint8_t> bytes, const std::string& sourceName);
+
+// Validates, serializes and writes atomically: on failure the file at `path` is left as it was.
+void saveModel(const Model& model, const std::filesystem::path& path);
+// Reads and deserializes; a missing or unreadable file is an Error naming it.
+Model loadModel(const std::filesystem::path& path);
+
+// The container level of a file, for tools (`swish inspect`): header and sections with their sizes,
+// after checking the magic, version, sizes and every checksum (Error otherwise), without parsing the
+// payloads.
+struct ModelFileSection {
+  std::string tag;       // 4 characters
+  uint64_t offset = 0;   // of the section header from the start of the file
+  uint64_t payloadBytes = 0;
+  uint32_t crc = 0;
+  bool known = true;     // false: a section of a newer minor version that this reader skips
+};
+struct ModelFileInfo {
+  uint16_t majorVersion = 0, minorVersion = 0;
+  uint64_t totalBytes = 0;
+  std::vector<ModelFileSection> sections;
+};
+ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::string& sourceName);
+
+// The whole file as bytes (Error naming the file when it cannot be read).
+std::vector<uint8_t> readFileBytes(const std::filesystem::path& path);
+
+}  // namespace swish
