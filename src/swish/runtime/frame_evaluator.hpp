@@ -1,0 +1,87 @@
+#pragma once
+// The per-frame CPU side of the runtime for N characters of one model (paper section 2.3, steps 1, 2
+// and 4): local joint rotations -> Theta -> MLP -> mesh weights + normal code -> nearest database map ->
+// temporal filter. What comes out is plain arrays for the GPU passes (no Vulkan here): mesh weights for
+// the deform pass, and per character the map to blend in and its blend factor for the normal-map pass.
+//
+// Data problems never stop the frame and are never silent: each frame's output lists the joints whose
+// quaternions were renormalised or replaced (with the character), the characters whose normal code was
+// not finite (they keep their previous map, map 0 on a first frame), and those whose dt was negative or
+// NaN (treated as 0). Wrong sizes (a programming error of the caller) throw Error.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "swish/core/skeleton.hpp"
+#include "swish/model/model.hpp"
+#include "swish/runtime/mlp_evaluator.hpp"
+#include "swish/runtime/nearest_code.hpp"
+#include "swish/runtime/temporal_filter.hpp"
+#include "swish/runtime/theta.hpp"
+
+namespace swish::runtime {
+
+inline constexpr uint32_t kNoMap = 0xFFFFFFFFu;  // mapIndex of a model without a normal-map database
+
+struct FrameTimings {  // seconds of wall clock spent in each stage of the last evaluate()
+  double theta = 0, mlp = 0, lookup = 0, filter = 0, total = 0;
+};
+
+struct CharacterJointIssue {
+  uint32_t character = 0;
+  ThetaJointIssue joint;
+};
+
+struct FrameOutput {
+  uint32_t characters = 0, meshComponents = 0, codeDims = 0;
+  // characters x K, character c's weights at [c*K, c*K + K): the deform pass's K x N column-major array.
+  std::vector<float> meshWeights;
+  std::vector<float> normalCodes;  // characters x C, same layout
+  std::vector<uint32_t> mapIndex;  // per character: the map to blend in (kNoMap without a database)
+  std::vector<float> blendAlpha;   // per character: its blend factor (1 on a first frame; 0 without a database)
+  std::vector<BlendStep> blend;    // per character: the full filter step (empty without a database)
+  // This frame's data problems.
+  std::vector<CharacterJointIssue> jointIssues;
+  std::vector<uint32_t> nonFiniteCode;  // characters whose code was NaN/Inf (kept their previous map)
+  std::vector<uint32_t> invalidDt;      // characters whose dt was negative or NaN
+  FrameTimings timings;
+};
+
+class FrameEvaluator {
+ public:
+  // Validates the model (Model::validate) and builds the MLP, the search and one filter per character.
+  FrameEvaluator(const Model& model, uint32_t characters, CpuKernel kernel = CpuKernel::Auto);
+
+  uint32_t characters() const { return characters_; }
+  uint32_t jointsPerCharacter() const { return joints_; }
+  bool hasNormalMaps() const { return search_.has_value(); }
+  const MlpEvaluator& mlp() const { return mlp_; }
+
+  // rotations: characters() x jointsPerCharacter() local rotations (Pose::local of each character, one
+  // after the other). dtSeconds: one per character, or a single value for all.
+  const FrameOutput& evaluate(std::span<const Quatf> rotations, std::span<const float> dtSeconds);
+  const FrameOutput& evaluate(std::span<const Quatf> rotations, float dtSeconds);
+  // The same from one Pose per character.
+  const FrameOutput& evaluate(std::span<const Pose> poses, float dtSeconds);
+
+  // The character's next frame starts without history (alpha 1): after a teleport or a respawn.
+  void resetCharacter(uint32_t character);
+  const FrameOutput& output() const { return out_; }
+
+ private:
+  void beginFrame();
+  void thetaOf(uint32_t character, std::span<const Quatf> localRotations);
+  const FrameOutput& finishFrame(std::span<const float> dtSeconds, double thetaStart);
+
+  std::vector<uint32_t> inputJoints_;
+  uint32_t characters_ = 0, joints_ = 0;
+  MlpEvaluator mlp_;
+  std::optional<NearestCodeSearch> search_;
+  std::vector<TemporalFilter> filters_;
+  std::vector<float> theta_;  // characters x thetaSize
+  std::vector<ThetaJointIssue> issueScratch_;
+  FrameOutput out_;
+};
+
+}  // namespace swish::runtime

@@ -1,0 +1,73 @@
+// MLP inference on one core: the paper's network, 32 -> 5 x 32 SELU -> 30, batch of 22 (a Madden team on
+// the field) and batch of 1. Goal: <= 0.5 us per instance (paper's console figure: 20 us; arithmetic floor
+// of 6,080 multiply-adds at 16 per cycle: about 0.11 us). The per-instance time is the counter
+// "us_per_instance" (a rate counter inverted: seconds per instance, shown in us).
+//
+//   build-*/tests/bench_mlp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <vector>
+
+#include "swish/core/rng.hpp"
+#include "swish/runtime/mlp_evaluator.hpp"
+
+using namespace swish;
+using namespace swish::runtime;
+
+namespace {
+
+struct PaperNetwork {
+  Mlp mlp;
+  Normalisation in, out;
+  static constexpr int kInputs = 32, kHidden = 32, kHiddenLayers = 5, kOutputs = 30, kMeshComponents = 20;
+
+  PaperNetwork() {
+    Rng rng(2021);
+    int prev = kInputs;
+    for (int l = 0; l <= kHiddenLayers; ++l) {
+      const int width = l < kHiddenLayers ? kHidden : kOutputs;
+      MlpLayer L;
+      L.weight.resize(width, prev);
+      L.bias.resize(width);
+      const double sd = 1.0 / std::sqrt(double(prev));  // LeCun normal, as SELU training would give
+      for (Eigen::Index i = 0; i < L.weight.size(); ++i) L.weight.data()[i] = float(rng.normal(0, sd));
+      for (Eigen::Index i = 0; i < L.bias.size(); ++i) L.bias[i] = float(rng.normal(0, 0.1));
+      mlp.layers.push_back(std::move(L));
+      prev = width;
+    }
+    in.mean = VecXf::Constant(kInputs, 0.1f);
+    in.scale = VecXf::Constant(kInputs, 0.5f);
+    out.mean = VecXf::Constant(kOutputs, 0.2f);
+    out.scale = VecXf::Constant(kOutputs, 2.f);
+  }
+};
+
+void runMlp(benchmark::State& state, CpuKernel kernel) {
+  static const PaperNetwork net;
+  const MlpEvaluator eval(net.mlp, net.in, net.out, PaperNetwork::kMeshComponents, kernel);
+  const size_t batch = size_t(state.range(0));
+  Rng rng(7);
+  std::vector<float> theta(batch * PaperNetwork::kInputs), lambda(batch * PaperNetwork::kOutputs);
+  for (float& t : theta) t = rng.uniformf(-1.f, 1.f);  // the range of 6D rotation entries
+  for (auto _ : state) {
+    eval.evaluateBatch(theta, lambda, batch);
+    benchmark::DoNotOptimize(lambda.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(toString(eval.kernel()));
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(batch));
+  // kIsRate|kInvert turns instances per second into seconds per instance.
+  state.counters["time_per_instance"] = benchmark::Counter(double(state.iterations()) * double(batch),
+                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_MlpAuto(benchmark::State& state) { runMlp(state, CpuKernel::Auto); }
+void BM_MlpPortable(benchmark::State& state) { runMlp(state, CpuKernel::Portable); }
+
+}  // namespace
+
+BENCHMARK(BM_MlpAuto)->Arg(22)->Arg(1)->Arg(256);
+BENCHMARK(BM_MlpPortable)->Arg(22)->Arg(1);
+
+BENCHMARK_MAIN();
