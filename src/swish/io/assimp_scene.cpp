@@ -10,7 +10,7 @@
 
 namespace swish::io {
 
-const aiScene& readAssimpScene(Assimp::Importer& importer, const std::filesystem::path& path) {
+const aiScene& readAssimpScene(Assimp::Importer& importer, const std::filesystem::path& path, bool animationOnly) {
   const std::string file = path.string();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw Error(file + ": no such file");
@@ -26,7 +26,7 @@ const aiScene& readAssimpScene(Assimp::Importer& importer, const std::filesystem
     const std::string why = importer.GetErrorString();
     throw Error(file + ": cannot read (" + (why.empty() ? "unknown format or corrupt file" : why) + ")");
   }
-  if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) && !(animationOnly && scene->mNumAnimations > 0))
     throw Error(file + ": the file is incomplete or corrupt (assimp could only read part of it)");
   return *scene;
 }

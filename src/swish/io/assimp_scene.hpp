@@ -12,7 +12,9 @@ namespace swish::io {
 // Throws Error naming the file when it is missing, unreadable, or assimp cannot make a scene of it.
 // UVs come out in glTF's convention (v = 0 at the top of the image) whatever the format; glTF files
 // keep their vertex order and count (no vertex joining), other formats get identical vertices joined.
-const aiScene& readAssimpScene(Assimp::Importer& importer, const std::filesystem::path& file);
+// animationOnly: a file with animation but no meshes (assimp flags those incomplete) is accepted.
+const aiScene& readAssimpScene(Assimp::Importer& importer, const std::filesystem::path& file,
+                                bool animationOnly = false);
 
 inline Eigen::Matrix4d toEigen(const aiMatrix4x4& m) {
   Eigen::Matrix4d e;

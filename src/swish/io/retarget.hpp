@@ -1,0 +1,40 @@
+#pragma once
+// Retargeting a clip onto a character's skeleton with rest-pose correction.
+//
+// The clip's rest (a BVH T-pose with its own offsets) and the character's rest (an A-pose with
+// identity joint rotations) differ, so copying local rotations would be wrong. Instead, per mapped
+// joint h driven by clip joint s, a rest alignment A_h (a world rotation) takes the character's rest
+// bone directions (to its mapped children) onto the clip's rest bone directions: for one child the
+// smallest rotation after the parent's alignment (so the twist follows the parent), for several the
+// least-squares rotation (Kabsch) of all of them. Then, per frame,
+//     R_h(t) = R_s(t) * R_s(rest)^-1 * A_h * R_h(rest)          (global rotations)
+// so each character bone points where the clip's bone points. Unmapped joints keep their rest local
+// rotation. Root translation: the character's rest root plus the clip root's displacement from its
+// first frame, scaled by the ratio of the skeletons' mapped bone lengths (clip units -> metres).
+#include <string>
+#include <vector>
+
+#include "swish/core/character.hpp"
+#include "swish/io/joint_map.hpp"
+#include "swish/io/source_animation.hpp"
+
+namespace swish::io {
+
+struct RetargetOptions {
+  JointMapOptions jointMap;
+  // Character joints that must be driven by the clip (Error naming the unmatched ones). The root is
+  // always required.
+  std::vector<std::string> requiredJoints = defaultInputJointNames();
+  float rootTranslationScale = 0.f;  // 0: from the bone length ratio
+};
+
+struct RetargetReport {
+  JointMapping mapping;
+  float rootTranslationScale = 1.f;
+  std::vector<std::string> unmappedCharacterJoints;
+};
+
+AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, const RetargetOptions& options = {},
+                       RetargetReport* report = nullptr);
+
+}  // namespace swish::io
