@@ -59,10 +59,12 @@ std::string unusableReason(VkPhysicalDevice pd) {
   if (props.apiVersion < VK_API_VERSION_1_3)
     return "supports Vulkan " + versionString(props.apiVersion) + ", swish needs 1.3 (update the driver)";
   if (!computeQueueFamily(pd)) return "has no compute queue";
-  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
   VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
   vkGetPhysicalDeviceFeatures2(pd, &f);
   if (!f12.bufferDeviceAddress) return "lacks the bufferDeviceAddress feature";
+  if (!f13.maintenance4) return "lacks the maintenance4 feature";
   return "";
 }
 
@@ -322,7 +324,10 @@ Context Context::create(const ContextOptions& options) {
 
   VkPhysicalDeviceFeatures supported;
   vkGetPhysicalDeviceFeatures(impl->physicalDevice, &supported);
-  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  // maintenance4: the shaders size workgroups with specialisation constants (SPIR-V LocalSizeId).
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  f13.maintenance4 = VK_TRUE;
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
   f12.bufferDeviceAddress = VK_TRUE;
   VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
   f.features.shaderStorageImageExtendedFormats = supported.shaderStorageImageExtendedFormats;

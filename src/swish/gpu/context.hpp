@@ -10,7 +10,7 @@
 //
 // Required of the device (swish enables them on its own device; a host must have enabled them on an
 // adopted one): Vulkan 1.3, a compute queue, bufferDeviceAddress (buffers are passed to kernels as
-// addresses in push constants). For normal maps also shaderStorageImageExtendedFormats and storage
+// addresses in push constants), maintenance4 (workgroup sizes are specialisation constants). For normal maps also shaderStorageImageExtendedFormats and storage
 // image support of VK_FORMAT_R16G16_SNORM. Missing ones give a swish::Error saying which.
 //
 // Validation: ContextOptions::validation, or SWISH_VALIDATION=1, enables VK_LAYER_KHRONOS_validation

@@ -1,0 +1,226 @@
+// Conformance of the deform kernel (shaders/deform.comp via gpu::DeformPass) to its CPU references:
+// runtime::referencePcaReconstruct (skinning off) and runtime::referenceSkin (skinning on), on seeded
+// random models (seed printed; SWISH_TEST_SEED overrides), odd sizes, many instances, NaN/Inf inputs
+// and exactly representable inputs. Every output is followed by guard words; every input is checked
+// unchanged afterwards.
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "support/gpu_buffers.hpp"
+#include "support/gpu_compare.hpp"
+#include "support/gpu_test.hpp"
+#include "support/random_model.hpp"
+#include "swish/gpu/deform_pass.hpp"
+#include "swish/runtime/reference_pca.hpp"
+#include "swish/runtime/reference_skinning.hpp"
+
+namespace swish {
+namespace {
+
+using test::CheckedInput;
+using test::GuardedOutput;
+
+struct DeformCase {
+  uint32_t vertices, components, influences, instances;
+};
+
+struct DeformInputs {
+  Model model;
+  std::vector<float> weights;   // instances x K
+  std::vector<Mat4f> matrices;  // instances x joints
+  uint32_t instances = 0;
+};
+
+DeformInputs randomInputs(uint64_t seed, const DeformCase& c) {
+  Rng rng(seed);
+  test::RandomModelSpec spec;
+  spec.vertices = c.vertices;
+  spec.meshComponents = c.components;
+  spec.influences = c.influences;
+  spec.normalMaps = 0;
+  DeformInputs in;
+  in.model = test::makeRandomModel(rng, spec);
+  in.instances = c.instances;
+  for (uint32_t i = 0; i < c.instances * c.components; ++i) in.weights.push_back(float(rng.normal(0, 2)));
+  for (uint32_t i = 0; i < c.instances; ++i) {
+    Pose pose = test::makeRandomPose(rng, in.model.skeleton);
+    pose.rootTranslation = Vec3f(rng.uniformf(-2, 2), rng.uniformf(0, 1), rng.uniformf(-2, 2));
+    const auto m = in.model.skeleton.skinningMatrices(pose);
+    in.matrices.insert(in.matrices.end(), m.begin(), m.end());
+  }
+  return in;
+}
+
+struct GpuDeformResult {
+  std::vector<float> positions;
+  std::vector<std::string> problems;  // guard or input violations
+};
+
+GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinning) {
+  const Model& m = in.model;
+  const uint32_t n = uint32_t(m.gameMesh.vertexCount()), k = uint32_t(m.meshComponents());
+  const std::vector<uint32_t> joints(m.gameMesh.skin.joints.begin(), m.gameMesh.skin.joints.end());
+  CheckedInput mean(ctx, std::span<const float>(m.meshPca.mean.data(), 3 * n), "mean");
+  CheckedInput basis(ctx, std::span<const float>(m.meshPca.basis.data(), size_t(m.meshPca.basis.size())), "basis");
+  CheckedInput weights(ctx, std::span<const float>(in.weights), "weights");
+  CheckedInput matrices(ctx, std::span<const float>(in.matrices.front().data(), in.matrices.size() * 16), "skin matrices");
+  CheckedInput skinJoints(ctx, std::span<const uint32_t>(joints), "skin joints");
+  CheckedInput skinWeights(ctx, std::span<const float>(m.gameMesh.skin.weights), "skin weights");
+  GuardedOutput out(ctx, size_t(in.instances) * n * 3 * sizeof(float), "deformed positions");
+
+  const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), skinning);
+  gpu::DeformPass::Args a;
+  a.mean = mean.address();
+  a.basis = basis.address();
+  a.weights = weights.address();
+  a.skinMatrices = matrices.address();
+  a.skinJoints = skinJoints.address();
+  a.skinWeights = skinWeights.address();
+  a.positionsOut = out.address();
+  a.vertexCount = n;
+  a.instanceCount = in.instances;
+  a.jointCount = uint32_t(m.skeleton.size());
+  ctx.submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, a); });
+
+  GpuDeformResult r;
+  r.positions = out.read<float>(ctx);
+  for (const CheckedInput* c : {&mean, &basis, &weights, &matrices, &skinJoints, &skinWeights})
+    if (auto s = c->unchanged(ctx); !s.empty()) r.problems.push_back(s);
+  if (auto s = out.guardsIntact(ctx); !s.empty()) r.problems.push_back(s);
+  return r;
+}
+
+std::vector<float> referencePositions(const DeformInputs& in, bool skinning) {
+  const Model& m = in.model;
+  const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
+  std::vector<float> out;
+  for (uint32_t i = 0; i < in.instances; ++i) {
+    Points3f p = runtime::referencePcaReconstruct(m.meshPca, std::span(in.weights).subspan(i * k, k));
+    if (skinning)
+      p = runtime::referenceSkin(p, m.gameMesh.skin,
+                                 std::vector<Mat4f>(in.matrices.begin() + i * j, in.matrices.begin() + (i + 1) * j));
+    out.insert(out.end(), p.data(), p.data() + p.size());
+  }
+  return out;
+}
+
+// PCA tolerance: the reference sums K products onto the mean in float. A device may contract each
+// multiply-add into an FMA or reorder nothing else, so each of the K additions can round differently:
+// the error is bounded by (K + 1) * eps * (|mean| + sum_k |basis_k * w_k|) (the standard gamma_K bound
+// of a length-K reduction), evaluated per element from the inputs.
+std::function<double(size_t)> pcaTolerance(const DeformInputs& in) {
+  const Model& m = in.model;
+  const size_t k = size_t(m.meshComponents()), rows = size_t(m.meshPca.mean.size());
+  auto bound = std::make_shared<std::vector<double>>(in.instances * rows);
+  for (uint32_t i = 0; i < in.instances; ++i)
+    for (size_t r = 0; r < rows; ++r) {
+      double mag = std::abs(double(m.meshPca.mean[Eigen::Index(r)]));
+      for (size_t c = 0; c < k; ++c) mag += std::abs(double(m.meshPca.basis(Eigen::Index(r), Eigen::Index(c))) * in.weights[i * k + c]);
+      (*bound)[i * rows + r] = double(k + 1) * FLT_EPSILON * mag;
+    }
+  return [bound](size_t e) { return (*bound)[e]; };
+}
+
+// Skinning tolerance, absolute + relative: on top of the PCA error, the blend of up to 8 matrices and
+// the 3x3 product + translation add about 16 roundings. 2 um + 1e-5 relative (~80 float ulps of the
+// position) admits FMA-contracting drivers, while any wrong joint, weight, matrix or instance moves
+// a vertex by millimetres or more and fails.
+double skinTolerance(float reference) { return 2e-6 + 1e-5 * std::abs(double(reference)); }
+
+std::string caseName(const ::testing::TestParamInfo<DeformCase>& info) {
+  const auto& c = info.param;
+  return "V" + std::to_string(c.vertices) + "_K" + std::to_string(c.components) + "_Inf" + std::to_string(c.influences) + "_I" +
+         std::to_string(c.instances);
+}
+
+class DeformConformance : public test::GpuTest, public ::testing::WithParamInterface<DeformCase> {};
+
+TEST_P(DeformConformance, PcaReconstructionMatchesReference) {
+  const uint64_t seed = test::testSeed(0xDEF0 + GetParam().vertices);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const DeformInputs in = randomInputs(seed, GetParam());
+  const auto gpu = runDeform(ctx(), in, false);
+  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+  test::CompareReport rep;
+  EXPECT_TRUE(test::matchesReference("pre-skinning positions", gpu.positions, referencePositions(in, false), pcaTolerance(in), &rep));
+  std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
+}
+
+TEST_P(DeformConformance, SkinnedPositionsMatchReference) {
+  const uint64_t seed = test::testSeed(0x5C1 + GetParam().vertices);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const DeformInputs in = randomInputs(seed, GetParam());
+  const auto gpu = runDeform(ctx(), in, true);
+  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+  const auto ref = referencePositions(in, true);
+  test::CompareReport rep;
+  EXPECT_TRUE(test::matchesReference("skinned positions", gpu.positions, ref, [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
+  std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
+}
+
+// Odd sizes: 1 vertex, a prime count, a large prime count; 1, 3 and 22 instances; K = 1, 5, 30;
+// the 64-component case puts 150 instances in 3 chunks of the kernel's shared-memory weight staging.
+INSTANTIATE_TEST_SUITE_P(Sizes, DeformConformance,
+                         ::testing::Values(DeformCase{1, 1, 1, 1}, DeformCase{7, 5, 4, 3}, DeformCase{997, 30, 4, 22},
+                                           DeformCase{997, 7, 8, 5}, DeformCase{100003, 2, 4, 2}, DeformCase{97, 64, 3, 150}),
+                         caseName);
+
+class DeformSpecialValues : public test::GpuTest {};
+
+// NaN/Inf placement: each poisoned input must reach exactly the outputs the reference says it reaches.
+TEST_F(DeformSpecialValues, NanAndInfReachExactlyTheReferenceOutputs) {
+  const uint64_t seed = test::testSeed(0xBAD);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  DeformInputs in = randomInputs(seed, {61, 6, 4, 4});
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  in.model.meshPca.basis(3 * 17 + 1, 2) = nan;  // vertex 17 (y), every instance
+  in.weights[2 * 6 + 4] = nan;                  // instance 2, every vertex
+  const uint16_t joint = in.model.gameMesh.skin.joints[5 * 4];  // a joint vertex 5 uses
+  in.matrices[3 * in.model.skeleton.size() + joint](0, 3) = inf;  // instance 3's translation x of that joint
+  in.model.gameMesh.skin.weights[9 * 4 + 1] = 0.f;                // a zero weight: skipped, so...
+  in.matrices[1 * in.model.skeleton.size() + in.model.gameMesh.skin.joints[9 * 4 + 1]](1, 1) = nan;  // ...no NaN unless used
+  const auto gpu = runDeform(ctx(), in, true);
+  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+  const auto ref = referencePositions(in, true);
+  test::CompareReport rep;
+  EXPECT_TRUE(test::matchesReference("skinned positions with NaN/Inf inputs", gpu.positions, ref,
+                                     [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
+  // The poison must be neither absent nor everywhere, or the test would prove nothing.
+  EXPECT_GT(rep.nonFinite, 61u * 3);
+  EXPECT_LT(rep.nonFinite, ref.size());
+}
+
+// Small integers and binary fractions: every sum and product is exact in float, so GPU and reference
+// must agree bit for bit (tolerance 0).
+TEST_F(DeformSpecialValues, ExactlyRepresentableInputsGiveExactResults) {
+  Rng rng(test::testSeed(0xE8AC7));
+  DeformInputs in = randomInputs(7, {40, 3, 2, 3});
+  Model& m = in.model;
+  for (Eigen::Index i = 0; i < m.meshPca.mean.size(); ++i) m.meshPca.mean[i] = float(int(rng.below(64)) - 32);
+  for (Eigen::Index i = 0; i < m.meshPca.basis.size(); ++i) m.meshPca.basis.data()[i] = float(int(rng.below(16)) - 8) * 0.25f;
+  for (auto& w : in.weights) w = float(int(rng.below(8)) - 4) * 0.5f;
+  for (size_t v = 0; v < m.gameMesh.vertexCount(); ++v) {
+    m.gameMesh.skin.weights[2 * v] = (v % 3 == 0) ? 1.f : 0.5f;
+    m.gameMesh.skin.weights[2 * v + 1] = (v % 3 == 0) ? 0.f : 0.5f;
+  }
+  for (auto& mat : in.matrices) {  // signed axis permutations with integer translations
+    const int axis = int(rng.below(3));
+    mat = Mat4f::Zero();
+    for (int r = 0; r < 3; ++r) mat(r, (r + axis) % 3) = rng.below(2) ? 1.f : -1.f;
+    mat(3, 3) = 1.f;
+    for (int r = 0; r < 3; ++r) mat(r, 3) = float(int(rng.below(20)) - 10);
+  }
+  for (bool skinning : {false, true}) {
+    const auto gpu = runDeform(ctx(), in, skinning);
+    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+    EXPECT_TRUE(test::matchesReference(skinning ? "skinned positions" : "PCA positions", gpu.positions,
+                                       referencePositions(in, skinning), [](size_t) { return 0.0; }));
+  }
+}
+
+}  // namespace
+}  // namespace swish
