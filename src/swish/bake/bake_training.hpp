@@ -1,0 +1,64 @@
+#pragma once
+// Part 2 of the bake (paper 2.2 from the training data on): Dataset -> mesh PCA, normal-map PCA,
+// k-means database, VQ, MLP -> validated Model, plus every measurement the bake report shows.
+// Poses are split once (seeded) into a training set and a held-out test set that nothing is fitted on.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "swish/bake/bake_evaluation.hpp"
+#include "swish/bake/dataset.hpp"
+#include "swish/bake/mlp_trainer.hpp"
+#include "swish/bake/normal_map_database.hpp"
+#include "swish/bake/normal_map_pca.hpp"
+#include "swish/bake/vq_codebook.hpp"
+#include "swish/model/model.hpp"
+
+namespace swish::bake {
+
+struct BakeTrainSettings {
+  int meshComponents = 24;         // K upper bound
+  double meshVariance = 0.0;       // if > 0: smallest K reaching this explained variance (<= meshComponents)
+  int normalCodeDims = 8;          // C (0: no normal maps in the model)
+  int databaseSize = 128;
+  VqOptions vq;
+  bool bc5Baseline = true;
+  MlpTrainOptions mlp;
+  double testFraction = 0.1;       // held out for the report
+  float temporalTimeConstant = 0.1f;
+  uint64_t seed = 1;
+
+  nlohmann::json toJson() const;
+};
+
+struct StageTime {
+  std::string stage;
+  double seconds = 0.0;
+};
+
+struct BakeTrainOutput {
+  Model model;
+  PcaResult meshPca;
+  NormalMapPca normalPca;
+  DatabaseSelection database;
+  std::vector<const NormalMapImage*> databaseMaps;  // uncompressed, pointing into the dataset
+  VqReport vq;
+  AngularErrorStats vqVsUncompressed, bc5VsUncompressed;
+  uint64_t bc5Bytes = 0, uncompressedBytes = 0;
+  MlpTrainResult regressor;
+  BakeEvaluation evaluation;
+  std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
+  std::vector<StageTime> stages;
+  nlohmann::json metadata;                          // what went into Model::metadata
+};
+
+// Progress: (stage, fraction of part 2 done in [0, 1]).
+using BakeProgress = std::function<void(const std::string& stage, double fraction)>;
+
+// The dataset must outlive the output (databaseMaps points into it). Throws Error for datasets it
+// cannot train on (fewer than 3 poses, mismatched mesh sizes, maps of mixed sizes, ...).
+BakeTrainOutput trainBake(const Dataset& dataset, const BakeTrainSettings& settings, const BakeProgress& progress = {});
+
+}  // namespace swish::bake
