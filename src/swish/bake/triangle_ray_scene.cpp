@@ -63,6 +63,9 @@ TriangleRayScene::TriangleRayScene(const Points3f& positions, const Triangles& t
                                   std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  // Robust mode: watertight edges, so a ray through a shared edge or vertex cannot slip between the
+  // two triangles (texel rays hit edges exactly whenever game and simulation meshes coincide).
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
   RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                          3 * sizeof(float), size_t(positions.rows())));
