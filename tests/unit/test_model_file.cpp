@@ -554,6 +554,18 @@ TEST(ModelFile, StructuralProblemsAreNamed) {
     std::reverse(e.begin(), e.end());
     expectBitwiseEqual(swish::deserializeModel(assemble(e), "reversed"), smallModel());
   }
+  {  // a NaN rest normal: parsed, then refused by validation
+    auto e = sections;
+    auto& mesh = sectionOf(e, "MESH").payload;
+    const size_t firstNormal = 12 + 12 * smallModel().gameMesh.vertexCount();
+    putU32(mesh, firstNormal, 0x7FC00000u);
+    EXPECT_CONTAINS(loadError(assemble(e)), "model.swish: game mesh: has non-finite rest normals or tangents");
+  }
+  {  // a NaN MLP weight
+    auto e = sections;
+    putU32(sectionOf(e, "MLP ").payload, 12, 0x7FC00000u);
+    EXPECT_CONTAINS(loadError(assemble(e)), "model.swish: mlp: layer 0 has non-finite values");
+  }
   {  // unknown attribute flags in the mesh
     auto e = sections;
     putU32(sectionOf(e, "MESH").payload, 8, 0x17);

@@ -55,6 +55,9 @@ void Model::validate(const std::string& what) const {
   if (size_t(gameMesh.uvs.rows()) != n) fail("game mesh", "needs one UV per vertex");
   if (size_t(gameMesh.normals.rows()) != n || size_t(gameMesh.tangents.rows()) != n)
     fail("game mesh", "needs rest normals and tangents for every vertex");
+  // Mesh::validate leaves these alone (they are optional there); the runtime's tangent frames use them.
+  if (!gameMesh.normals.allFinite() || !gameMesh.tangents.allFinite())
+    fail("game mesh", "has non-finite rest normals or tangents");
   if (size_t(meshPca.mean.size()) != 3 * n)
     fail("mesh pca", "mean has " + n2s(meshPca.mean.size()) + " values for " + n2s(n) + " vertices (3 each)");
   if (size_t(meshPca.basis.rows()) != 3 * n)
