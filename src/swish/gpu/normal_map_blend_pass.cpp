@@ -1,11 +1,16 @@
 #include "swish/gpu/normal_map_blend_pass.hpp"
 
+#include <cstddef>
+
 #include "shaders/swish_layouts.h"
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/normal_map_images.hpp"
 #include "swish/gpu/vk_check.hpp"
 
 namespace swish::gpu {
+
+static_assert(sizeof(NormalMapBlendPass::Character) == sizeof(layout::NormalMapBlendCharacter) &&
+              offsetof(NormalMapBlendPass::Character, alpha) == offsetof(layout::NormalMapBlendCharacter, alpha));
 
 NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t maxBindings) : device_(ctx.device()) {
   const VkDevice dev = device_;

@@ -21,11 +21,18 @@ class NormalMapImages;
 
 class NormalMapBlendPass {
  public:
+  // One character's entry of the `characters` buffer (layout::NormalMapBlendCharacter in
+  // shaders/swish_layouts.h; the .cpp asserts they match).
+  struct Character {
+    uint32_t decodedSlot;  // slot of the decoded map this character selected
+    float alpha;           // weight of the new map
+  };
+
   static constexpr uint32_t kWorkgroupSize = 8;  // 8x8 texels
 
   struct Args {
     VkDeviceAddress decoded = 0;     // VqDecodePass output
-    VkDeviceAddress characters = 0;  // layout::NormalMapBlendCharacter[characterCount]
+    VkDeviceAddress characters = 0;  // Character[characterCount]
     uint32_t width = 0, height = 0;
     uint32_t characterCount = 0;     // <= layers of the bound images
   };

@@ -1,0 +1,174 @@
+// Conformance of the normal-map kernels to their CPU references: VQ decode (shaders/vq_decode.comp,
+// runtime::referenceVqDecode) must be EXACT (it is a lossless gather of snorm8 bytes); the temporal
+// blend (shaders/normal_map_blend.comp, runtime::referenceNormalBlend) must match within 1 LSB of
+// snorm16, because Vulkan lets a device round float -> snorm to either neighbour; alpha = 0 and 1 are
+// exact. Seeded random databases (seed printed; SWISH_TEST_SEED overrides), odd sizes, maps selected
+// several times, out-of-range indices, guard words and unchanged inputs.
+#include <cstdio>
+
+#include "support/gpu_buffers.hpp"
+#include "support/gpu_compare.hpp"
+#include "support/gpu_test.hpp"
+#include "support/random_model.hpp"
+#include "swish/gpu/normal_map_blend_pass.hpp"
+#include "swish/gpu/normal_map_images.hpp"
+#include "swish/gpu/vq_decode_pass.hpp"
+#include "swish/runtime/reference_normal_blend.hpp"
+#include "swish/runtime/reference_vq_decode.hpp"
+
+namespace swish {
+namespace {
+
+using test::CheckedInput;
+using test::GuardedOutput;
+
+NormalMapDatabase randomDatabase(Rng& rng, uint32_t size, uint32_t maps, uint32_t codebook) {
+  test::RandomModelSpec spec;
+  spec.vertices = 4;
+  spec.normalMaps = maps;
+  spec.mapSize = size;
+  spec.codebookSize = codebook;
+  NormalMapDatabase db = test::makeRandomModel(rng, spec).normalMaps;
+  for (auto& c : db.codebook) c = int8_t(int(rng.below(256)) - 128);  // every snorm8 value, -128 included
+  return db;
+}
+
+// Decodes `slotMaps` on the GPU; returns the decoded texels as snorm8 pairs.
+std::vector<int8_t> gpuDecode(gpu::Context& ctx, const NormalMapDatabase& db, const std::vector<uint32_t>& slotMaps,
+                              std::vector<std::string>& problems) {
+  std::vector<int8_t> cb(db.codebook);
+  cb.resize((cb.size() + 3) / 4 * 4, 0);
+  std::vector<uint16_t> idx(db.indices);
+  idx.resize((idx.size() + 1) / 2 * 2, 0);
+  CheckedInput codebook(ctx, std::span<const int8_t>(cb), "codebook");
+  CheckedInput indices(ctx, std::span<const uint16_t>(idx), "indices");
+  CheckedInput slots(ctx, std::span<const uint32_t>(slotMaps), "slot maps");
+  const size_t bytes = slotMaps.size() * db.width * db.height * 2;
+  GuardedOutput out(ctx, bytes, "decoded maps");
+  const gpu::VqDecodePass pass(ctx);
+  gpu::VqDecodePass::Args a;
+  a.codebook = codebook.address();
+  a.indices = indices.address();
+  a.slotMaps = slots.address();
+  a.decodedOut = out.address();
+  a.width = db.width;
+  a.height = db.height;
+  a.slotCount = uint32_t(slotMaps.size());
+  a.codebookSize = db.codebookSize;
+  ctx.submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, a); });
+  auto texels = out.read<int8_t>(ctx);
+  texels.resize(bytes);
+  for (const CheckedInput* c : {&codebook, &indices, &slots})
+    if (auto s = c->unchanged(ctx); !s.empty()) problems.push_back(s);
+  if (auto s = out.guardsIntact(ctx); !s.empty()) problems.push_back(s);
+  return texels;
+}
+
+void expectDecodeExact(gpu::Context& ctx, const NormalMapDatabase& db, const std::vector<uint32_t>& slotMaps) {
+  std::vector<std::string> problems;
+  const auto gpu = gpuDecode(ctx, db, slotMaps, problems);
+  for (const auto& p : problems) ADD_FAILURE() << p;
+  const size_t per = size_t(db.width) * db.height * 2;
+  for (size_t s = 0; s < slotMaps.size(); ++s) {
+    const auto ref = runtime::referenceVqDecode(db, slotMaps[s]);
+    size_t bad = 0, first = 0;
+    for (size_t i = 0; i < per; ++i)
+      if (gpu[s * per + i] != ref.xy[i] && bad++ == 0) first = i;
+    EXPECT_EQ(bad, 0u) << "slot " << s << " (map " << slotMaps[s] << "): " << bad << " bytes differ, first at texel "
+                       << first / 2 << " (gpu " << int(gpu[s * per + first]) << ", reference " << int(ref.xy[first]) << ")";
+  }
+}
+
+struct DecodeCase {
+  uint32_t size, maps, codebook;
+  std::vector<uint32_t> slots;
+};
+
+class VqDecodeConformance : public test::GpuTest, public ::testing::WithParamInterface<DecodeCase> {};
+
+TEST_P(VqDecodeConformance, DecodesExactlyLikeReference) {
+  const uint64_t seed = test::testSeed(0x7D + GetParam().size);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  Rng rng(seed);
+  const auto db = randomDatabase(rng, GetParam().size, GetParam().maps, GetParam().codebook);
+  expectDecodeExact(ctx(), db, GetParam().slots);
+}
+
+// 4x4 (one block), 12x20 (odd block counts), the paper's 360x360 with 8 slots; a codebook of 1 entry and
+// one of 65536 (every 16-bit index value usable); an odd index count (word padding).
+INSTANTIATE_TEST_SUITE_P(Sizes, VqDecodeConformance,
+                         ::testing::Values(DecodeCase{4, 1, 1, {0}}, DecodeCase{12, 3, 7, {2, 0, 1}},
+                                           DecodeCase{20, 5, 65536, {4, 4, 1}}, DecodeCase{360, 16, 4096, {0, 3, 5, 7, 9, 11, 13, 15}}),
+                         [](const auto& info) {
+                           return "S" + std::to_string(info.param.size) + "_C" + std::to_string(info.param.codebook) + "_Slots" +
+                                  std::to_string(info.param.slots.size());
+                         });
+
+class NormalMapSpecialCases : public test::GpuTest {};
+
+// Indices beyond the codebook (impossible in a validated model) decode to 0 on both sides instead of
+// reading out of bounds.
+TEST_F(NormalMapSpecialCases, IndexBeyondCodebookDecodesToZero) {
+  Rng rng(test::testSeed(0x0B));
+  auto db = randomDatabase(rng, 8, 2, 5);
+  db.indices[1] = 5;
+  db.indices[6] = 65535;
+  expectDecodeExact(ctx(), db, {0, 1});
+  EXPECT_EQ(runtime::referenceVqDecode(db, 0).xy[2 * 4], 0);  // texel (4,0) is in block 1
+}
+
+// The blend of decoded slots into per-character layers: random previous maps and alphas.
+TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
+  const uint64_t seed = test::testSeed(0xB1E);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  Rng rng(seed);
+  if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
+  const uint32_t size = 12, characters = 5;
+  const auto db = randomDatabase(rng, size, 3, 9);
+  const std::vector<uint32_t> slotMaps = {2, 0};
+  // Characters 0..4: slots and alphas, including alpha 0 (keep prev) and 1 (take decoded).
+  const std::vector<gpu::NormalMapBlendPass::Character> chars = {{0, 0.f}, {1, 1.f}, {0, 0.37f}, {1, float(rng.uniform())}, {0, 0.5f}};
+  std::vector<runtime::BlendedNormalMap> prev;
+  std::vector<int16_t> prevAll;
+  for (uint32_t c = 0; c < characters; ++c) {
+    auto m = runtime::BlendedNormalMap::zeros(size, size);
+    for (auto& v : m.xy) v = int16_t(int(rng.below(65535)) - 32767);
+    prevAll.insert(prevAll.end(), m.xy.begin(), m.xy.end());
+    prev.push_back(std::move(m));
+  }
+  std::vector<std::string> problems;
+  const auto decoded = gpuDecode(ctx(), db, slotMaps, problems);
+  CheckedInput decodedIn(ctx(), std::span<const int8_t>(decoded), "decoded");
+  CheckedInput charsIn(ctx(), std::span<const gpu::NormalMapBlendPass::Character>(chars), "characters");
+  gpu::NormalMapImages prevImg(ctx(), size, size, characters), outImg(ctx(), size, size, characters);
+  prevImg.upload(ctx(), prevAll);
+  const gpu::NormalMapBlendPass pass(ctx(), 1);
+  {
+    const auto binding = pass.makeBinding(prevImg, outImg);
+    gpu::NormalMapBlendPass::Args a;
+    a.decoded = decodedIn.address();
+    a.characters = charsIn.address();
+    a.width = a.height = size;
+    a.characterCount = characters;
+    ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, binding.get(), a); });
+  }
+  for (const auto& p : problems) ADD_FAILURE() << p;
+  for (const CheckedInput* c : {&decodedIn, &charsIn})
+    if (auto s = c->unchanged(ctx()); !s.empty()) ADD_FAILURE() << s;
+  EXPECT_EQ(prevImg.download(ctx()), prevAll) << "the previous maps must be read, never written";
+  const auto out = outImg.download(ctx());
+  const size_t per = size_t(size) * size * 2;
+  for (uint32_t c = 0; c < characters; ++c) {
+    runtime::BlendedNormalMap ref = prev[c];
+    runtime::referenceNormalBlend(ref, runtime::referenceVqDecode(db, slotMaps[chars[c].decodedSlot]), chars[c].alpha);
+    const bool exact = chars[c].alpha == 0.f || chars[c].alpha == 1.f;
+    int maxDiff = 0;
+    for (size_t i = 0; i < per; ++i) maxDiff = std::max(maxDiff, std::abs(int(out[c * per + i]) - int(ref.xy[i])));
+    EXPECT_LE(maxDiff, exact ? 0 : 1) << "character " << c << " (alpha " << chars[c].alpha << ")";
+  }
+}
+
+}  // namespace
+}  // namespace swish

@@ -1,0 +1,135 @@
+// One whole frame, and a few in a row: every output of gpu::FrameRecorder (deformed positions,
+// normals, tangents per instance; per-character normal maps after the temporal blend) against
+// runtime::referenceFrame, with two frames in flight so that each frame's blend reads the previous
+// frame's maps from the other slot. Tolerances are those of the kernel tests (see test_deform.cpp,
+// test_tangent_frames.cpp, test_normal_maps.cpp), with the normal and tangent tolerance widened from
+// 1e-4 to 2e-4 because here they are computed from GPU positions that already differ from the reference
+// positions by up to the skinning tolerance.
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "support/gpu_compare.hpp"
+#include "support/gpu_test.hpp"
+#include "support/random_model.hpp"
+#include "swish/gpu/frame_recorder.hpp"
+#include "swish/gpu/gpu_model.hpp"
+#include "swish/runtime/reference_frame.hpp"
+
+namespace swish {
+namespace {
+
+runtime::FrameKernelInputs randomFrameInputs(Rng& rng, const Model& m, uint32_t instances, bool maps) {
+  runtime::FrameKernelInputs in;
+  in.instanceCount = instances;
+  for (int i = 0; i < int(instances) * m.meshComponents(); ++i) in.meshWeights.push_back(float(rng.normal(0, 2)));
+  for (uint32_t i = 0; i < instances; ++i) {
+    Pose pose = test::makeRandomPose(rng, m.skeleton);
+    pose.rootTranslation = Vec3f(rng.uniformf(-50, 50), 0.f, rng.uniformf(-25, 25));  // a football field
+    const auto mats = m.skeleton.skinningMatrices(pose);
+    in.skinMatrices.insert(in.skinMatrices.end(), mats.begin(), mats.end());
+    if (maps) {
+      in.selectedMaps.push_back(uint32_t(rng.below(3)));  // few maps: several characters share one
+      in.blendAlpha.push_back(float(rng.uniform(0.05, 1.0)));
+    }
+  }
+  return in;
+}
+
+void expectFrameMatches(const runtime::ReferenceFrameOutputs& gpu, const runtime::ReferenceFrameOutputs& ref, int frame) {
+  SCOPED_TRACE("frame " + std::to_string(frame));
+  ASSERT_EQ(gpu.positions.size(), ref.positions.size());
+  ASSERT_EQ(gpu.normals.size(), ref.normals.size());
+  ASSERT_EQ(gpu.normalMaps.size(), ref.normalMaps.size());
+  auto span = [](const auto& m) { return std::span<const float>(m.data(), size_t(m.size())); };
+  for (size_t i = 0; i < ref.positions.size(); ++i) {
+    SCOPED_TRACE("instance " + std::to_string(i));
+    const auto r = span(ref.positions[i]);
+    EXPECT_TRUE(test::matchesReference("positions", span(gpu.positions[i]), r,
+                                       [&](size_t e) { return 2e-6 + 1e-5 * std::abs(double(r[e])); }));
+    EXPECT_TRUE(test::matchesReference("normals", span(gpu.normals[i]), span(ref.normals[i]), [](size_t) { return 2e-4; }));
+    EXPECT_TRUE(test::matchesReference("tangents", span(gpu.tangents[i]), span(ref.tangents[i]), [](size_t) { return 2e-4; }));
+  }
+  for (size_t i = 0; i < ref.normalMaps.size(); ++i) {
+    int maxDiff = 0;
+    for (size_t t = 0; t < ref.normalMaps[i].xy.size(); ++t)
+      maxDiff = std::max(maxDiff, std::abs(int(gpu.normalMaps[i].xy[t]) - int(ref.normalMaps[i].xy[t])));
+    // 1 LSB of snorm16 per blend; the maps carry one blend per frame, so up to frame + 1 LSB.
+    EXPECT_LE(maxDiff, frame + 1) << "normal map of instance " << i;
+  }
+}
+
+class WholeFrame : public test::GpuTest {};
+
+TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
+  const uint64_t seed = test::testSeed(0xF4A3E);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  Rng rng(seed);
+  test::RandomModelSpec spec;
+  spec.vertices = 311;
+  spec.meshComponents = 30;
+  spec.influences = 4;
+  spec.normalMaps = 6;
+  spec.mapSize = 24;
+  spec.codebookSize = 40;
+  const Model model = test::makeRandomModel(rng, spec);
+  const uint32_t instances = 22;
+  gpu::GpuModel gpuModel(ctx(), model, "random model");
+  gpu::FrameRecorderOptions options;
+  options.framesInFlight = 2;
+  gpu::FrameRecorder recorder(ctx(), gpuModel, instances, options);
+
+  std::vector<runtime::BlendedNormalMap> prevMaps;  // reference state; starts at zeros like the GPU images
+  for (int frame = 0; frame < 3; ++frame) {
+    const auto in = randomFrameInputs(rng, model, instances, true);
+    ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, uint64_t(frame), in); });
+    const uint32_t slot = recorder.slotOf(uint64_t(frame));
+    const auto gpu = recorder.download(slot);
+    const auto ref = runtime::referenceFrame(model, in, prevMaps);
+    expectFrameMatches(gpu, ref, frame);
+    // Each selected map decoded once, however many characters chose it.
+    EXPECT_EQ(recorder.frame(slot).decodedSlotCount, std::set<uint32_t>(in.selectedMaps.begin(), in.selectedMaps.end()).size());
+    if (ctx().supportsTimestamps()) {
+      const auto t = recorder.stageTimes(slot);
+      EXPECT_FALSE(std::isnan(t.deformMs) || std::isnan(t.tangentFramesMs) || std::isnan(t.vqDecodeMs) || std::isnan(t.normalBlendMs));
+      EXPECT_GE(t.totalMs, t.deformMs);
+    }
+    prevMaps = ref.normalMaps;
+  }
+}
+
+TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
+  const uint64_t seed = test::testSeed(0x40AB);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  Rng rng(seed);
+  test::RandomModelSpec spec;
+  spec.vertices = 53;
+  spec.normalMaps = 0;
+  const Model model = test::makeRandomModel(rng, spec);
+  gpu::GpuModel gpuModel(ctx(), model);
+  gpu::FrameRecorder recorder(ctx(), gpuModel, 3, {1, true, true});
+  const auto in = randomFrameInputs(rng, model, 3, false);
+  ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, 0, in); });
+  const auto gpu = recorder.download(0);
+  EXPECT_TRUE(gpu.normalMaps.empty());
+  expectFrameMatches(gpu, runtime::referenceFrame(model, in), 0);
+  if (ctx().supportsTimestamps()) EXPECT_TRUE(std::isnan(recorder.stageTimes(0).vqDecodeMs));
+}
+
+TEST_F(WholeFrame, BadInputsAreRejectedWithAReason) {
+  Rng rng(3);
+  const Model model = test::makeRandomModel(rng, {});
+  gpu::GpuModel gpuModel(ctx(), model);
+  gpu::FrameRecorder recorder(ctx(), gpuModel, 2);
+  auto in = randomFrameInputs(rng, model, 2, true);
+  in.selectedMaps[1] = 99;
+  VkCommandBuffer cmd = ctx().beginOneTime();
+  EXPECT_THROW(recorder.record(cmd, 0, in), Error);
+  in = randomFrameInputs(rng, model, 3, true);
+  EXPECT_THROW(recorder.record(cmd, 0, in), Error);  // beyond the capacity of 2
+  ctx().abandonOneTime(cmd);
+}
+
+}  // namespace
+}  // namespace swish
