@@ -1,0 +1,84 @@
+#pragma once
+// A replay scene: which characters play, wearing which model, driven by which motion, standing where,
+// over which frames, and which outputs are wanted. Plain data (no Vulkan, no I/O); scene_file.hpp reads
+// it from JSON and documents the file format; planner.hpp turns it into the work of one frame.
+//
+// Positions are kept in double: a character may stand kilometres from the origin (open worlds), and
+// the runtime computes everything relative to the character (float is precise there), applying the
+// placement only at the very end (see ScenePlacement::apply).
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "swish/core/types.hpp"
+
+namespace swish::runtime {
+
+// The model name that stands for the embedded default model (assets/default) instead of a file.
+inline constexpr const char* kDefaultModelName = "default";
+
+// Where a character stands in the world: a rotation about +Y (yaw), then a translation.
+struct ScenePlacement {
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // metres
+  double yawDegrees = 0.0;
+
+  // Character space -> world, in double (precise at 1e4 m and beyond).
+  Eigen::Vector3d apply(const Vec3f& characterPoint) const;
+  Eigen::Matrix3d rotation() const;
+};
+
+// Motion from an animation clip file (BVH or anything io::readAnimationWithAssimp reads).
+struct SceneClip {
+  std::filesystem::path file;
+  std::string clipName;        // empty: the file's (only) clip; else must match it
+  double timeOffsetSeconds = 0.0;  // clip time at scene time 0 (wraps around the clip's length)
+  double speed = 1.0;          // playback speed, > 0
+};
+
+struct SceneCharacter {
+  std::string name;
+  std::string model;           // kDefaultModelName, or a .swish file (resolved path)
+  std::optional<SceneClip> clip;                    // exactly one of clip / poseStream
+  std::optional<std::filesystem::path> poseStream;  // a recorded pose stream (pose_stream format)
+  ScenePlacement placement;
+  bool visible = true;         // false: off screen, skips mesh and normal-map work
+};
+
+// Outputs a scene asks for. What they need decides the work (planner.hpp):
+//   render     a renderer consumes every frame: deformed meshes, normals+tangents, normal maps
+//   meshes     per-frame glTF meshes (positions; with normals when render or normalMaps is on)
+//   normalMaps per-frame PNG normal maps per character (needs the normal-map passes and tangents)
+//   report     JSON + Markdown report with plots (always cheap: it reads what the frame produced)
+struct SceneOutputs {
+  std::filesystem::path directory = "replay-out";
+  bool report = true;
+  bool render = false;
+  bool meshes = false;
+  bool normalMaps = false;
+  uint32_t gpuCheckEvery = 1;  // compare GPU outputs with the CPU reference on every Nth frame (>= 1)
+};
+
+struct Scene {
+  std::string name;
+  std::filesystem::path source;     // the scene file, for messages ("<built-in>" for code-made scenes)
+  uint32_t firstFrame = 0;          // scene frames [firstFrame, firstFrame + frameCount)
+  uint32_t frameCount = 1;
+  double framesPerSecond = 30.0;
+  Eigen::Vector3d camera = Eigen::Vector3d::Zero();
+  std::optional<double> cullDistance;  // metres from the camera; beyond it a character is off screen
+  SceneOutputs outputs;
+  std::vector<SceneCharacter> characters;
+
+  double timeOfFrame(uint32_t sceneFrame) const { return double(sceneFrame) / framesPerSecond; }
+  // Whether character c gets mesh and normal work: visible, and (with a cull distance) its placement no
+  // further than cullDistance from the camera. Culling looks at the placement, not the per-frame root
+  // motion, so that the plan stays the same for every frame.
+  bool onScreen(size_t c) const;
+  // Checks values (counts, ranges, names) and throws Error naming the scene and the field. Does not
+  // touch files: scene_file.cpp checks those.
+  void validate() const;
+};
+
+}  // namespace swish::runtime

@@ -1,0 +1,232 @@
+#include "swish/runtime/scene_file.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include "swish/core/error.hpp"
+
+namespace swish::runtime {
+
+namespace {
+
+using nlohmann::json;
+
+// Walks the JSON with the path of the current node, so that every error says where it is.
+class Reader {
+ public:
+  Reader(const json& j, std::string source, std::string path) : j_(j), source_(std::move(source)), path_(std::move(path)) {}
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw Error(source_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " + problem);
+  }
+  const json& value() const { return j_; }
+  const std::string& path() const { return path_; }
+  const std::string& source() const { return source_; }
+
+  void requireObject(std::initializer_list<const char*> allowed) const {
+    if (!j_.is_object()) fail("must be an object, is " + std::string(j_.type_name()));
+    const std::set<std::string> ok(allowed.begin(), allowed.end());
+    for (const auto& [key, v] : j_.items())
+      if (!ok.count(key)) {
+        std::string list;
+        for (const auto& k : ok) list += (list.empty() ? "" : ", ") + k;
+        child(key).fail("unknown key (allowed here: " + list + ")");
+      }
+  }
+  bool has(const char* key) const { return j_.contains(key); }
+  Reader child(const std::string& key) const {
+    static const json null;
+    const json& v = j_.contains(key) ? j_.at(key) : null;
+    return Reader(v, source_, path_.empty() ? key : path_ + "." + key);
+  }
+  Reader at(size_t i) const { return Reader(j_.at(i), source_, path_ + "[" + std::to_string(i) + "]"); }
+  Reader required(const char* key) const {
+    if (!j_.contains(key)) child(key).fail("is required");
+    return child(key);
+  }
+
+  std::string string() const {
+    if (!j_.is_string()) fail("must be a string, is " + std::string(j_.type_name()));
+    return j_.get<std::string>();
+  }
+  bool boolean() const {
+    if (!j_.is_boolean()) fail("must be true or false, is " + std::string(j_.type_name()));
+    return j_.get<bool>();
+  }
+  double number() const {
+    if (!j_.is_number()) fail("must be a number, is " + std::string(j_.type_name()));
+    const double v = j_.get<double>();
+    if (!std::isfinite(v)) fail("must be finite");
+    return v;
+  }
+  uint32_t integer(uint64_t lo, uint64_t hi) const {
+    if (!j_.is_number_integer() && !(j_.is_number_float() && j_.get<double>() == std::floor(j_.get<double>())))
+      fail("must be an integer, is " + std::string(j_.is_number() ? "a fraction" : j_.type_name()));
+    const double v = j_.get<double>();
+    if (v < double(lo) || v > double(hi))
+      fail("must be " + std::to_string(lo) + " to " + std::to_string(hi) + ", is " + j_.dump());
+    return uint32_t(v);
+  }
+  Eigen::Vector3d vec3() const {
+    if (!j_.is_array() || j_.size() != 3) fail("must be an array of 3 numbers");
+    Eigen::Vector3d v;
+    for (size_t i = 0; i < 3; ++i) v[Eigen::Index(i)] = at(i).number();
+    return v;
+  }
+
+ private:
+  const json& j_;
+  std::string source_, path_;
+};
+
+std::filesystem::path resolve(const std::filesystem::path& base, const std::string& p) {
+  const std::filesystem::path path(p);
+  return path.is_absolute() ? path : (base / path).lexically_normal();
+}
+
+void requireFile(const Reader& r, const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) r.fail("file '" + file.string() + "' does not exist or is not a file");
+}
+
+SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base, bool checkFiles) {
+  r.requireObject({"name", "model", "animation", "poseStream", "placement", "visible"});
+  SceneCharacter c;
+  c.name = r.required("name").string();
+  const Reader model = r.required("model");
+  c.model = model.string();
+  if (c.model != kDefaultModelName) {
+    c.model = resolve(base, c.model).string();
+    if (checkFiles) requireFile(model, c.model);
+  }
+  if (r.has("animation") == r.has("poseStream")) r.fail("needs exactly one of \"animation\" and \"poseStream\"");
+  if (r.has("animation")) {
+    const Reader a = r.child("animation");
+    a.requireObject({"file", "clip", "timeOffset", "speed"});
+    SceneClip clip;
+    const Reader file = a.required("file");
+    clip.file = resolve(base, file.string());
+    if (checkFiles) requireFile(file, clip.file);
+    if (a.has("clip")) clip.clipName = a.child("clip").string();
+    if (a.has("timeOffset")) clip.timeOffsetSeconds = a.child("timeOffset").number();
+    if (a.has("speed")) {
+      clip.speed = a.child("speed").number();
+      if (!(clip.speed > 0.0 && clip.speed <= 100.0)) a.child("speed").fail("must be in (0, 100]");
+    }
+    c.clip = clip;
+  } else {
+    const Reader s = r.child("poseStream");
+    c.poseStream = resolve(base, s.string());
+    if (checkFiles) requireFile(s, *c.poseStream);
+  }
+  if (r.has("placement")) {
+    const Reader p = r.child("placement");
+    p.requireObject({"translation", "yawDegrees"});
+    if (p.has("translation")) {
+      c.placement.translation = p.child("translation").vec3();
+      if (c.placement.translation.cwiseAbs().maxCoeff() > 1e7) p.child("translation").fail("is beyond 1e7 m");
+    }
+    if (p.has("yawDegrees")) c.placement.yawDegrees = p.child("yawDegrees").number();
+  }
+  if (r.has("visible")) c.visible = r.child("visible").boolean();
+  return c;
+}
+
+}  // namespace
+
+Scene parseScene(const json& j, const std::filesystem::path& source, bool checkFiles) {
+  const Reader root(j, source.string(), "");
+  root.requireObject({"name", "frames", "camera", "cullDistance", "outputs", "characters"});
+  const std::filesystem::path base = source.has_parent_path() ? source.parent_path() : std::filesystem::path(".");
+  Scene s;
+  s.source = source;
+  s.name = root.has("name") ? root.child("name").string() : source.stem().string();
+
+  const Reader frames = root.required("frames");
+  frames.requireObject({"start", "count", "rate"});
+  if (frames.has("start")) s.firstFrame = frames.child("start").integer(0, 100'000'000);
+  s.frameCount = frames.required("count").integer(1, 10'000'000);
+  if (frames.has("rate")) {
+    s.framesPerSecond = frames.child("rate").number();
+    if (!(s.framesPerSecond > 0.0 && s.framesPerSecond <= 1000.0)) frames.child("rate").fail("must be in (0, 1000]");
+  }
+
+  if (root.has("camera")) {
+    const Reader cam = root.child("camera");
+    cam.requireObject({"position"});
+    s.camera = cam.required("position").vec3();
+  }
+  if (root.has("cullDistance")) {
+    const double d = root.child("cullDistance").number();
+    if (!(d > 0.0)) root.child("cullDistance").fail("must be a positive number of metres");
+    s.cullDistance = d;
+  }
+
+  if (root.has("outputs")) {
+    const Reader o = root.child("outputs");
+    o.requireObject({"directory", "report", "render", "meshes", "normalMaps", "gpuCheckEvery"});
+    if (o.has("directory")) s.outputs.directory = resolve(base, o.child("directory").string());
+    else s.outputs.directory = resolve(base, s.outputs.directory.string());
+    if (o.has("report")) s.outputs.report = o.child("report").boolean();
+    if (o.has("render")) s.outputs.render = o.child("render").boolean();
+    if (o.has("meshes")) s.outputs.meshes = o.child("meshes").boolean();
+    if (o.has("normalMaps")) s.outputs.normalMaps = o.child("normalMaps").boolean();
+    if (o.has("gpuCheckEvery")) s.outputs.gpuCheckEvery = o.child("gpuCheckEvery").integer(1, 1'000'000);
+  } else {
+    s.outputs.directory = resolve(base, s.outputs.directory.string());
+  }
+
+  const Reader chars = root.required("characters");
+  if (!chars.value().is_array()) chars.fail("must be an array, is " + std::string(chars.value().type_name()));
+  if (chars.value().empty()) chars.fail("a scene needs at least one character");
+  std::set<std::string> names;
+  for (size_t i = 0; i < chars.value().size(); ++i) {
+    s.characters.push_back(parseCharacter(chars.at(i), base, checkFiles));
+    if (!names.insert(s.characters.back().name).second)
+      chars.at(i).child("name").fail("'" + s.characters.back().name + "' is used by another character");
+  }
+  s.validate();
+  return s;
+}
+
+Scene loadScene(const std::filesystem::path& file, bool checkFiles) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw Error(file.string() + ": scene file does not exist");
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot open the scene file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw Error(file.string() + ": not valid JSON: " + e.what());
+  }
+  return parseScene(j, file, checkFiles);
+}
+
+json sceneToJson(const Scene& s) {
+  json j;
+  j["name"] = s.name;
+  j["frames"] = {{"start", s.firstFrame}, {"count", s.frameCount}, {"rate", s.framesPerSecond}};
+  j["camera"] = {{"position", {s.camera.x(), s.camera.y(), s.camera.z()}}};
+  if (s.cullDistance) j["cullDistance"] = *s.cullDistance;
+  j["outputs"] = {{"directory", s.outputs.directory.string()}, {"report", s.outputs.report},
+                  {"render", s.outputs.render},                {"meshes", s.outputs.meshes},
+                  {"normalMaps", s.outputs.normalMaps},        {"gpuCheckEvery", s.outputs.gpuCheckEvery}};
+  j["characters"] = json::array();
+  for (const SceneCharacter& c : s.characters) {
+    json cj{{"name", c.name}, {"model", c.model}, {"visible", c.visible}};
+    if (c.clip)
+      cj["animation"] = {{"file", c.clip->file.string()}, {"clip", c.clip->clipName},
+                         {"timeOffset", c.clip->timeOffsetSeconds}, {"speed", c.clip->speed}};
+    if (c.poseStream) cj["poseStream"] = c.poseStream->string();
+    const auto& t = c.placement.translation;
+    cj["placement"] = {{"translation", {t.x(), t.y(), t.z()}}, {"yawDegrees", c.placement.yawDegrees}};
+    j["characters"].push_back(cj);
+  }
+  return j;
+}
+
+}  // namespace swish::runtime
