@@ -1,0 +1,206 @@
+#include "swish/bake/body_collider.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "swish/core/error.hpp"
+#include "swish/core/skinning.hpp"
+
+namespace swish::bake {
+namespace {
+
+// Which feature of a triangle holds the closest point: the face, a vertex (0..2) or a side
+// (0: ab, 1: bc, 2: ca). The sign test needs the pseudo-normal of exactly that feature.
+enum class Feature { Face, Vertex, Edge };
+struct ClosestOnTriangle {
+  Vec3f point;
+  Feature feature;
+  int index;
+};
+
+// Ericson, Real-Time Collision Detection, 5.1.5, keeping track of the Voronoi region.
+ClosestOnTriangle closestOnTriangle(const Vec3f& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const Vec3f ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.f && d2 <= 0.f) return {a, Feature::Vertex, 0};
+  const Vec3f bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.f && d4 <= d3) return {b, Feature::Vertex, 1};
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.f && d1 >= 0.f && d3 <= 0.f) return {a + ab * (d1 / (d1 - d3)), Feature::Edge, 0};
+  const Vec3f cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.f && d5 <= d6) return {c, Feature::Vertex, 2};
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.f && d2 >= 0.f && d6 <= 0.f) return {a + ac * (d2 / (d2 - d6)), Feature::Edge, 2};
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.f && (d4 - d3) >= 0.f && (d5 - d6) >= 0.f)
+    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), Feature::Edge, 1};
+  const float denom = va + vb + vc;
+  if (!(std::abs(denom) > 0.f)) return {a, Feature::Vertex, 0};  // degenerate triangle
+  const float v = vb / denom, w = vc / denom;
+  return {a + ab * v + ac * w, Feature::Face, 0};
+}
+
+}  // namespace
+
+BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& what)
+    : restPositions_(body.positions), triangles_(body.triangles), skin_(body.skin), cellSize_(cellSize) {
+  body.validate(what);
+  if (body.triangleCount() == 0) throw Error(what + ": the collider body has no triangles");
+  if (!(cellSize > 0.f) || !std::isfinite(cellSize)) throw Error(what + ": collider cell size must be positive");
+  // Edge numbering: shared sides get one index, so their pseudo-normal sums both faces.
+  std::unordered_map<uint64_t, uint32_t> edgeIndex;
+  triangleEdges_.resize(size_t(triangles_.rows()) * 3);
+  for (Eigen::Index t = 0; t < triangles_.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      uint32_t a = triangles_(t, k), b = triangles_(t, (k + 1) % 3);
+      if (a > b) std::swap(a, b);
+      auto [it, inserted] = edgeIndex.try_emplace((uint64_t(a) << 32) | b, uint32_t(edgeTriangles_.size()));
+      if (inserted) edgeTriangles_.push_back({int32_t(t), -1});
+      else if (edgeTriangles_[it->second][1] < 0) edgeTriangles_[it->second][1] = int32_t(t);
+      triangleEdges_[size_t(t) * 3 + k] = it->second;
+    }
+  positions_ = restPositions_;
+  rebuild();
+}
+
+void BodyCollider::pose(const std::vector<Mat4f>& skinMatrices) {
+  if (skin_.vertexCount() != size_t(restPositions_.rows()))
+    throw Error("body collider: the body has no skin weights, it cannot be posed");
+  positions_ = skinPositions(restPositions_, skin_, skinMatrices);
+  rebuild();
+}
+
+void BodyCollider::setPositions(const Points3f& positions) {
+  if (positions.rows() != restPositions_.rows())
+    throw Error("body collider: " + std::to_string(positions.rows()) + " positions for a body of " +
+                std::to_string(restPositions_.rows()) + " vertices");
+  positions_ = positions;
+  rebuild();
+}
+
+void BodyCollider::rebuild() {
+  const size_t nt = size_t(triangles_.rows()), nv = size_t(positions_.rows());
+  if (!positions_.allFinite()) throw Error("body collider: posed body has non-finite positions");
+  faceNormals_.assign(nt, Vec3f::Zero());
+  vertexNormals_.assign(nv, Vec3f::Zero());
+  edgeNormals_.assign(edgeTriangles_.size(), Vec3f::Zero());
+  triangleSpheres_.resize(nt);
+  for (size_t t = 0; t < nt; ++t) {
+    const Vec3f p[3] = {positions_.row(triangles_(t, 0)), positions_.row(triangles_(t, 1)),
+                        positions_.row(triangles_(t, 2))};
+    const Vec3f n = (p[1] - p[0]).cross(p[2] - p[0]);
+    const float len = n.norm();
+    faceNormals_[t] = len > 0.f ? Vec3f(n / len) : Vec3f::Zero();
+    for (int k = 0; k < 3; ++k) {
+      // Angle-weighted vertex pseudo-normal.
+      const Vec3f e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
+      const float d = e1.norm() * e2.norm();
+      const float angle = d > 0.f ? std::acos(std::clamp(e1.dot(e2) / d, -1.f, 1.f)) : 0.f;
+      vertexNormals_[triangles_(t, k)] += angle * faceNormals_[t];
+      edgeNormals_[triangleEdges_[t * 3 + k]] += faceNormals_[t];
+    }
+    const Vec3f centre = (p[0] + p[1] + p[2]) / 3.f;
+    const float r = std::max({(p[0] - centre).norm(), (p[1] - centre).norm(), (p[2] - centre).norm()});
+    triangleSpheres_[t] << centre, r;
+  }
+  for (auto& n : vertexNormals_) n.normalize();
+  for (auto& n : edgeNormals_) n.normalize();
+
+  // Grid over the posed body's bounds; capped at ~4M cells so a scattered body cannot eat memory.
+  const Vec3f lo = positions_.colwise().minCoeff().transpose(), hi = positions_.colwise().maxCoeff().transpose();
+  float h = cellSize_;
+  const Vec3f extent = (hi - lo).cwiseMax(Vec3f::Constant(1e-6f));
+  while ((extent / h).array().ceil().prod() > 4e6f) h *= 1.5f;
+  gridOrigin_ = lo;
+  cellSize_ = h;
+  for (int k = 0; k < 3; ++k) gridDims_[k] = std::max(1, int(std::ceil(extent[k] / h)));
+  const size_t cells = size_t(gridDims_.prod());
+  auto cellRange = [&](size_t t, Eigen::Vector3i& a, Eigen::Vector3i& b) {
+    Vec3f tlo = positions_.row(triangles_(t, 0)), thi = tlo;
+    for (int k = 1; k < 3; ++k) {
+      tlo = tlo.cwiseMin(positions_.row(triangles_(t, k)).transpose());
+      thi = thi.cwiseMax(positions_.row(triangles_(t, k)).transpose());
+    }
+    for (int k = 0; k < 3; ++k) {
+      a[k] = std::clamp(int((tlo[k] - lo[k]) / h), 0, gridDims_[k] - 1);
+      b[k] = std::clamp(int((thi[k] - lo[k]) / h), 0, gridDims_[k] - 1);
+    }
+  };
+  cellStart_.assign(cells + 1, 0);
+  Eigen::Vector3i a, b;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<uint32_t> fill;
+    if (pass == 1) {
+      for (size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
+      cellTriangles_.resize(cellStart_[cells]);
+      fill.assign(cellStart_.begin(), cellStart_.end() - 1);
+    }
+    for (size_t t = 0; t < nt; ++t) {
+      cellRange(t, a, b);
+      for (int z = a[2]; z <= b[2]; ++z)
+        for (int y = a[1]; y <= b[1]; ++y)
+          for (int x = a[0]; x <= b[0]; ++x) {
+            const size_t c = (size_t(z) * gridDims_[1] + y) * gridDims_[0] + x;
+            if (pass == 0) ++cellStart_[c + 1];
+            else cellTriangles_[fill[c]++] = uint32_t(t);
+          }
+    }
+  }
+}
+
+BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance) const {
+  Hit hit;
+  if (!p.allFinite() || !(maxDistance > 0.f)) return hit;
+  Eigen::Vector3i a, b;
+  for (int k = 0; k < 3; ++k) {
+    const float lo = (p[k] - maxDistance - gridOrigin_[k]) / cellSize_;
+    const float hi = (p[k] + maxDistance - gridOrigin_[k]) / cellSize_;
+    if (hi < 0.f || lo >= float(gridDims_[k])) return hit;  // the search ball misses the grid
+    a[k] = std::clamp(int(std::floor(lo)), 0, gridDims_[k] - 1);
+    b[k] = std::clamp(int(std::floor(hi)), 0, gridDims_[k] - 1);
+  }
+  float best = maxDistance;
+  int bestTri = -1;
+  ClosestOnTriangle bestPoint{};
+  for (int z = a[2]; z <= b[2]; ++z)
+    for (int y = a[1]; y <= b[1]; ++y)
+      for (int x = a[0]; x <= b[0]; ++x) {
+        const size_t c = (size_t(z) * gridDims_[1] + y) * gridDims_[0] + x;
+        for (uint32_t i = cellStart_[c]; i < cellStart_[c + 1]; ++i) {
+          const uint32_t t = cellTriangles_[i];
+          const Vec4f& s = triangleSpheres_[t];
+          if ((p - s.head<3>()).norm() - s[3] > best) continue;
+          const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
+                                                        positions_.row(triangles_(t, 1)),
+                                                        positions_.row(triangles_(t, 2)));
+          const float d = (p - q.point).norm();
+          // Ties (a triangle seen from two cells, or two triangles sharing the closest feature) keep
+          // the lowest triangle index, so the answer does not depend on the visiting order.
+          if (d < best || (d == best && int(t) < bestTri)) {
+            best = d;
+            bestTri = int(t);
+            bestPoint = q;
+          }
+        }
+      }
+  if (bestTri < 0) return hit;
+  Vec3f pseudo;
+  switch (bestPoint.feature) {
+    case Feature::Face: pseudo = faceNormals_[size_t(bestTri)]; break;
+    case Feature::Vertex: pseudo = vertexNormals_[triangles_(bestTri, bestPoint.index)]; break;
+    default: pseudo = edgeNormals_[triangleEdges_[size_t(bestTri) * 3 + bestPoint.index]]; break;
+  }
+  const Vec3f diff = p - bestPoint.point;
+  const float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
+  hit.found = true;
+  hit.signedDistance = sign * best;
+  hit.point = bestPoint.point;
+  hit.normal = best > 1e-7f ? Vec3f(sign * diff / best) : pseudo;
+  return hit;
+}
+
+}  // namespace swish::bake

@@ -1,0 +1,317 @@
+#include "swish/bake/cloth_solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "swish/core/error.hpp"
+#include "swish/core/rotation.hpp"
+#include "swish/core/skinning.hpp"
+
+namespace swish::bake {
+namespace {
+
+using Affine34 = Eigen::Matrix<float, 3, 4>;
+using V3 = Eigen::Map<Vec3f>;
+
+// FNV-1a over raw bytes: the fingerprint of a setup (not cryptographic; it only tells setups apart).
+struct Fnv {
+  uint64_t h = 1469598103934665603ull;
+  void bytes(const void* p, size_t n) {
+    const auto* c = static_cast<const uint8_t*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
+  }
+  template <class T>
+  void value(const T& v) { bytes(&v, sizeof v); }
+  template <class M>
+  void matrix(const M& m) { bytes(m.data(), size_t(m.size()) * sizeof(typename M::Scalar)); }
+  template <class T>
+  void vec(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
+};
+
+Vec3f garmentCentre(const SimulationMesh& mesh) {
+  if (mesh.vertexCount() == 0) return Vec3f::Zero();
+  const Vec3f lo = mesh.restPositions.colwise().minCoeff(), hi = mesh.restPositions.colwise().maxCoeff();
+  return 0.5f * (lo + hi);
+}
+
+Mesh shiftedBody(const Character& ch, const Vec3f& origin) {
+  Mesh body = ch.body;
+  body.validate("body of character '" + ch.name + "'", ch.skeleton.size());
+  if (body.skin.vertexCount() != body.vertexCount())
+    throw Error("body of character '" + ch.name + "' has no skin weights: the collider cannot follow the pose");
+  body.positions.rowwise() -= origin.transpose();
+  return body;
+}
+
+}  // namespace
+
+void ClothSimSettings::validate() const {
+  validateClothMaterial(material);
+  auto check = [](bool ok, const std::string& what) {
+    if (!ok) throw Error("cloth simulation settings: " + what);
+  };
+  check(std::isfinite(thickness) && thickness >= 0.f && thickness < 0.1f, "thickness must be in [0, 0.1) m");
+  check(std::isfinite(contactMargin) && contactMargin > 0.f && contactMargin < 0.5f, "contactMargin must be in (0, 0.5) m");
+  check(std::isfinite(transitionSeconds) && transitionSeconds > 0.f && transitionSeconds <= 60.f,
+        "transitionSeconds must be in (0, 60]");
+  check(std::isfinite(settleSeconds) && settleSeconds >= 0.f && settleSeconds <= 60.f, "settleSeconds must be in [0, 60]");
+  check(std::isfinite(frameRate) && frameRate >= 1.f && frameRate <= 1000.f, "frameRate must be in [1, 1000]");
+  check(substeps >= 1 && substeps <= 1000, "substeps must be in [1, 1000]");
+  check(iterations >= 1 && iterations <= 100, "iterations must be in [1, 100]");
+  check(gravity.allFinite(), "gravity must be finite");
+  check(std::isfinite(attachTopFraction) && attachTopFraction >= 0.f && attachTopFraction <= 1.f,
+        "attachTopFraction must be in [0, 1]");
+  check(std::isfinite(attachSag) && attachSag > 0.f, "attachSag must be positive");
+  check(std::isfinite(tetherSlack) && tetherSlack >= 0.f, "tetherSlack must be >= 0");
+  check(std::isfinite(convergedSpeed) && convergedSpeed > 0.f, "convergedSpeed must be positive");
+  check(std::isfinite(convergedStrain) && convergedStrain > 0.f, "convergedStrain must be positive");
+  check(std::isfinite(failPenetration) && failPenetration > 0.f, "failPenetration must be positive");
+  check(std::isfinite(failStrain) && failStrain > 0.f, "failStrain must be positive");
+}
+
+ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSettings settings)
+    : skeleton_(ch.skeleton),
+      mesh_(std::move(mesh)),
+      settings_((settings.validate(), std::move(settings))),
+      origin_(garmentCentre(mesh_)),
+      colliderPrototype_(shiftedBody(ch, origin_), settings_.thickness + settings_.contactMargin,
+                         "body of character '" + ch.name + "'") {
+  skeleton_.validate("skeleton of character '" + ch.name + "'");
+  if (skeleton_.inverseBind.empty()) skeleton_.computeInverseBindFromRest();
+  const std::string what = "simulation mesh of character '" + ch.name + "'";
+  if (mesh_.vertexCount() == 0 || mesh_.triangles.rows() == 0) throw Error(what + ": empty");
+  if (mesh_.skin.vertexCount() != mesh_.vertexCount()) throw Error(what + ": skin weights do not match the vertices");
+  for (uint16_t j : mesh_.skin.joints)
+    if (j >= skeleton_.size()) throw Error(what + ": skin weight names joint " + std::to_string(j) + ", beyond the skeleton");
+  if (!mesh_.restPositions.allFinite()) throw Error(what + ": non-finite rest positions");
+
+  restLocal_ = mesh_.restPositions.rowwise() - origin_.transpose();
+  constraints_ = buildClothConstraints(mesh_, restLocal_, settings_.material);
+
+  // The top band (collar and shoulders of a shirt) hangs on the body: attach it softly to skinning.
+  const float top = restLocal_.col(1).maxCoeff(), bottom = restLocal_.col(1).minCoeff();
+  const float cut = top - settings_.attachTopFraction * (top - bottom);
+  // The band's springs together would hold the garment's whole weight at attachSag, shared by area
+  // (on a body the shoulders carry most of it through contact; this keeps it from sliding down).
+  double bandArea = 0.0, totalArea = 0.0;
+  for (uint32_t v = 0; v < mesh_.vertexCount(); ++v) {
+    totalArea += constraints_.vertexArea[v];
+    if (settings_.attachTopFraction > 0.f && restLocal_(v, 1) >= cut) {
+      attached_.push_back(v);
+      bandArea += constraints_.vertexArea[v];
+    }
+  }
+  const double g = settings_.gravity.norm() > 0.f ? double(settings_.gravity.norm()) : 9.81;
+  const double bandStiffness = double(settings_.material.density) * totalArea * g / double(settings_.attachSag);
+  for (uint32_t v : attached_)
+    attachCompliance_.push_back(float(bandArea / (bandStiffness * constraints_.vertexArea[v])));
+  tethers_ = buildTethers(mesh_, restLocal_, attached_);
+
+  // A garment that starts inside the body cannot be simulated meaningfully: say so up front.
+  colliderPrototype_.pose(localSkinMatrices(skeleton_.restPose()));
+  float worst = 0.f;
+  uint32_t worstVertex = 0;
+  for (uint32_t v = 0; v < mesh_.vertexCount(); ++v) {
+    const float p = penetrationOf(colliderPrototype_, restLocal_.row(v));
+    if (p > worst) worst = p, worstVertex = v;
+  }
+  if (worst - settings_.thickness > settings_.failPenetration)
+    throw Error("garment of character '" + ch.name + "' starts inside the body: simulation vertex " +
+                std::to_string(worstVertex) + " is " + std::to_string(worst - settings_.thickness) +
+                " m below the body surface in the rest pose");
+
+  Fnv f;
+  f.matrix(mesh_.restPositions);
+  f.matrix(mesh_.triangles);
+  f.vec(mesh_.skin.joints);
+  f.vec(mesh_.skin.weights);
+  f.matrix(ch.body.positions);
+  f.matrix(ch.body.triangles);
+  f.vec(ch.body.skin.joints);
+  f.vec(ch.body.skin.weights);
+  for (const Joint& j : skeleton_.joints) {
+    f.value(j.parent);
+    f.matrix(j.rest.rotation.coeffs());
+    f.matrix(j.rest.translation);
+  }
+  for (const Mat4f& m : skeleton_.inverseBind) f.matrix(m);
+  const ClothSimSettings& s = settings_;
+  const ClothMaterial& m = s.material;
+  for (float x : {m.density, m.stretchModulus, m.compressionModulus, m.shearModulus, m.bendingStiffness, m.friction,
+                  m.damping, s.thickness, s.contactMargin, s.transitionSeconds, s.settleSeconds, s.frameRate,
+                  s.attachTopFraction, s.attachSag, s.tetherSlack, s.convergedSpeed, s.convergedStrain, s.failPenetration,
+                  s.failStrain})
+    f.value(x);
+  f.value(s.substeps);
+  f.value(s.iterations);
+  f.matrix(s.gravity);
+  fingerprint_ = f.h;
+}
+
+std::vector<Mat4f> ClothSolver::localSkinMatrices(const Pose& pose) const {
+  // M' = T(-origin) M T(origin): the same skinning, expressed relative to the solve's origin.
+  std::vector<Mat4f> m = skeleton_.skinningMatrices(pose);
+  for (Mat4f& x : m) x.topRightCorner<3, 1>() += x.topLeftCorner<3, 3>() * origin_ - origin_;
+  return m;
+}
+
+float ClothSolver::penetrationOf(const BodyCollider& body, const Vec3f& p) const {
+  // Depth below the thick surface; the search widens until it finds the surface (or 0.4 m).
+  for (float r = settings_.thickness + settings_.contactMargin; r < 0.8f; r *= 2.f) {
+    const BodyCollider::Hit hit = body.closest(p, r);
+    if (hit.found) return std::max(0.f, settings_.thickness - hit.signedDistance);
+  }
+  return 0.f;
+}
+
+PoseSimulation ClothSolver::simulate(const Pose& target) const {
+  const auto start = std::chrono::steady_clock::now();
+  PoseSimulation out;
+  auto fail = [&](std::string why) {
+    out.ok = false;
+    out.failure = std::move(why);
+    out.positions.resize(0, 3);
+    out.residuals.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  };
+  if (target.local.size() != skeleton_.size())
+    return fail("pose has " + std::to_string(target.local.size()) + " joint rotations, the skeleton has " +
+                std::to_string(skeleton_.size()));
+  const Pose rest = skeleton_.restPose();
+  Pose goal = rest;  // keeps the rest root translation: the solve ignores the pose's
+  for (size_t j = 0; j < skeleton_.size(); ++j) {
+    const SanitizedQuat q = sanitizeQuaternion(target.local[j]);
+    if (q.status == QuatStatus::Invalid)
+      return fail("joint '" + skeleton_.joints[j].name + "' has a non-finite or zero rotation");
+    goal.local[j] = q.q;
+  }
+
+  const ClothSimSettings& s = settings_;
+  const ClothMaterial& mat = s.material;
+  const ClothConstraints& cc = constraints_;
+  const size_t nv = mesh_.vertexCount();
+  const int transitionFrames = std::max(1, int(std::lround(s.transitionSeconds * s.frameRate)));
+  const int totalFrames = transitionFrames + std::max(0, int(std::lround(s.settleSeconds * s.frameRate)));
+  const float dt = 1.f / (s.frameRate * float(s.substeps));
+  const float invDt2 = 1.f / (dt * dt);
+  const float keep = std::max(0.f, 1.f - mat.damping * dt);
+  const float reach = s.thickness + s.contactMargin;
+  const float* w = cc.inverseMass.data();
+
+  BodyCollider body = colliderPrototype_;
+  Points3f x = restLocal_, xPrev = restLocal_, vel = Points3f::Zero(Eigen::Index(nv), 3);
+  std::vector<Affine34> blendOld(nv), blendNew(nv);
+  auto blendAll = [&](const std::vector<Mat4f>& m, std::vector<Affine34>& b) {
+    for (size_t v = 0; v < nv; ++v) b[v] = blendedSkinMatrix(mesh_.skin, v, m).topRows<3>();
+  };
+  blendAll(localSkinMatrices(rest), blendOld);
+  std::vector<uint8_t> contact(nv, 0);
+  std::vector<Vec3f> contactPoint(nv), contactNormal(nv), attachTarget(attached_.size());
+  std::vector<float> lambda(cc.stretch.size() + cc.bending.size() + cc.shear.size() + attached_.size());
+
+  float lastFrameSpeed = 0.f;
+  for (int frame = 1; frame <= totalFrames; ++frame) {
+    // The body's pose at this frame: eased slerp from the A-pose, then held.
+    const float t = easeInOut(std::min(1.f, float(frame) / float(transitionFrames)));
+    Pose p = rest;
+    for (size_t j = 0; j < skeleton_.size(); ++j) p.local[j] = slerpShortest(rest.local[j], goal.local[j], t);
+    const std::vector<Mat4f> m = localSkinMatrices(p);
+    blendAll(m, blendNew);
+
+    // Carry every vertex (and its velocity) by its own skinning change since the last frame.
+    for (size_t v = 0; v < nv; ++v) {
+      const Mat3f aOld = blendOld[v].leftCols<3>(), aNew = blendNew[v].leftCols<3>();
+      if (!(std::abs(aOld.determinant()) > 1e-6f)) continue;  // degenerate blend: leave it to the solve
+      const Mat3f d = aNew * aOld.inverse();
+      V3 xv(x.data() + 3 * v), vv(vel.data() + 3 * v);
+      xv = d * (xv - blendOld[v].col(3)) + blendNew[v].col(3);
+      vv = d * Vec3f(vv);
+    }
+    body.pose(m);
+    for (size_t v = 0; v < nv; ++v) {
+      const BodyCollider::Hit hit = body.closest(x.row(Eigen::Index(v)), reach);
+      contact[v] = hit.found;
+      if (hit.found) contactPoint[v] = hit.point, contactNormal[v] = hit.normal;
+    }
+    for (size_t a = 0; a < attached_.size(); ++a) {
+      const uint32_t v = attached_[a];
+      attachTarget[a] = blendNew[v].leftCols<3>() * restLocal_.row(v).transpose() + blendNew[v].col(3);
+    }
+
+    float frameSpeed = 0.f;
+    for (int sub = 0; sub < s.substeps; ++sub) {
+      xPrev = x;
+      for (size_t v = 0; v < nv; ++v) {
+        V3 vv(vel.data() + 3 * v);
+        vv = (vv + s.gravity * dt) * keep;
+        V3(x.data() + 3 * v) += vv * dt;
+      }
+      for (int it = 0; it < s.iterations; ++it) {
+        if (it == 0) std::fill(lambda.begin(), lambda.end(), 0.f);
+        float* l = lambda.data();
+        for (const DistanceConstraint& c : cc.stretch) projectDistance(c, x.data(), w, invDt2, *l++);
+        for (const ShearConstraint& c : cc.shear) projectShear(c, x.data(), w, invDt2, *l++);
+        for (const DistanceConstraint& c : cc.bending) projectDistance(c, x.data(), w, invDt2, *l++);
+        for (size_t a = 0; a < attached_.size(); ++a, ++l) {
+          const uint32_t v = attached_[a];
+          V3 xv(x.data() + 3 * size_t(v));
+          const Vec3f d = xv - attachTarget[a];
+          const float C = d.norm();
+          if (!(C > 1e-9f)) continue;
+          const float alpha = attachCompliance_[a] * invDt2;
+          const float dl = (-C - alpha * *l) / (w[v] + alpha);
+          *l += dl;
+          xv += (w[v] * dl / C) * d;
+        }
+        // Tethers after the attachments, against the anchors' final positions of this sweep.
+        for (const Tether& t : tethers_) projectTether(t, s.tetherSlack, x.data());
+      }
+      // Contacts last, so the substep ends outside the thick body; friction cancels the tangential
+      // slide up to mu times the push (position-level Coulomb friction).
+      for (size_t v = 0; v < nv; ++v) {
+        if (!contact[v]) continue;
+        V3 xv(x.data() + 3 * v);
+        const Vec3f& n = contactNormal[v];
+        const float depth = s.thickness - n.dot(xv - contactPoint[v]);
+        if (!(depth > 0.f)) continue;
+        xv += depth * n;
+        Vec3f slide = xv - xPrev.row(Eigen::Index(v)).transpose();
+        slide -= n * n.dot(slide);
+        const float sl = slide.norm(), limit = mat.friction * depth;
+        xv -= sl <= limit ? slide : Vec3f(slide * (limit / sl));
+      }
+      for (size_t v = 0; v < nv; ++v) {
+        V3 vv(vel.data() + 3 * v);
+        vv = (V3(x.data() + 3 * v) - xPrev.row(Eigen::Index(v)).transpose()) / dt;
+        frameSpeed = std::max(frameSpeed, vv.squaredNorm());
+      }
+    }
+    if (!x.allFinite()) return fail("the solve produced non-finite positions at frame " + std::to_string(frame));
+    float stretch = 0.f;
+    for (const DistanceConstraint& c : cc.stretch)
+      stretch = std::max(stretch, ((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
+    if (stretch > s.failStrain)
+      return fail("the solve exploded at frame " + std::to_string(frame) + ": an edge stretched by " +
+                  std::to_string(100.f * stretch) + "%");
+    std::swap(blendOld, blendNew);
+    lastFrameSpeed = std::sqrt(frameSpeed);
+  }
+
+  SimResiduals& r = out.residuals;
+  for (const DistanceConstraint& c : cc.stretch)
+    r.maxConstraintViolation = std::max(r.maxConstraintViolation, ((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
+  for (size_t v = 0; v < nv; ++v) r.maxPenetration = std::max(r.maxPenetration, penetrationOf(body, x.row(Eigen::Index(v))));
+  r.iterations = totalFrames * s.substeps * s.iterations;
+  r.converged = lastFrameSpeed < s.convergedSpeed && r.maxConstraintViolation < s.convergedStrain;
+  if (r.maxPenetration > s.failPenetration)
+    return fail("the garment ends " + std::to_string(r.maxPenetration) + " m inside the body (bound " +
+                std::to_string(s.failPenetration) + " m)");
+  out.ok = true;
+  out.positions = x.rowwise() + origin_.transpose();
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace swish::bake

@@ -1,0 +1,91 @@
+#pragma once
+// The quasi-static garment solver of the bake (paper 2.2: "a slow 1 s transition from the A-pose to
+// the target pose, keep the final frame"). XPBD with small substeps (Macklin et al. 2016, 2019):
+// stretch, shear and bending constraints, the skinned body as a collider with thickness and Coulomb
+// friction, gravity, damping, and the garment's top band softly attached to its skinned position.
+//
+// Following the body: at every frame the cloth is carried by the change of its own skinning (each
+// vertex moved by B_new * B_old^-1), so a fast limb drags its sleeve along instead of tunnelling
+// through it; the solver then corrects what skinning gets wrong (stretch, squash, penetration, drape).
+//
+// Coordinates: the solve runs relative to the garment's rest centre (huge character coordinates lose
+// no precision inside the solve) and ignores the pose's root translation (the shape is a function of
+// the joint rotations alone). Results are in character space with the root at its rest position.
+#include <string>
+
+#include "swish/bake/body_collider.hpp"
+#include "swish/bake/cloth_constraints.hpp"
+#include "swish/bake/cloth_material.hpp"
+#include "swish/bake/dataset.hpp"
+#include "swish/bake/simulation_mesh.hpp"
+
+namespace swish::bake {
+
+struct ClothSimSettings {
+  ClothMaterial material = clothMaterialPreset("jersey");
+  float thickness = 0.004f;          // m: how far the cloth keeps off the body surface
+  float contactMargin = 0.02f;       // m: vertices this close beyond the thickness get a contact plane
+  float transitionSeconds = 1.f;     // A-pose -> target, eased
+  float settleSeconds = 0.5f;        // at the target pose before the frame is kept
+  float frameRate = 30.f;            // body poses (and contact planes) per second
+  int substeps = 8;                  // per frame
+  int iterations = 1;                // constraint sweeps per substep
+  Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);
+  float attachTopFraction = 0.08f;   // top band of the garment (fraction of its rest height) attached
+  float attachSag = 0.005f;          // m: how far the attached band would sag holding the whole garment
+  float tetherSlack = 0.01f;         // tethers let a vertex stretch this much beyond its rest geodesic
+  // Outcome bounds.
+  float convergedSpeed = 0.05f;      // m/s: the fastest vertex in the last frame, to count as settled
+  float convergedStrain = 0.25f;     // worst edge strain to count as converged
+  float failPenetration = 0.01f;     // m inside the thick surface: the pose fails beyond this
+  float failStrain = 1.0f;           // worst edge strain beyond which the solve has exploded
+
+  // Throws Error naming the field that is out of range.
+  void validate() const;
+};
+
+// One pose's outcome. When !ok, `failure` says why and `positions` is empty: never kept.
+struct PoseSimulation {
+  bool ok = false;
+  std::string failure;
+  Points3f positions;  // simulation-mesh vertices, character space (root translation ignored)
+  SimResiduals residuals;
+};
+
+class ClothSolver {
+ public:
+  // Validates the character's body and skeleton against the mesh and prepares constraints, masses,
+  // attachments and the collider prototype. Throws Error on bad input (including a garment that
+  // starts inside the body by more than failPenetration).
+  ClothSolver(const Character& character, SimulationMesh mesh, ClothSimSettings settings);
+
+  // Simulates one target pose. Thread-safe and deterministic: all state is local to the call, every
+  // loop is sequential, so the same input gives bitwise the same output on any thread. Bad poses
+  // (wrong joint count, non-finite rotations) and failed solves come back as !ok, never throw.
+  PoseSimulation simulate(const Pose& target) const;
+
+  const SimulationMesh& mesh() const { return mesh_; }
+  const ClothSimSettings& settings() const { return settings_; }
+  const std::vector<uint32_t>& attachedVertices() const { return attached_; }
+  // A 64-bit digest of everything that decides the result (mesh, body, skeleton, settings): the pose
+  // driver stores it with each result so that a re-run never reuses results of another setup.
+  uint64_t fingerprint() const { return fingerprint_; }
+
+ private:
+  std::vector<Mat4f> localSkinMatrices(const Pose& pose) const;
+  float penetrationOf(const BodyCollider& body, const Vec3f& p) const;
+
+  Skeleton skeleton_;
+  SimulationMesh mesh_;
+  ClothSimSettings settings_;
+  Vec3f origin_;            // the solve's origin in character space
+  Points3f restLocal_;      // simulation mesh rest positions relative to origin_
+  ClothConstraints constraints_;
+  std::vector<uint32_t> attached_;
+  std::vector<float> attachCompliance_;  // per attached vertex: 1 / its share of the band's stiffness
+  std::vector<Tether> tethers_;
+  BodyCollider colliderPrototype_;
+  uint64_t fingerprint_ = 0;
+};
+
+}  // namespace swish::bake

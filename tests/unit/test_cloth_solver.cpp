@@ -1,0 +1,258 @@
+// The source cloth simulation: simulation mesh, body collider, XPBD constraints, the per-pose solve.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+#include "support/random_model.hpp"
+#include "swish/bake/body_collider.hpp"
+#include "swish/bake/cloth_constraints.hpp"
+#include "swish/bake/cloth_solver.hpp"
+#include "swish/bake/simulation_mesh.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/rng.hpp"
+#include "unit/test_cloth_fixture.hpp"
+
+using namespace swish;
+using namespace swish::bake;
+
+namespace {
+
+// Short, coarse settings so each test runs in well under a second; the physics is the same.
+ClothSimSettings quickSettings(const char* preset = "jersey") {
+  ClothSimSettings s;
+  s.material = clothMaterialPreset(preset);
+  s.transitionSeconds = 0.5f;
+  s.settleSeconds = 0.5f;
+  return s;
+}
+
+// A square sheet of n x n vertices in a plane, skinned rigidly to joint 0.
+Mesh sheet(int n, float size, const Vec3f& corner, const Vec3f& du, const Vec3f& dv) {
+  Mesh m;
+  m.positions.resize(n * n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < n; ++k)
+      m.positions.row(i * n + k) = corner + size * (float(k) / float(n - 1) * du + float(i) / float(n - 1) * dv);
+  m.triangles.resize(2 * (n - 1) * (n - 1), 3);
+  int t = 0;
+  for (int i = 0; i + 1 < n; ++i)
+    for (int k = 0; k + 1 < n; ++k) {
+      const uint32_t a = uint32_t(i * n + k), b = a + 1, c = a + uint32_t(n), d = c + 1;
+      m.triangles.row(t++) << a, b, d;
+      m.triangles.row(t++) << a, d, c;
+    }
+  m.skin.influences = 1;
+  m.skin.joints.assign(m.vertexCount(), 0);
+  m.skin.weights.assign(m.vertexCount(), 1.f);
+  return m;
+}
+
+Mesh rigidBody(Mesh m) {
+  m.skin.influences = 1;
+  m.skin.joints.assign(m.vertexCount(), 0);
+  m.skin.weights.assign(m.vertexCount(), 1.f);
+  return m;
+}
+
+Pose bentPose(const Skeleton& sk, float angle) {
+  Pose p = sk.restPose();
+  p.local[2] = Quatf(Eigen::AngleAxisf(angle, Vec3f::UnitX()));
+  return p;
+}
+
+}  // namespace
+
+TEST(ClothSimulationMesh, WeldsSeamsAndSubdividesTowardsTarget) {
+  const Character ch = test::capsuleCharacter();
+  const SimulationMesh welded = buildSimulationMesh(ch, 0);
+  const test::CapsuleSpec spec;
+  EXPECT_EQ(welded.vertexCount(), size_t(spec.garmentAround * (spec.garmentRows + 1)));  // seam column merged
+  const SimulationMesh sim = buildSimulationMesh(ch, 12000);
+  EXPECT_GT(sim.vertexCount(), 6000u);
+  EXPECT_LT(sim.vertexCount(), 24000u);
+  EXPECT_EQ(sim.triangles.rows(), welded.triangles.rows() << (2 * sim.subdivisionLevels));
+  ASSERT_EQ(sim.gameToSim.size(), ch.garment.vertexCount());
+  for (size_t g = 0; g < sim.gameToSim.size(); ++g)
+    EXPECT_EQ(sim.restPositions.row(sim.gameToSim[g]), ch.garment.positions.row(Eigen::Index(g)));
+  for (size_t v = 0; v < sim.vertexCount(); ++v) {
+    float sum = 0.f;
+    for (int k = 0; k < sim.skin.influences; ++k) sum += sim.skin.weights[v * sim.skin.influences + k];
+    ASSERT_NEAR(sum, 1.f, 1e-5f) << "vertex " << v;
+  }
+}
+
+TEST(ClothSimulationMesh, RejectsGarmentWithoutSkinAndNonManifoldEdges) {
+  Character ch = test::capsuleCharacter();
+  Character noSkin = ch;
+  noSkin.garment.skin = {};
+  EXPECT_THROW(buildSimulationMesh(noSkin), Error);
+  Character fan = ch;  // a third triangle on an interior edge
+  fan.garment.triangles.conservativeResize(fan.garment.triangles.rows() + 1, 3);
+  fan.garment.triangles.bottomRows(1) << fan.garment.triangles(0, 0), fan.garment.triangles(0, 2), 100;  // a-e: interior
+  EXPECT_THROW(buildSimulationMesh(fan), Error);
+}
+
+TEST(ClothBodyCollider, SignedDistanceMatchesTheAnalyticCapsule) {
+  const test::CapsuleSpec spec;
+  const Mesh body = test::capsuleBody(spec);
+  BodyCollider collider(body, 0.03f);
+  Rng rng(test::testSeed(31));
+  for (int tested = 0; tested < 500;) {
+    // Points in a shell of +-3 cm around the surface, caps included, inside and outside.
+    const Vec3f p(rng.uniformf(-0.16f, 0.16f), rng.uniformf(-0.16f, 0.86f), rng.uniformf(-0.16f, 0.16f));
+    const float exact = test::capsuleSignedDistance(spec, p);
+    if (std::abs(exact) > 0.03f) continue;
+    ++tested;
+    const BodyCollider::Hit hit = collider.closest(p, 0.1f);
+    ASSERT_TRUE(hit.found) << "point " << p.transpose() << " exact " << exact;
+    // The tessellation lies inside the true capsule by at most R (1 - cos(pi / 32)) ~ 0.6 mm on the
+    // cylinder and ~2.3 mm on the 8-ring caps.
+    EXPECT_NEAR(hit.signedDistance, exact, 2.5e-3f) << "point " << p.transpose();
+    EXPECT_NEAR(hit.normal.norm(), 1.f, 1e-4f);
+    EXPECT_NEAR((hit.point + hit.normal * hit.signedDistance - p).norm(), 0.f, 1e-4f);
+  }
+  EXPECT_FALSE(collider.closest(Vec3f(1.f, 0.3f, 0.f), 0.1f).found);  // nothing within reach
+}
+
+TEST(ClothConstraints, ProjectionReducesViolation) {
+  const Character ch = test::capsuleCharacter();
+  const SimulationMesh sim = buildSimulationMesh(ch, 0);
+  ClothMaterial stiff = clothMaterialPreset("stiff");
+  const ClothConstraints cc = buildClothConstraints(sim, sim.restPositions, stiff);
+  ASSERT_FALSE(cc.stretch.empty());
+  ASSERT_FALSE(cc.shear.empty());
+  ASSERT_FALSE(cc.bending.empty());
+  Rng rng(test::testSeed(32));
+  Points3f x = sim.restPositions;
+  for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] += rng.uniformf(-3e-3f, 3e-3f);
+  auto stretchError = [&]() {
+    double e = 0;
+    for (const auto& c : cc.stretch) e += std::abs((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest;
+    return e;
+  };
+  auto shearError = [&]() {
+    double e = 0;
+    for (const auto& c : cc.shear) e += std::abs(shearStrain(c, x.data()));
+    return e;
+  };
+  const double stretch0 = stretchError(), shear0 = shearError();
+  const float invDt2 = 240.f * 240.f;
+  for (int sweep = 0; sweep < 3; ++sweep) {
+    std::vector<float> lambda(cc.stretch.size() + cc.shear.size(), 0.f);
+    float* l = lambda.data();
+    for (const auto& c : cc.stretch) projectDistance(c, x.data(), cc.inverseMass.data(), invDt2, *l++);
+    for (const auto& c : cc.shear) projectShear(c, x.data(), cc.inverseMass.data(), invDt2, *l++);
+  }
+  EXPECT_LT(stretchError(), 0.25 * stretch0);
+  EXPECT_LT(shearError(), 0.5 * shear0);
+}
+
+TEST(ClothSolver, HangingClothSettles) {
+  Character ch;
+  ch.name = "hanging sheet";
+  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
+  ch.garment = sheet(25, 0.5f, Vec3f(-0.25f, 0.5f, 0.f), Vec3f::UnitX(), Vec3f::UnitY());
+  test::CapsuleSpec far;
+  far.offset = Vec3f(0, -5.f, 0);  // a body, far out of the way
+  ch.body = test::capsuleBody(far);
+  ClothSimSettings s = quickSettings();
+  s.attachTopFraction = 0.01f;  // the top row only
+  s.settleSeconds = 1.5f;
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), s);
+  EXPECT_EQ(solver.attachedVertices().size(), 25u);
+  const PoseSimulation r = solver.simulate(ch.skeleton.restPose());
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_TRUE(r.residuals.converged);
+  EXPECT_LT(r.residuals.maxConstraintViolation, 0.05f);  // a knit stretches a little under its weight
+  EXPECT_GT(r.residuals.maxConstraintViolation, 0.f);
+  // It hangs: the bottom edge stays below the top, in the plane it started in, and has sagged.
+  const float bottomRest = 0.5f;
+  for (int k = 0; k < 25; ++k) {
+    EXPECT_LT(r.positions(k, 1), bottomRest);
+    EXPECT_NEAR(r.positions(k, 2), 0.f, 1e-3f);
+  }
+}
+
+TEST(ClothSolver, SphereIsNeverPenetratedBeyondThickness) {
+  test::CapsuleSpec ball;
+  ball.axisLow = ball.axisHigh = 0.f;
+  ball.rows = 0;
+  ball.around = 48;
+  Character ch;
+  ch.name = "sheet on a ball";
+  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
+  ch.body = rigidBody(test::capsuleBody(ball));
+  ch.garment = sheet(30, 0.5f, Vec3f(-0.25f, 0.14f, -0.25f), Vec3f::UnitX(), Vec3f::UnitZ());
+  ClothSimSettings s = quickSettings();
+  s.attachTopFraction = 0.f;  // free: it falls onto the ball and drapes
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), s);
+  const PoseSimulation r = solver.simulate(ch.skeleton.restPose());
+  ASSERT_TRUE(r.ok) << r.failure;
+  float lowest = 1.f, closest = 1.f;
+  for (Eigen::Index v = 0; v < r.positions.rows(); ++v) {
+    const float d = test::capsuleSignedDistance(ball, r.positions.row(v));
+    closest = std::min(closest, d);
+    lowest = std::min(lowest, r.positions(v, 1));
+  }
+  // The cloth fell (its corners droop well below where it started) yet stays off the ball: the
+  // thickness less the tessellation's deviation from the true sphere (R (1 - cos(11.25 deg)) = 2.3 mm).
+  EXPECT_LT(lowest, 0.f);
+  EXPECT_GT(closest, s.thickness - 2.4e-3f);
+  EXPECT_LT(r.residuals.maxPenetration, 1e-3f);
+}
+
+TEST(ClothSolver, TubeOnCapsuleFollowsABendWithoutPenetration) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 4000), quickSettings());
+  const PoseSimulation rest = solver.simulate(ch.skeleton.restPose());
+  ASSERT_TRUE(rest.ok) << rest.failure;
+  EXPECT_TRUE(rest.residuals.converged);
+  for (Eigen::Index v = 0; v < rest.positions.rows(); ++v)
+    ASSERT_GT(test::capsuleSignedDistance(spec, rest.positions.row(v)), solver.settings().thickness - 1e-3f);
+  const PoseSimulation bent = solver.simulate(bentPose(ch.skeleton, 0.8f));
+  ASSERT_TRUE(bent.ok) << bent.failure;
+  EXPECT_LT(bent.residuals.maxPenetration, 2e-3f);
+  // The upper part of the tube went with the bend (the Spine joint tips it towards +z... or -z).
+  float moved = 0.f;
+  for (Eigen::Index v = 0; v < bent.positions.rows(); ++v)
+    moved = std::max(moved, (bent.positions.row(v) - rest.positions.row(v)).norm());
+  EXPECT_GT(moved, 0.05f);
+}
+
+TEST(ClothSolver, DeterministicAcrossRunsAndThreads) {
+  const Character ch = test::capsuleCharacter();
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), quickSettings());
+  const Pose pose = bentPose(ch.skeleton, -0.6f);
+  const PoseSimulation a = solver.simulate(pose);
+  PoseSimulation b, c;
+  std::thread t1([&] { b = solver.simulate(pose); });
+  std::thread t2([&] { c = solver.simulate(pose); });
+  t1.join();
+  t2.join();
+  ASSERT_TRUE(a.ok && b.ok && c.ok);
+  EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), sizeof(float) * size_t(a.positions.size())));
+  EXPECT_EQ(0, std::memcmp(a.positions.data(), c.positions.data(), sizeof(float) * size_t(a.positions.size())));
+  EXPECT_EQ(a.residuals.maxPenetration, b.residuals.maxPenetration);
+}
+
+TEST(ClothSolver, BadPosesAreReportedNotSimulated) {
+  const Character ch = test::capsuleCharacter();
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), quickSettings());
+  Pose wrong = ch.skeleton.restPose();
+  wrong.local.pop_back();
+  const PoseSimulation r = solver.simulate(wrong);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("joint rotations"), std::string::npos) << r.failure;
+  EXPECT_EQ(r.positions.rows(), 0);
+}
+
+TEST(ClothSolver, RejectsAGarmentInsideTheBody) {
+  test::CapsuleSpec spec;
+  spec.gap = -0.03f;  // the tube 3 cm inside the capsule
+  const Character ch = test::capsuleCharacter(spec);
+  EXPECT_THROW(ClothSolver(ch, buildSimulationMesh(ch, 0), quickSettings()), Error);
+}
