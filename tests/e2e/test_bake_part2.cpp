@@ -1,7 +1,8 @@
 // Part 2 of the bake end to end on a synthetic dataset whose truth is known: shapes from a low-rank
 // smooth function of the pose, normal maps from pose-dependent sinusoids. trainBake -> report files ->
 // saveModel -> loadModel -> the runtime's MLP evaluator and reference frame run on the loaded model.
-// (The full `swish bake CONFIG` with part 1 is not wired yet; see the bake pipeline.)
+// The second test drives runBake (what `swish bake CONFIG` runs) on the same dataset written to a
+// dataset folder, and checks that a re-run skips part 2. (Part 1 is not wired into runBake yet.)
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,9 +10,12 @@
 #include <fstream>
 
 #include "support/random_model.hpp"
+#include "swish/bake/bake_pipeline.hpp"
 #include "swish/bake/bake_report.hpp"
+#include "swish/bake/dataset_io.hpp"
 #include "swish/bake/bake_training.hpp"
 #include "swish/core/skinning.hpp"
+#include "swish/core/error.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/reference_frame.hpp"
@@ -124,5 +128,42 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     err += (frame.positions[0].row(v) - p.gameMeshWorld.row(v)).norm();
   err = 1000.0 * err / double(frame.positions[0].rows());
   EXPECT_NEAR(err, out.evaluation.perPose[0].meanMm, 1e-3);  // same path, same answer
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {
+  const uint64_t seed = test::testSeed(502);
+  const Dataset ds = syntheticDataset(seed, 60, 16);
+  const auto dir = std::filesystem::temp_directory_path() / ("swish_run_bake_" + std::to_string(seed));
+  std::filesystem::remove_all(dir);
+  {
+    DatasetWriter w(dir / "dataset", ds.character, ds.inputJoints, ds.settings, 16);
+    for (const auto& p : ds.poses) w.writePose(p);
+    w.writeManifest();
+  }
+  const BakeConfig cfg = parseBakeConfig(
+      {{"name", "tiny"}, {"output", "out"}, {"dataset", "dataset"},
+       {"train", {{"mesh_components", 4}, {"normal_code_dims", 3}, {"database_size", 8}, {"codebook_size", 64},
+                  {"hidden_layers", 2}, {"max_epochs", 60}, {"patience", 20}}}},
+      "tiny.json", dir);
+  std::vector<std::string> lines;
+  BakeRunOptions o;
+  o.log = [&](const std::string& l) { lines.push_back(l); };
+  const BakeRunResult first = runBake(cfg, o);
+  EXPECT_FALSE(first.part2Skipped);
+  EXPECT_TRUE(std::filesystem::exists(first.report));
+  const Model m = loadModel(first.model);
+  EXPECT_EQ(m.normalMaps.mapCount(), 8u);
+  EXPECT_EQ(nlohmann::json::parse(m.metadata)["name"], "tiny");
+  bool sawTimeLeft = false;
+  for (const auto& l : lines) sawTimeLeft |= l.find("left") != std::string::npos;
+  EXPECT_TRUE(sawTimeLeft);
+  EXPECT_TRUE(runBake(cfg, o).part2Skipped);  // same dataset, same settings: nothing to redo
+  BakeRunOptions force = o;
+  force.force = true;
+  EXPECT_FALSE(runBake(cfg, force).part2Skipped);
+  // No dataset and no part 1 section: a clear error before any work.
+  const BakeConfig none = parseBakeConfig({{"output", "o2"}}, "none.json", dir);
+  EXPECT_THROW(runBake(none, o), Error);
   std::filesystem::remove_all(dir);
 }
