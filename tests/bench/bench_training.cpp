@@ -24,7 +24,7 @@ static void makeData(MatXf& x, MatXf& y, int samples, int outputs) {
       x.block<3, 1>(6 * j, s) = r.col(0);
       x.block<3, 1>(6 * j + 3, s) = r.col(1);
     }
-    y.col(s) = (mix * x.col(s)).array().sin().matrix() / float(1 + s % 3);
+    y.col(s) = (0.5f * mix * x.col(s)).array().sin().matrix();
   }
 }
 
