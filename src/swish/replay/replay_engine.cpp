@@ -1,0 +1,278 @@
+#include "swish/replay/replay_engine.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "swish/core/error.hpp"
+#include "swish/gpu/frame_recorder.hpp"
+#include "swish/gpu/gpu_model.hpp"
+#include "swish/replay/gpu_check.hpp"
+#include "swish/replay/pose_stream.hpp"
+#include "swish/runtime/mlp_evaluator.hpp"
+#include "swish/runtime/nearest_code.hpp"
+#include "swish/runtime/temporal_filter.hpp"
+#include "swish/runtime/theta.hpp"
+
+namespace swish::replay {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+double addMs(double a, double b) { return std::isnan(b) ? a : (std::isnan(a) ? b : a + b); }
+
+}  // namespace
+
+double FrameRecord::maxPositionErrorMm() const {
+  double m = 0;
+  for (const auto& c : checks) m = std::max(m, c.maxPositionErrorMm);
+  return m;
+}
+double FrameRecord::maxNormalErrorDeg() const {
+  double m = 0;
+  for (const auto& c : checks) m = std::max({m, c.maxNormalErrorDeg, c.maxTangentErrorDeg});
+  return m;
+}
+int FrameRecord::maxMapErrorSteps() const {
+  int m = 0;
+  for (const auto& c : checks) m = std::max(m, c.maxMapErrorSteps);
+  return m;
+}
+
+// One model's batch: its CPU evaluators, per-character motion and filter state, and its GPU side.
+struct Batch {
+  const runtime::PlannedBatch* planned = nullptr;
+  const Model* model = nullptr;
+  Model gpuModelData;  // the model as uploaded: without its database when the plan leaves maps out
+  std::optional<runtime::MlpEvaluator> mlp;
+  std::optional<runtime::NearestCodeSearch> search;
+  std::vector<runtime::TemporalFilter> filters;
+  std::vector<uint32_t> lastMap;
+  std::vector<CharacterMotion> motions;
+  std::unique_ptr<gpu::GpuModel> gpuModel;
+  std::unique_ptr<gpu::FrameRecorder> recorder;
+  // Per frame scratch.
+  std::vector<float> theta, meshWeights, codes;
+  runtime::FrameKernelInputs inputs;
+};
+
+struct ReplayEngine::Impl {
+  const runtime::Scene& scene;
+  ModelLibrary& models;
+  ReplayOptions options;
+  runtime::ReplayPlan plan;
+  std::optional<gpu::Context> ownContext;
+  gpu::Context* ctx = nullptr;
+  std::vector<Batch> batches;
+
+  Impl(const runtime::Scene& s, ModelLibrary& m, const ReplayOptions& o) : scene(s), models(m), options(o) {}
+  void setUp();
+  FrameRecord runFrame(uint32_t index, ReplayResult& result);
+};
+
+void ReplayEngine::Impl::setUp() {
+  const std::string where = scene.source.empty() ? std::string("scene") : scene.source.string();
+  plan = runtime::planReplay(scene, models.modelMap());
+  batches.resize(plan.batches.size());
+  for (size_t b = 0; b < plan.batches.size(); ++b) {
+    Batch& B = batches[b];
+    B.planned = &plan.batches[b];
+    B.model = &models.at(B.planned->model).model;
+    B.mlp.emplace(*B.model);
+    if (B.planned->normalMaps) {
+      B.search.emplace(B.model->normalMaps.keys);
+      B.filters.assign(B.planned->characters.size(), runtime::TemporalFilter(B.model->temporalFilter.timeConstantSeconds));
+      B.lastMap.assign(B.planned->characters.size(), 0);
+    }
+    for (uint32_t c : B.planned->characters) {
+      const runtime::SceneCharacter& ch = scene.characters[c];
+      try {
+        if (ch.clip) {
+          auto clip = models.clip(ch.clip->file, ch.model);
+          if (!ch.clip->clipName.empty() && ch.clip->clipName != clip->name)
+            throw Error("the file's clip is '" + clip->name + "', not '" + ch.clip->clipName + "'");
+          B.motions.emplace_back(clip, *ch.clip, B.model->skeleton, ch.name);
+        } else {
+          B.motions.emplace_back(std::make_shared<PoseStream>(readPoseStream(*ch.poseStream)), B.model->skeleton, ch.name);
+        }
+      } catch (const Error& e) {
+        throw Error(where + ": characters[" + std::to_string(c) + "] ('" + ch.name + "'): " + e.what());
+      }
+    }
+  }
+  if (!plan.gpuWork) return;
+  if (options.context) {
+    ctx = options.context;
+  } else {
+    ownContext.emplace(gpu::Context::create(options.device));
+    ctx = &*ownContext;
+  }
+  for (Batch& B : batches) {
+    B.gpuModelData = *B.model;
+    if (!B.planned->normalMaps) {
+      B.gpuModelData.normalMaps = NormalMapDatabase{};  // not uploaded: the plan leaves normal maps out
+    }
+    B.gpuModel = std::make_unique<gpu::GpuModel>(*ctx, B.gpuModelData, B.planned->model);
+    gpu::FrameRecorderOptions ro;
+    ro.framesInFlight = 1;
+    ro.tangentFrames = B.planned->tangentFrames;
+    ro.normalMaps = B.planned->normalMaps;
+    B.recorder = std::make_unique<gpu::FrameRecorder>(*ctx, *B.gpuModel, uint32_t(B.planned->characters.size()), ro);
+  }
+}
+
+FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
+  FrameRecord rec;
+  rec.frame = scene.firstFrame + index;
+  const double seconds = scene.timeOfFrame(rec.frame);
+  const float dt = index == 0 ? 0.f : float(1.0 / scene.framesPerSecond);
+  FrameTimes& t = rec.times;
+  t.gpuDeform = t.gpuTangents = t.gpuDecode = t.gpuBlend = t.gpuTotal = kNaN;
+  std::vector<PoseIssue> issues;
+
+  for (Batch& B : batches) {
+    const Model& m = *B.model;
+    const uint32_t n = uint32_t(B.planned->characters.size());
+    const size_t jc = m.skeleton.size(), ts = size_t(m.thetaSize()), k = size_t(m.meshComponents());
+    auto t0 = Clock::now();
+    std::vector<Pose> poses;
+    poses.reserve(n);
+    B.inputs.instanceCount = n;
+    B.inputs.skinMatrices.resize(n * jc);
+    for (uint32_t i = 0; i < n; ++i) {
+      poses.push_back(B.motions[i].poseAt(seconds, rec.frame, issues));
+      // Character space: the placement never enters the skinning (precision far from the origin).
+      const auto mats = m.skeleton.skinningMatrices(poses.back());
+      std::copy(mats.begin(), mats.end(), B.inputs.skinMatrices.begin() + i * jc);
+    }
+    t.pose += msSince(t0);
+
+    t0 = Clock::now();
+    B.theta.resize(n * ts);
+    for (uint32_t i = 0; i < n; ++i)
+      runtime::computeTheta(m.inputJoints, poses[i].local, std::span<float>(B.theta).subspan(i * ts, ts));
+    t.theta += msSince(t0);
+
+    t0 = Clock::now();
+    B.meshWeights.resize(n * k);
+    B.codes.resize(n * size_t(m.normalCodeDims()));
+    B.mlp->evaluateBatchSplit(B.theta, B.meshWeights, B.codes, n);
+    t.mlp += msSince(t0);
+
+    t0 = Clock::now();
+    B.inputs.meshWeights = B.meshWeights;
+    B.inputs.selectedMaps.clear();
+    B.inputs.blendAlpha.clear();
+    if (B.search) {
+      const size_t cd = size_t(m.normalCodeDims());
+      for (uint32_t i = 0; i < n; ++i) {
+        const auto hit = B.search->find(std::span<const float>(B.codes).subspan(i * cd, cd), B.lastMap[i]);
+        if (!hit.found)
+          issues.push_back({rec.frame, scene.characters[B.planned->characters[i]].name, "", "non-finite normal code",
+                            "previous normal map kept"});
+        B.lastMap[i] = hit.index;
+        const runtime::BlendStep step = B.filters[i].step(dt, hit.index);
+        B.inputs.selectedMaps.push_back(step.selectedMap);
+        B.inputs.blendAlpha.push_back(step.alpha);
+      }
+    }
+    t.lookup += msSince(t0);
+  }
+
+  const bool check = plan.gpuWork && index % scene.outputs.gpuCheckEvery == 0;
+  const bool readBack = plan.gpuWork && (check || options.readBackEveryFrame || options.onCharacterOutput);
+  if (plan.gpuWork) {
+    // The reference needs each character's normal map as the GPU had it before this frame.
+    std::vector<std::vector<runtime::BlendedNormalMap>> prevMaps(batches.size());
+    if (check)
+      for (size_t b = 0; b < batches.size(); ++b) {
+        Batch& B = batches[b];
+        if (!B.planned->normalMaps) continue;
+        const auto& imgs = B.recorder->frame(0).normalMaps;
+        const auto all = imgs.download(*ctx);
+        const size_t per = size_t(imgs.width()) * imgs.height() * 2;
+        for (uint32_t i = 0; i < B.planned->characters.size(); ++i)
+          prevMaps[b].push_back({imgs.width(), imgs.height(), std::vector<int16_t>(all.begin() + i * per, all.begin() + (i + 1) * per)});
+      }
+    auto t0 = Clock::now();
+    VkCommandBuffer cmd = ctx->beginOneTime();
+    try {
+      for (Batch& B : batches) B.recorder->record(cmd, index, B.inputs);
+    } catch (...) {
+      ctx->abandonOneTime(cmd);
+      throw;
+    }
+    t.record = msSince(t0);
+    t0 = Clock::now();
+    ctx->endOneTimeAndWait(cmd);
+    t.gpuWait = msSince(t0);
+    for (Batch& B : batches) {
+      const gpu::StageTimes s = B.recorder->stageTimes(0);
+      t.gpuDeform = addMs(t.gpuDeform, s.deformMs);
+      t.gpuTangents = addMs(t.gpuTangents, s.tangentFramesMs);
+      t.gpuDecode = addMs(t.gpuDecode, s.vqDecodeMs);
+      t.gpuBlend = addMs(t.gpuBlend, s.normalBlendMs);
+      t.gpuTotal = addMs(t.gpuTotal, s.totalMs);
+    }
+    if (readBack) {
+      rec.checked = check;
+      for (size_t b = 0; b < batches.size(); ++b) {
+        Batch& B = batches[b];
+        const runtime::ReferenceFrameOutputs gpuOut = B.recorder->download(0);
+        if (check) {
+          const runtime::ReferenceFrameOutputs cpuOut = runtime::referenceFrame(B.gpuModelData, B.inputs, prevMaps[b]);
+          for (uint32_t i = 0; i < B.planned->characters.size(); ++i) {
+            CharacterCheck c = compareInstance(gpuOut, cpuOut, i, B.planned->characters[i]);
+            if (!c.ok)
+              result.failures.push_back("frame " + std::to_string(rec.frame) + ", character '" +
+                                        scene.characters[c.character].name + "': GPU output differs from the CPU reference (" +
+                                        std::to_string(c.maxPositionErrorMm) + " mm, " + std::to_string(c.maxNormalErrorDeg) +
+                                        " deg, " + std::to_string(c.maxMapErrorSteps) + " map steps)");
+            rec.checks.push_back(c);
+          }
+        }
+        if (options.onCharacterOutput)
+          for (uint32_t i = 0; i < B.planned->characters.size(); ++i)
+            options.onCharacterOutput(rec.frame, B.planned->characters[i], gpuOut, i);
+      }
+    }
+  }
+  rec.poseIssues = uint32_t(issues.size());
+  result.issueCount += issues.size();
+  for (auto& i : issues)
+    if (result.issues.size() < kMaxIssues) result.issues.push_back(std::move(i));
+  return rec;
+}
+
+ReplayEngine::ReplayEngine(const runtime::Scene& scene, ModelLibrary& models, const ReplayOptions& options)
+    : impl_(std::make_unique<Impl>(scene, models, options)) {
+  impl_->setUp();
+}
+
+ReplayEngine::~ReplayEngine() = default;
+
+const runtime::ReplayPlan& ReplayEngine::plan() const { return impl_->plan; }
+
+ReplayResult ReplayEngine::run() {
+  Impl& I = *impl_;
+  ReplayResult r;
+  r.plan = I.plan;
+  r.device = I.ctx ? I.ctx->deviceName() : std::string("(no GPU work planned)");
+  if (I.options.truthEvery > 0)
+    r.truthNote = "--truth-every " + std::to_string(I.options.truthEvery) +
+                  ": no ground truth: the source simulation needs the model's bake character (body mesh, simulation mesh, "
+                  "cloth settings), which a .swish file does not carry, and the bake has no API yet from a model back to its "
+                  "recipe";
+  else
+    r.truthNote = "no ground truth requested (--truth-every N), and the models' metadata holds no held-out poses";
+  for (uint32_t f = 0; f < I.scene.frameCount; ++f) {
+    r.frames.push_back(I.runFrame(f, r));
+    if (I.options.progress) I.options.progress(f + 1, I.scene.frameCount);
+  }
+  return r;
+}
+
+}  // namespace swish::replay

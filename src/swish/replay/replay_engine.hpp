@@ -1,0 +1,111 @@
+#pragma once
+// The replay frame loop: for every scene frame, per model batch (planner.hpp), on the CPU the poses
+// (CharacterMotion), forward kinematics and skinning matrices, Theta, the MLP, the nearest-code lookup
+// and temporal filter; then the GPU passes of every batch recorded into one command buffer, submitted
+// and waited on. Per-stage times come from CPU clocks and GPU timestamps.
+//
+// Far from the origin: everything is computed in CHARACTER space (skinning matrices, deformed meshes,
+// normals); the placement (ScenePlacement, double precision) is applied only to what leaves the
+// engine (world positions of reports and exported meshes). A character at 1e4 m therefore gets
+// bitwise the local mesh it gets at the origin.
+//
+// Errors measured: on every outputs.gpuCheckEvery-th frame, the GPU outputs of that frame against the
+// CPU reference (runtime::referenceFrame) fed the same inputs and the GPU's previous normal maps:
+// positions (mm), normals and tangents (degrees), normal maps (snorm16 steps), per character.
+// Ground truth (per-vertex error against the source simulation) needs a model whose bake character is
+// at hand; ReplayResult::truthNote says why it is not available.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "swish/gpu/context.hpp"
+#include "swish/replay/character_motion.hpp"
+#include "swish/replay/model_library.hpp"
+#include "swish/runtime/planner.hpp"
+#include "swish/runtime/reference_frame.hpp"
+#include "swish/runtime/scene.hpp"
+
+namespace swish::replay {
+
+struct ReplayOptions {
+  gpu::ContextOptions device;
+  gpu::Context* context = nullptr;  // use this device instead of creating one (tests, hosts)
+  uint32_t truthEvery = 0;          // 0: none; N: ask for ground truth on every Nth frame
+  std::function<void(uint32_t framesDone, uint32_t framesTotal)> progress;
+  // Called after each frame with its GPU outputs read back (local, character space), per on-screen
+  // character in plan order; only on frames where outputs are read back (checks, meshes, normalMaps).
+  std::function<void(uint32_t sceneFrame, uint32_t character, const runtime::ReferenceFrameOutputs& batchOutputs,
+                     uint32_t instance)>
+      onCharacterOutput;
+  bool readBackEveryFrame = false;  // read outputs back on every frame, not only on checks
+};
+
+// Milliseconds; NaN where a stage did not run.
+struct FrameTimes {
+  double pose = 0, theta = 0, mlp = 0, lookup = 0, record = 0;  // CPU stages (record: inputs + commands)
+  double gpuWait = 0;                                            // submit -> fence, wall clock
+  double gpuDeform = 0, gpuTangents = 0, gpuDecode = 0, gpuBlend = 0, gpuTotal = 0;  // GPU timestamps
+  double cpuTotal() const { return pose + theta + mlp + lookup + record; }
+};
+
+struct CharacterCheck {
+  uint32_t character = 0;
+  double maxPositionErrorMm = 0, rmsPositionErrorMm = 0;
+  double maxNormalErrorDeg = 0, maxTangentErrorDeg = 0;
+  int maxMapErrorSteps = 0;  // snorm16 steps
+  bool ok = true;
+};
+
+struct FrameRecord {
+  uint32_t frame = 0;
+  FrameTimes times;
+  bool checked = false;
+  std::vector<CharacterCheck> checks;  // when checked
+  uint32_t poseIssues = 0;
+  double maxPositionErrorMm() const;
+  double maxNormalErrorDeg() const;
+  int maxMapErrorSteps() const;
+};
+
+// Tolerances of the GPU-vs-CPU check, with their reasons (the conformance suite's per-kernel bounds
+// are tighter; these flag a broken device, not rounding): positions 0.05 mm (float rounding of a
+// few-metre skinning is ~1e-4 mm), normals and tangents 0.5 degrees (a near-degenerate triangle can
+// tip a gathered sum), normal maps 2 snorm16 steps (Vulkan allows 1 either way on float -> snorm).
+inline constexpr double kPositionToleranceMm = 0.05, kFrameToleranceDeg = 0.5;
+inline constexpr int kMapToleranceSteps = 2;
+
+struct ReplayResult {
+  runtime::ReplayPlan plan;
+  std::string device;
+  std::vector<FrameRecord> frames;
+  std::vector<PoseIssue> issues;  // the first kMaxIssues
+  size_t issueCount = 0;
+  std::vector<std::string> failures;  // checks beyond tolerance, in words
+  bool truthAvailable = false;
+  std::string truthNote;
+  bool failed() const { return !failures.empty() || issueCount > 0; }
+};
+
+inline constexpr size_t kMaxIssues = 2000;
+
+class ReplayEngine {
+ public:
+  // Plans, loads motions (Error naming the scene and character), creates or adopts the device and
+  // uploads the models of the batches.
+  ReplayEngine(const runtime::Scene& scene, ModelLibrary& models, const ReplayOptions& options = {});
+  ~ReplayEngine();
+  ReplayEngine(const ReplayEngine&) = delete;
+  ReplayEngine& operator=(const ReplayEngine&) = delete;
+
+  const runtime::ReplayPlan& plan() const;
+  // Runs every frame of the scene.
+  ReplayResult run();
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace swish::replay

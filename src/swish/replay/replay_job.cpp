@@ -1,0 +1,83 @@
+#include "swish/replay/replay_job.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "swish/core/error.hpp"
+#include "swish/io/png.hpp"
+#include "swish/replay/progress_bar.hpp"
+#include "swish/replay/report_writer.hpp"
+
+namespace swish::replay {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Removes the staging folder unless released.
+struct StagingFolder {
+  fs::path path;
+  bool keep = false;
+  ~StagingFolder() {
+    std::error_code ec;
+    if (!keep && !path.empty()) fs::remove_all(path, ec);
+  }
+};
+
+void writeNormalMap(const fs::path& file, const runtime::BlendedNormalMap& map) {
+  std::vector<float> xy(map.xy.size());
+  for (size_t i = 0; i < xy.size(); ++i) xy[i] = runtime::snorm16ToFloat(map.xy[i]);
+  io::writePng(file, io::encodeNormalMap(map.width, map.height, xy, 16));
+}
+
+}  // namespace
+
+ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions& options) {
+  const runtime::SceneOutputs& out = scene.outputs;
+  if (out.meshes)
+    throw Error(scene.source.string() + ": outputs.meshes: glTF export needs io/gltf_export, which this build does not have yet");
+  ModelLibrary models(scene);
+  ReplayOptions eo = options.engine;
+  const bool writes = out.report || out.normalMaps;
+  StagingFolder staging;
+  if (writes) {
+    staging.path = out.directory.string() + ".partial-" + std::to_string(::getpid());
+    fs::remove_all(staging.path);
+    fs::create_directories(staging.path);
+  }
+  if (out.normalMaps) {
+    eo.readBackEveryFrame = true;
+    fs::create_directories(staging.path / "normal_maps");
+    eo.onCharacterOutput = [&, user = options.engine.onCharacterOutput](uint32_t frame, uint32_t c,
+                                                                        const runtime::ReferenceFrameOutputs& o, uint32_t i) {
+      if (i < o.normalMaps.size()) {
+        char name[64];
+        std::snprintf(name, sizeof name, "_%06u.png", frame);
+        writeNormalMap(staging.path / "normal_maps" / (scene.characters[c].name + name), o.normalMaps[i]);
+      }
+      if (user) user(frame, c, o, i);
+    };
+  }
+  ProgressBar bar("swish replay", options.quiet);
+  eo.progress = [&, user = options.engine.progress](uint32_t d, uint32_t t) {
+    bar.update(d, t);
+    if (user) user(d, t);
+  };
+  ReplayEngine engine(scene, models, eo);
+  ReplayJobResult r;
+  r.result = engine.run();
+  bar.finish();
+  if (out.report) writeReport(staging.path, scene, models, r.result);
+  if (writes) {
+    std::error_code ec;
+    fs::remove_all(out.directory, ec);
+    fs::rename(staging.path, out.directory, ec);
+    if (ec) throw Error(out.directory.string() + ": cannot move the outputs into place: " + ec.message());
+    staging.keep = true;
+    r.directory = out.directory;
+  }
+  return r;
+}
+
+}  // namespace swish::replay

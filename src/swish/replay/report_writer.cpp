@@ -1,0 +1,214 @@
+#include "swish/replay/report_writer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "swish/model/atomic_write.hpp"
+#include "swish/replay/svg_plot.hpp"
+#include "swish/runtime/scene_file.hpp"
+
+namespace swish::replay {
+
+namespace {
+
+using nlohmann::json;
+
+struct StageColumn {
+  const char* key;
+  const char* label;
+  double FrameTimes::*field;
+};
+const std::vector<StageColumn>& stageColumns() {
+  static const std::vector<StageColumn> s = {
+      {"pose", "CPU pose + FK + skin matrices", &FrameTimes::pose},
+      {"theta", "CPU Theta (6D)", &FrameTimes::theta},
+      {"mlp", "CPU MLP", &FrameTimes::mlp},
+      {"lookup", "CPU lookup + filter", &FrameTimes::lookup},
+      {"record", "CPU record + upload", &FrameTimes::record},
+      {"gpuDeform", "GPU deform", &FrameTimes::gpuDeform},
+      {"gpuTangents", "GPU normals + tangents", &FrameTimes::gpuTangents},
+      {"gpuDecode", "GPU VQ decode", &FrameTimes::gpuDecode},
+      {"gpuBlend", "GPU normal-map blend", &FrameTimes::gpuBlend},
+      {"gpuTotal", "GPU total (timestamps)", &FrameTimes::gpuTotal},
+      {"gpuWait", "submit to fence (wall)", &FrameTimes::gpuWait},
+  };
+  return s;
+}
+
+double quantile(std::vector<double> v, double q) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[size_t(std::min<double>(double(v.size() - 1), std::floor(q * double(v.size()))))];
+}
+
+std::string fmt(double v, const char* f = "%.4g") {
+  if (!std::isfinite(v)) return "-";
+  char s[48];
+  std::snprintf(s, sizeof s, f, v);
+  return s;
+}
+double num(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
+
+}  // namespace
+
+json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const ReplayResult& r) {
+  json j;
+  j["swishReplayReport"] = 1;
+  j["scene"] = runtime::sceneToJson(scene);
+  j["device"] = r.device;
+  j["models"] = json::array();
+  for (const auto& e : models.entries()) {
+    const Model& m = e->model;
+    j["models"].push_back({{"key", e->key}, {"label", e->label}, {"procedural", e->procedural},
+                           {"vertices", m.gameMesh.vertexCount()}, {"triangles", m.gameMesh.triangleCount()},
+                           {"joints", m.skeleton.size()}, {"inputJoints", m.inputJoints.size()},
+                           {"meshComponents", m.meshComponents()}, {"normalMaps", m.normalMaps.mapCount()},
+                           {"mapSize", m.normalMaps.width}});
+  }
+  j["plan"] = r.plan.toJson();
+  j["truth"] = {{"available", r.truthAvailable}, {"note", r.truthNote}};
+  j["frames"] = json::array();
+  std::vector<json> perChar(scene.characters.size());
+  for (size_t c = 0; c < scene.characters.size(); ++c)
+    perChar[c] = {{"name", scene.characters[c].name}, {"model", scene.characters[c].model}, {"onScreen", scene.onScreen(c)},
+                  {"checks", 0}, {"maxPositionErrorMm", 0.0}, {"maxNormalErrorDeg", 0.0}, {"maxMapErrorSteps", 0}, {"poseIssues", 0}};
+  for (const auto& f : r.frames) {
+    json t;
+    for (const auto& s : stageColumns()) t[s.key] = f.times.*s.field;
+    t["cpuTotal"] = f.times.cpuTotal();
+    json fj{{"frame", f.frame}, {"times", t}, {"checked", f.checked}, {"poseIssues", f.poseIssues}};
+    if (f.checked)
+      fj["gpuVsCpu"] = {{"maxPositionErrorMm", f.maxPositionErrorMm()}, {"maxNormalErrorDeg", f.maxNormalErrorDeg()},
+                        {"maxMapErrorSteps", f.maxMapErrorSteps()}};
+    for (const auto& c : f.checks) {
+      json& pc = perChar[c.character];
+      pc["checks"] = pc["checks"].get<int>() + 1;
+      pc["maxPositionErrorMm"] = std::max(pc["maxPositionErrorMm"].get<double>(), c.maxPositionErrorMm);
+      pc["maxNormalErrorDeg"] = std::max({pc["maxNormalErrorDeg"].get<double>(), c.maxNormalErrorDeg, c.maxTangentErrorDeg});
+      pc["maxMapErrorSteps"] = std::max(pc["maxMapErrorSteps"].get<int>(), c.maxMapErrorSteps);
+    }
+    j["frames"].push_back(fj);
+  }
+  for (const auto& i : r.issues)
+    for (size_t c = 0; c < scene.characters.size(); ++c)
+      if (scene.characters[c].name == i.character) perChar[c]["poseIssues"] = perChar[c]["poseIssues"].get<int>() + 1;
+  j["characters"] = perChar;
+  json summary;
+  for (const auto& s : stageColumns()) {
+    std::vector<double> v;
+    for (const auto& f : r.frames) v.push_back(f.times.*s.field);
+    summary["medianMs"][s.key] = quantile(v, 0.5);
+    summary["p95Ms"][s.key] = quantile(v, 0.95);
+  }
+  std::vector<double> cpu;
+  for (const auto& f : r.frames) cpu.push_back(f.times.cpuTotal());
+  summary["medianMs"]["cpuTotal"] = quantile(cpu, 0.5);
+  double maxPos = 0, maxDeg = 0;
+  int maxMap = 0, checked = 0;
+  for (const auto& f : r.frames)
+    if (f.checked) {
+      ++checked;
+      maxPos = std::max(maxPos, f.maxPositionErrorMm());
+      maxDeg = std::max(maxDeg, f.maxNormalErrorDeg());
+      maxMap = std::max(maxMap, f.maxMapErrorSteps());
+    }
+  summary["frames"] = r.frames.size();
+  summary["checkedFrames"] = checked;
+  summary["gpuVsCpu"] = {{"maxPositionErrorMm", maxPos}, {"maxNormalErrorDeg", maxDeg}, {"maxMapErrorSteps", maxMap}};
+  summary["failures"] = r.failures.size();
+  summary["poseIssues"] = r.issueCount;
+  summary["failed"] = r.failed();
+  j["summary"] = summary;
+  j["failures"] = r.failures;
+  j["issues"] = json::array();
+  for (const auto& i : r.issues)
+    j["issues"].push_back({{"frame", i.frame}, {"character", i.character}, {"joint", i.joint}, {"problem", i.problem}, {"action", i.action}});
+  return j;
+}
+
+std::string reportMarkdown(const json& j) {
+  std::ostringstream s;
+  const json& sum = j["summary"];
+  s << "# swish replay: " << j["scene"]["name"].get<std::string>() << "\n\n";
+  s << "**Result: " << (sum["failed"].get<bool>() ? "FAILED" : "OK") << "** -- " << sum["frames"] << " frames, "
+    << j["characters"].size() << " characters, device: " << j["device"].get<std::string>() << ".\n\n";
+  s << "## Models\n\n";
+  for (const auto& m : j["models"])
+    s << "- `" << m["key"].get<std::string>() << "`: " << m["label"].get<std::string>() << " -- " << m["vertices"]
+      << " vertices, " << m["joints"] << " joints (" << m["inputJoints"] << " in Theta), K = " << m["meshComponents"] << ", "
+      << m["normalMaps"] << " normal maps of " << m["mapSize"] << " px\n";
+  s << "\n## Plan\n\n" << j["plan"]["gpuDispatchesPerFrame"] << " GPU dispatches per frame, "
+    << fmt(num(j["plan"]["gpuBytes"]) / 1048576.0, "%.2f") << " MiB of GPU memory, " << j["plan"]["rot6JointsPerFrame"]
+    << " joints converted to 6D per frame.\n\nLeft out:\n\n";
+  for (const auto& l : j["plan"]["leftOut"]) s << "- " << l["what"].get<std::string>() << " -- because " << l["why"].get<std::string>() << "\n";
+  if (j["plan"]["leftOut"].empty()) s << "- nothing\n";
+  s << "\n## Error against run time\n\n";
+  s << "Ground truth: " << (j["truth"]["available"].get<bool>() ? "available" : "not available") << " -- "
+    << j["truth"]["note"].get<std::string>() << ".\n\n";
+  s << "Numerical error of the GPU outputs against the CPU reference (" << sum["checkedFrames"] << " checked frames): "
+    << "positions max " << fmt(num(sum["gpuVsCpu"]["maxPositionErrorMm"])) << " mm, normals/tangents max "
+    << fmt(num(sum["gpuVsCpu"]["maxNormalErrorDeg"])) << " deg, normal maps max " << sum["gpuVsCpu"]["maxMapErrorSteps"]
+    << " snorm16 steps.\n\n";
+  s << "| stage | median ms / frame | p95 ms / frame |\n|---|---:|---:|\n";
+  for (const auto& st : stageColumns())
+    s << "| " << st.label << " | " << fmt(num(sum["medianMs"][st.key])) << " | " << fmt(num(sum["p95Ms"][st.key])) << " |\n";
+  s << "| CPU total | " << fmt(num(sum["medianMs"]["cpuTotal"])) << " | |\n\n";
+  s << "![time per frame](plots/time_per_frame.svg)\n\n![time per stage](plots/time_per_stage.svg)\n\n"
+    << "![GPU vs CPU error per frame](plots/error_per_frame.svg)\n\n![error against time](plots/error_vs_time.svg)\n\n";
+  s << "## Characters\n\n| character | model | on screen | checks | max position error mm | max normal error deg | max map error | pose issues |\n"
+    << "|---|---|---|---:|---:|---:|---:|---:|\n";
+  for (const auto& c : j["characters"])
+    s << "| " << c["name"].get<std::string>() << " | " << c["model"].get<std::string>() << " | " << (c["onScreen"].get<bool>() ? "yes" : "no")
+      << " | " << c["checks"] << " | " << fmt(num(c["maxPositionErrorMm"])) << " | " << fmt(num(c["maxNormalErrorDeg"])) << " | "
+      << c["maxMapErrorSteps"] << " | " << c["poseIssues"] << " |\n";
+  s << "\n## Bad poses and failures\n\n" << sum["poseIssues"] << " pose issues, " << sum["failures"] << " check failures.\n\n";
+  size_t shown = 0;
+  for (const auto& i : j["issues"]) {
+    if (++shown > 50) {
+      s << "- ... (all in report.json)\n";
+      break;
+    }
+    s << "- frame " << i["frame"] << ", " << i["character"].get<std::string>() << (i["joint"].get<std::string>().empty() ? "" : ", joint " + i["joint"].get<std::string>())
+      << ": " << i["problem"].get<std::string>() << " -> " << i["action"].get<std::string>() << "\n";
+  }
+  for (const auto& f : j["failures"]) s << "- " << f.get<std::string>() << "\n";
+  return s.str();
+}
+
+void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, const ModelLibrary& models, const ReplayResult& r) {
+  const json j = reportJson(scene, models, r);
+  std::filesystem::create_directories(dir / "plots");
+  PlotSeries cpu{"CPU total", {}, {}}, gpu{"GPU total", {}, {}}, wall{"submit to fence", {}, {}};
+  PlotSeries pos{"positions (mm)", {}, {}}, deg{"normals (deg)", {}, {}}, vsTime{"checked frames", {}, {}};
+  for (const auto& f : r.frames) {
+    const double x = f.frame;
+    cpu.x.push_back(x), cpu.y.push_back(f.times.cpuTotal());
+    gpu.x.push_back(x), gpu.y.push_back(f.times.gpuTotal);
+    wall.x.push_back(x), wall.y.push_back(f.times.gpuWait);
+    if (f.checked) {
+      pos.x.push_back(x), pos.y.push_back(f.maxPositionErrorMm());
+      deg.x.push_back(x), deg.y.push_back(f.maxNormalErrorDeg());
+      vsTime.x.push_back(f.times.cpuTotal() + (std::isfinite(f.times.gpuTotal) ? f.times.gpuTotal : 0.0));
+      vsTime.y.push_back(f.maxPositionErrorMm());
+    }
+  }
+  writeTextFileAtomic(dir / "plots/time_per_frame.svg", svgLineChart({"Time per frame", "scene frame", "ms"}, {cpu, gpu, wall}));
+  writeTextFileAtomic(dir / "plots/error_per_frame.svg",
+                      svgLineChart({"GPU vs CPU reference, worst character", "scene frame", "error"}, {pos, deg}));
+  writeTextFileAtomic(dir / "plots/error_vs_time.svg",
+                      svgScatter({"Error against run time (checked frames)", "CPU + GPU ms per frame", "max position error (mm)"}, {vsTime}));
+  std::vector<std::string> labels;
+  std::vector<double> values;
+  for (const auto& st : stageColumns()) {
+    labels.push_back(st.label);
+    values.push_back(num(j["summary"]["medianMs"][st.key]));
+  }
+  writeTextFileAtomic(dir / "plots/time_per_stage.svg", svgBarChart({"Median time per stage", "ms", ""}, labels, values));
+  writeTextFileAtomic(dir / "report.json", j.dump(2));
+  writeTextFileAtomic(dir / "report.md", reportMarkdown(j));
+}
+
+}  // namespace swish::replay
