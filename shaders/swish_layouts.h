@@ -31,9 +31,8 @@ struct alignas(8) Address {
 #define SWISH_ADDRESS uvec2
 #endif
 
-// Weights of this many (instance, component) pairs are staged in shared memory at a time by deform.comp.
-#define SWISH_DEFORM_SHARED_WEIGHTS 4096
-// Largest K the deform kernel accepts (its per-thread basis registers are sized by K).
+// Largest K the deform kernel accepts (its per-thread basis registers are sized by K; beyond a few
+// hundred they would spill).
 #define SWISH_MAX_MESH_COMPONENTS 256
 
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances.

@@ -6,6 +6,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 #include <limits>
 
 #include "support/gpu_buffers.hpp"
@@ -25,6 +26,10 @@ using test::GuardedOutput;
 struct DeformCase {
   uint32_t vertices, components, influences, instances;
 };
+// Readable parameters in test names and JUnit reports.
+void PrintTo(const DeformCase& c, std::ostream* os) {
+  *os << c.vertices << " vertices, K " << c.components << ", " << c.influences << " influences, " << c.instances << " instances";
+}
 
 struct DeformInputs {
   Model model;

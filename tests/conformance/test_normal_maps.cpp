@@ -5,6 +5,7 @@
 // exact. Seeded random databases (seed printed; SWISH_TEST_SEED overrides), odd sizes, maps selected
 // several times, out-of-range indices, guard words and unchanged inputs.
 #include <cstdio>
+#include <ostream>
 
 #include "support/gpu_buffers.hpp"
 #include "support/gpu_compare.hpp"
@@ -83,6 +84,9 @@ struct DecodeCase {
   uint32_t size, maps, codebook;
   std::vector<uint32_t> slots;
 };
+void PrintTo(const DecodeCase& c, std::ostream* os) {
+  *os << c.size << "x" << c.size << ", " << c.maps << " maps, " << c.codebook << " codebook entries, " << c.slots.size() << " slots";
+}
 
 class VqDecodeConformance : public test::GpuTest, public ::testing::WithParamInterface<DecodeCase> {};
 

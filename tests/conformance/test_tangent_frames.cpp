@@ -4,6 +4,7 @@
 // an exactly representable flat mesh, guard words and unchanged inputs.
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 #include <limits>
 
 #include "support/gpu_buffers.hpp"
@@ -31,6 +32,7 @@ constexpr double kFrameTolerance = 1e-4;
 struct FramesCase {
   uint32_t vertices, instances;
 };
+void PrintTo(const FramesCase& c, std::ostream* os) { *os << c.vertices << " vertices, " << c.instances << " instances"; }
 
 struct Frames {
   std::vector<float> normals, tangents;

@@ -1,0 +1,152 @@
+// The deform pass on the selected Vulkan device (SWISH_DEVICE; lavapipe here): 1 and 22 instances of a
+// 3000-vertex, K = 30 model, timed with GPU timestamps, its bytes moved per second reported against a
+// plain vec4 copy kernel of the same byte count measured in the same iterations (vs_copy: goal >= 0.5);
+// and the cost of an empty dispatch (one alone, and amortised over 100 back to back).
+//   ./bench_deform --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "support/random_model.hpp"
+#include "swish/gpu/context.hpp"
+#include "swish/gpu/copy_vec4_pass.hpp"
+#include "swish/gpu/deform_pass.hpp"
+#include "swish/gpu/empty_dispatch_pass.hpp"
+#include "swish/gpu/gpu_model.hpp"
+#include "swish/gpu/timestamp_queries.hpp"
+
+namespace swish {
+namespace {
+
+gpu::Context* benchContext() {
+  static std::unique_ptr<gpu::Context> ctx;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    gpu::ContextOptions o;
+    o.validation = false;  // the layers would time themselves
+    auto made = gpu::Context::tryCreate(o);
+    if (made) ctx = std::make_unique<gpu::Context>(std::move(made.value()));
+    else std::fprintf(stderr, "bench_deform: no Vulkan device: %s\n", made.error().what());
+    if (ctx) std::fprintf(stderr, "bench_deform: device %s\n", ctx->deviceName().c_str());
+  }
+  return ctx.get();
+}
+
+// GPU time of what `record` records, in seconds, from timestamps around it.
+template <class F>
+double gpuSeconds(gpu::Context& ctx, gpu::TimestampQueries& ts, F&& record) {
+  ctx.submitAndWait([&](VkCommandBuffer cmd) {
+    ts.reset(cmd);
+    ts.mark(cmd, 0);
+    record(cmd);
+    ts.mark(cmd, 1);
+  });
+  return ts.readNs()[1] * 1e-9;
+}
+
+struct DeformSetup {
+  Model model;
+  std::unique_ptr<gpu::GpuModel> gpuModel;
+  gpu::Buffer weights, matrices, positions, copySrc, copyDst;
+  std::unique_ptr<gpu::DeformPass> pass;
+  std::unique_ptr<gpu::CopyVec4Pass> copy;
+  double bytesMoved = 0;
+  uint32_t copyVec4s = 0;
+};
+
+DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning) {
+  DeformSetup s;
+  Rng rng(42);
+  test::RandomModelSpec spec;
+  spec.vertices = 3000;
+  spec.meshComponents = 30;
+  spec.influences = 4;
+  spec.joints = 24;
+  spec.normalMaps = 0;
+  s.model = test::makeRandomModel(rng, spec);
+  s.gpuModel = std::make_unique<gpu::GpuModel>(ctx, s.model);
+  const size_t n = 3000, k = 30, j = s.model.skeleton.size();
+  std::vector<float> w(instances * k);
+  for (auto& x : w) x = float(rng.normal());
+  std::vector<Mat4f> m;
+  for (uint32_t i = 0; i < instances; ++i) {
+    const auto mats = s.model.skeleton.skinningMatrices(test::makeRandomPose(rng, s.model.skeleton));
+    m.insert(m.end(), mats.begin(), mats.end());
+  }
+  s.weights = gpu::Buffer(ctx, w.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
+  s.weights.upload(ctx, w.data(), w.size() * 4);
+  s.matrices = gpu::Buffer(ctx, m.size() * 64, gpu::MemoryKind::DeviceLocal, "matrices");
+  s.matrices.upload(ctx, m.data(), m.size() * 64);
+  s.positions = gpu::Buffer(ctx, instances * n * 12, gpu::MemoryKind::DeviceLocal, "positions");
+  s.pass = std::make_unique<gpu::DeformPass>(ctx, uint32_t(k), 4, skinning);
+  // Bytes the kernel must move at least once: basis, mean, skin influences, weights, matrices, output.
+  s.bytesMoved = double(n * k * 3 * 4 + n * 3 * 4 + n * 4 * 8 + w.size() * 4 + m.size() * 64 + instances * n * 12);
+  // The copy moves the same bytes: reads half, writes half.
+  s.copyVec4s = uint32_t(s.bytesMoved / 32);
+  s.copySrc = gpu::Buffer(ctx, size_t(s.copyVec4s) * 16, gpu::MemoryKind::DeviceLocal, "copy src");
+  s.copyDst = gpu::Buffer(ctx, size_t(s.copyVec4s) * 16, gpu::MemoryKind::DeviceLocal, "copy dst");
+  s.copy = std::make_unique<gpu::CopyVec4Pass>(ctx);
+  return s;
+}
+
+void BM_Deform(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const uint32_t instances = uint32_t(state.range(0));
+  DeformSetup s = makeSetup(*ctx, instances, state.range(1) != 0);
+  gpu::TimestampQueries ts(*ctx, 2);
+  gpu::DeformPass::Args a;
+  a.mean = s.gpuModel->mean.address();
+  a.basis = s.gpuModel->basis.address();
+  a.weights = s.weights.address();
+  a.skinMatrices = s.matrices.address();
+  a.skinJoints = s.gpuModel->skinJoints.address();
+  a.skinWeights = s.gpuModel->skinWeights.address();
+  a.positionsOut = s.positions.address();
+  a.vertexCount = 3000;
+  a.instanceCount = instances;
+  a.jointCount = uint32_t(s.model.skeleton.size());
+  // Warm-up: lavapipe compiles a pipeline at its first dispatch; that is not the kernel's cost.
+  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); });
+  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.copy->record(cmd, s.copySrc.address(), s.copyDst.address(), s.copyVec4s); });
+  double deformTotal = 0, copyTotal = 0;
+  for (auto _ : state) {
+    const double t = gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); });
+    const double c = gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) {
+      s.copy->record(cmd, s.copySrc.address(), s.copyDst.address(), s.copyVec4s);
+    });
+    state.SetIterationTime(t);
+    deformTotal += t;
+    copyTotal += c;
+  }
+  const double deformBw = s.bytesMoved * double(state.iterations()) / deformTotal;
+  const double copyBw = double(s.copyVec4s) * 32 * double(state.iterations()) / copyTotal;
+  state.counters["deform_GBps"] = deformBw * 1e-9;
+  state.counters["copy_GBps"] = copyBw * 1e-9;
+  state.counters["vs_copy"] = deformBw / copyBw;
+  state.counters["us_per_instance"] = 1e6 * deformTotal / double(state.iterations()) / instances;
+}
+// Args: instances, skinning (0: PCA reconstruction only, to see what skinning costs).
+BENCHMARK(BM_Deform)->Args({1, 1})->Args({22, 1})->Args({22, 0})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
+// One empty dispatch between two timestamps (arg 1), or 100 back to back, reported per dispatch (arg 100).
+void BM_EmptyDispatch(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const uint32_t n = uint32_t(state.range(0));
+  gpu::EmptyDispatchPass empty(*ctx);
+  gpu::TimestampQueries ts(*ctx, 2);
+  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { empty.record(cmd, n); });  // warm-up (first-use compile)
+  for (auto _ : state) state.SetIterationTime(gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { empty.record(cmd, n); }) / n);
+  state.counters["dispatches"] = n;
+}
+BENCHMARK(BM_EmptyDispatch)->Arg(1)->Arg(100)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.3);
+
+}  // namespace
+}  // namespace swish
+
+BENCHMARK_MAIN();
