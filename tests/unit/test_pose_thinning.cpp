@@ -77,12 +77,10 @@ TEST(PoseThinning, KeptPosesAreSeparatedAndEveryRejectedPoseIsCovered) {
   }
 }
 
-TEST(PoseThinning, EqualsBruteForceGreedyForAnyProjectionSeed) {
-  const PoseSamples s = randomWalks(5, 800, 12, test::testSeed(4));
-  const auto expect = bruteForceGreedy(s, 0.9f);
-  for (uint64_t seed : {1u, 2u, 99u}) {
-    const ThinningResult r = thinPoses(s, 0.9f, SIZE_MAX, seed);
-    EXPECT_EQ(r.kept, expect) << "projection seed " << seed;
+TEST(PoseThinning, EqualsBruteForceGreedy) {
+  for (uint64_t seed : {4u, 5u}) {
+    const PoseSamples s = randomWalks(5, 800, 12, test::testSeed(seed));
+    for (float tol : {0.5f, 0.9f, 2.f}) EXPECT_EQ(thinPoses(s, tol).kept, bruteForceGreedy(s, tol)) << "tolerance " << tol;
   }
 }
 
@@ -102,6 +100,7 @@ TEST(PoseThinning, BisectionReachesTargetCount) {
   for (size_t target : {size_t(50), size_t(300)}) {
     const ThinningResult r = thinPosesToCount(s, target);
     EXPECT_FALSE(r.truncated);
+    EXPECT_LT(r.passes, 30);
     EXPECT_NEAR(double(r.kept.size()), double(target), 0.03 * double(target)) << "tolerance " << r.tolerance;
     EXPECT_EQ(thinPoses(s, r.tolerance).kept, r.kept);  // the reported tolerance reproduces the set
   }

@@ -3,11 +3,15 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+#include <array>
+
 #include "swish/core/error.hpp"
-#include "swish/core/rng.hpp"
 
 namespace swish::bake {
 namespace {
+
+constexpr int kAxes = 3;  // principal axes: the first orders the band search, the others pre-filter
 
 // Squared distance with an early exit once it exceeds `limit` (most candidates are far).
 inline bool withinSquared(const float* a, const float* b, int dim, float limit) {
@@ -27,17 +31,37 @@ inline bool withinSquared(const float* a, const float* b, int dim, float limit) 
   return s <= limit;
 }
 
-std::vector<float> randomUnitDirection(int dim, uint64_t seed) {
-  Rng rng(seed);
-  std::vector<float> dir(static_cast<size_t>(dim));
-  double n = 0;
-  for (auto& v : dir) {
-    v = float(rng.normal());
-    n += double(v) * v;
+// The samples' three principal axes (from at most ~16k evenly spaced samples): projections on them are
+// as spread out as projections get, so the band search and the pre-filters reject the most.
+std::array<std::vector<float>, kAxes> principalAxes(const PoseSamples& samples) {
+  const int dim = samples.dim;
+  const size_t n = samples.size();
+  const size_t stride = std::max<size_t>(1, n / 16384);
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(dim);
+  size_t m = 0;
+  for (size_t i = 0; i < n; i += stride, ++m)
+    for (int k = 0; k < dim; ++k) mean[k] += samples.row(i)[k];
+  std::array<std::vector<float>, kAxes> axes;
+  if (m == 0) {
+    for (int a = 0; a < kAxes; ++a) axes[size_t(a)].assign(size_t(dim), a < dim && a == 0 ? 1.f : 0.f);
+    return axes;
   }
-  n = std::sqrt(n);
-  for (auto& v : dir) v = float(v / n);
-  return dir;
+  mean /= double(m);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(dim, dim);
+  for (size_t i = 0; i < n; i += stride) {
+    Eigen::VectorXd x(dim);
+    for (int k = 0; k < dim; ++k) x[k] = samples.row(i)[k] - mean[k];
+    cov.selfadjointView<Eigen::Lower>().rankUpdate(x);
+  }
+  cov = cov.selfadjointView<Eigen::Lower>();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
+  for (int a = 0; a < kAxes; ++a) {
+    axes[size_t(a)].assign(size_t(dim), 0.f);
+    if (a >= dim) continue;
+    const Eigen::VectorXd v = eig.eigenvectors().col(dim - 1 - a);  // ascending eigenvalues
+    for (int k = 0; k < dim; ++k) axes[size_t(a)][size_t(k)] = float(v[k]);
+  }
+  return axes;
 }
 
 void checkSamples(const PoseSamples& samples) {
@@ -50,14 +74,21 @@ void checkSamples(const PoseSamples& samples) {
       throw Error("pose thinning: sample " + std::to_string(i / size_t(samples.dim)) + " is not finite");
 }
 
-// The kept set: rows copied contiguously, plus their projections sorted for the band search.
+// The kept set: rows copied contiguously, plus their projections, sorted by the first, for the band
+// search. Projections never increase distances, so a kept pose whose projection on any axis differs
+// by more than the tolerance cannot cover the query.
 class KeptPoses {
  public:
-  KeptPoses(int dim, std::vector<float> direction) : dim_(dim), dir_(std::move(direction)) {}
+  using Projection = std::array<float, kAxes>;
+  KeptPoses(int dim, const std::array<std::vector<float>, kAxes>& axes) : dim_(dim), axes_(axes) {}
 
-  float project(const float* x) const {
-    float p = 0.f;
-    for (int k = 0; k < dim_; ++k) p += x[k] * dir_[size_t(k)];
+  Projection project(const float* x) const {
+    Projection p{};
+    for (int a = 0; a < kAxes; ++a) {
+      float s = 0.f;
+      for (int k = 0; k < dim_; ++k) s += x[k] * axes_[size_t(a)][size_t(k)];
+      p[size_t(a)] = s;
+    }
     return p;
   }
   size_t size() const { return sampleIndex_.size(); }
@@ -65,49 +96,50 @@ class KeptPoses {
   uint32_t sampleIndex(size_t k) const { return sampleIndex_[k]; }
 
   // Index of some kept pose within sqrt(limitSq) of x (projection p), or -1.
-  long findWithin(const float* x, float p, float tol, float limitSq, size_t& checks) const {
-    auto lo = std::lower_bound(order_.begin(), order_.end(), p - tol,
-                               [](const Entry& e, float v) { return e.proj < v; });
-    for (auto it = lo; it != order_.end() && it->proj <= p + tol; ++it) {
+  long findWithin(const float* x, const Projection& p, float tol, float limitSq, size_t& checks) const {
+    auto lo = std::lower_bound(order_.begin(), order_.end(), p[0] - tol,
+                               [](const Entry& e, float v) { return e.proj[0] < v; });
+    for (auto it = lo; it != order_.end() && it->proj[0] <= p[0] + tol; ++it) {
+      bool far = false;
+      for (int a = 1; a < kAxes; ++a) far = far || std::abs(it->proj[size_t(a)] - p[size_t(a)]) > tol;
+      if (far) continue;
       ++checks;
       if (withinSquared(x, row(it->slot), dim_, limitSq)) return long(it->slot);
     }
     return -1;
   }
 
-  void add(const float* x, float p, uint32_t sample) {
+  void add(const float* x, const Projection& p, uint32_t sample) {
     const size_t slot = size();
     rows_.insert(rows_.end(), x, x + dim_);
     sampleIndex_.push_back(sample);
     Entry e{p, uint32_t(slot)};
     order_.insert(std::upper_bound(order_.begin(), order_.end(), e,
-                                   [](const Entry& a, const Entry& b) { return a.proj < b.proj; }),
+                                   [](const Entry& a, const Entry& b) { return a.proj[0] < b.proj[0]; }),
                   e);
   }
 
  private:
   struct Entry {
-    float proj;
+    Projection proj;
     uint32_t slot;
   };
   int dim_;
-  std::vector<float> dir_;
+  const std::array<std::vector<float>, kAxes>& axes_;
   std::vector<float> rows_;
   std::vector<uint32_t> sampleIndex_;
   std::vector<Entry> order_;
 };
 
-}  // namespace
-
-ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept, uint64_t seed) {
-  checkSamples(samples);
+ThinningResult thinPass(const PoseSamples& samples, float tolerance, size_t maxKept,
+                        const std::array<std::vector<float>, kAxes>& axes) {
   if (!(tolerance >= 0.f) || !std::isfinite(tolerance))
     throw Error("pose thinning: tolerance " + std::to_string(tolerance) + " must be finite and >= 0");
   const int dim = samples.dim;
   const size_t n = samples.size();
   // "Farther than the tolerance" keeps a pose; distance <= tolerance rejects it.
   const float limitSq = tolerance * tolerance;
-  KeptPoses kept(dim, randomUnitDirection(dim, seed));
+  KeptPoses kept(dim, axes);
   ThinningResult result;
   result.tolerance = tolerance;
   long lastCover = -1;
@@ -117,7 +149,7 @@ ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t max
       ++result.distanceChecks;
       if (withinSquared(x, kept.row(size_t(lastCover)), dim, limitSq)) continue;
     }
-    const float p = kept.project(x);
+    const auto p = kept.project(x);
     const long cover = kept.findWithin(x, p, tolerance, limitSq, result.distanceChecks);
     if (cover >= 0) {
       lastCover = cover;
@@ -135,44 +167,68 @@ ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t max
   return result;
 }
 
+}  // namespace
+
+ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept) {
+  checkSamples(samples);
+  return thinPass(samples, tolerance, maxKept, principalAxes(samples));
+}
+
 ThinningResult thinPosesToCount(const PoseSamples& samples, size_t target, const ThinToCountOptions& options) {
   checkSamples(samples);
   const size_t n = samples.size();
   if (target == 0) throw Error("pose thinning: target count must be at least 1");
   if (n == 0) throw Error("pose thinning: no samples to thin");
-  if (target >= n) return thinPoses(samples, 0.f, SIZE_MAX, options.seed);
+  if (target >= n) return thinPoses(samples, 0.f);
 
+  const auto axes = principalAxes(samples);
   // Upper bound: at twice the largest distance from sample 0, one pose covers everything.
   double hi = 0;
   for (size_t i = 1; i < n; ++i) {
-    double s = 0;
+    double d2 = 0;
     for (int k = 0; k < samples.dim; ++k) {
       const double d = double(samples.row(i)[k]) - samples.row(0)[k];
-      s += d * d;
+      d2 += d * d;
     }
-    hi = std::max(hi, s);
+    hi = std::max(hi, d2);
   }
   hi = 2.0 * std::sqrt(hi) + 1e-6;
-  double lo = 0.0;
+  double lo = hi * 1e-6;  // a stand-in for 0 that keeps the search in log space
   const double slack = std::max(options.relativeSlack * double(target), 0.0);
   // A pass at a too-small tolerance is abandoned once it keeps far more than asked.
   const size_t cap = std::max<size_t>(target * 4, target + 16);
+  double countLo = double(cap), countHi = 1.0;  // counts at lo (at least) and at hi
 
-  ThinningResult best = thinPoses(samples, float(hi), cap, options.seed);
-  auto distance = [&](const ThinningResult& r) {
+  ThinningResult best = thinPass(samples, float(hi), cap, axes);
+  int passes = 1;
+  auto miss = [&](const ThinningResult& r) {
     return r.truncated ? double(n) : std::abs(double(r.kept.size()) - double(target));
   };
   for (int it = 0; it < options.maxIterations; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    ThinningResult r = thinPoses(samples, float(mid), cap, options.seed);
+    // The count falls roughly like a power of the tolerance: interpolate in log-log between the
+    // bracket's ends, kept away from them so that the bracket always shrinks; plain log-space
+    // bisection while the low end's count is unknown (truncated).
+    const double llo = std::log(lo), lhi = std::log(hi);
+    double f = 0.5;
+    if (countLo > double(target) && countHi < double(target) && countLo < double(cap))
+      f = (std::log(countLo) - std::log(double(target))) / (std::log(countLo) - std::log(countHi));
+    f = std::clamp(f, 0.1, 0.9);
+    const double mid = std::exp(llo + f * (lhi - llo));
+    ThinningResult r = thinPass(samples, float(mid), cap, axes);
+    ++passes;
     const bool tooMany = r.truncated || r.kept.size() > target;
-    if (distance(r) < distance(best) || (distance(r) == distance(best) && !r.truncated && r.tolerance > best.tolerance))
-      best = r;
-    if (distance(best) <= slack && !best.truncated) break;
-    if (tooMany) lo = mid;
-    else hi = mid;
+    if (miss(r) < miss(best) || (miss(r) == miss(best) && r.tolerance > best.tolerance)) best = r;
+    if (miss(best) <= slack && !best.truncated) break;
+    if (tooMany) {
+      lo = mid;
+      countLo = r.truncated ? double(cap) : double(r.kept.size());
+    } else {
+      hi = mid;
+      countHi = double(r.kept.size());
+    }
     if (hi - lo <= 1e-7 * hi) break;
   }
+  best.passes = passes;
   return best;
 }
 
