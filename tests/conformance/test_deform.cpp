@@ -168,7 +168,7 @@ TEST_P(DeformConformance, SkinnedPositionsMatchReference) {
 }
 
 // Odd sizes: 1 vertex, a prime count, a large prime count; 1, 3 and 22 instances; K = 1, 5, 30;
-// the 64-component case puts 150 instances in 3 chunks of the kernel's shared-memory weight staging.
+// the 64-component case runs 150 instances through one dispatch.
 INSTANTIATE_TEST_SUITE_P(Sizes, DeformConformance,
                          ::testing::Values(DeformCase{1, 1, 1, 1}, DeformCase{7, 5, 4, 3}, DeformCase{997, 30, 4, 22},
                                            DeformCase{997, 7, 8, 5}, DeformCase{100003, 2, 4, 2}, DeformCase{97, 64, 3, 150}),
