@@ -1,10 +1,19 @@
 // Character import: the shared CC0 test character exactly, and a clear Error for every bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 
+#include <assimp/scene.h>
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+
 #include "support/paths.hpp"
+#include "swish/bake/default_character.hpp"
+#include "swish/io/gltf_export.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/character_import.hpp"
 #include "swish/io/mesh_topology_check.hpp"
@@ -168,4 +177,37 @@ TEST(IoCharacterImport, SharedGarmentPassesTopologyChecks) {
   EXPECT_EQ(r.inconsistentEdges, 0u);
   EXPECT_GT(r.boundaryEdges, 0u);  // hem, collar, sleeves
   EXPECT_GT(r.normalAgreement, 0.9);
+}
+
+TEST(IoCharacterImport, FbxPathReadsWhatGltfHolds) {
+  // No FBX asset ships with the project: make one with assimp's own FBX (ASCII) exporter from the
+  // default character's .glb, and check the FBX route (joined vertices, FBX node conventions) gives
+  // the same character.
+  const Character c = bake::makeDefaultCharacter();
+  const fs::path glb = tempFile("fbxsrc.glb", "");
+  io::writeCharacterGlb(glb, c);
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(glb.string(), 0);
+  ASSERT_NE(scene, nullptr) << importer.GetErrorString();
+  const fs::path fbx = fs::temp_directory_path() / ("swish_test_io_" + std::to_string(::getpid()) + "_char.fbx");
+  Assimp::Exporter exporter;
+  ASSERT_EQ(exporter.Export(scene, "fbxa", fbx.string()), AI_SUCCESS) << exporter.GetErrorString();
+  const Character back = io::importCharacter(fbx);
+  fs::remove(glb);
+  fs::remove(fbx);
+  EXPECT_EQ(back.skeleton.size(), c.skeleton.size());
+  ASSERT_EQ(back.body.vertexCount(), c.body.vertexCount());
+  ASSERT_EQ(back.garment.vertexCount(), c.garment.vertexCount());
+  // The FBX route re-orders vertices (faces are written per corner, then identical corners joined):
+  // every imported vertex must match some original vertex in position and UV.
+  float worst = 0;
+  for (Eigen::Index v = 0; v < back.garment.positions.rows(); ++v) {
+    float best = INFINITY;
+    for (Eigen::Index u = 0; u < c.garment.positions.rows() && best > 1e-6f; ++u)
+      best = std::min(best, std::max((back.garment.positions.row(v) - c.garment.positions.row(u)).cwiseAbs().maxCoeff(),
+                                     (back.garment.uvs.row(v) - c.garment.uvs.row(u)).cwiseAbs().maxCoeff()));
+    worst = std::max(worst, best);
+  }
+  EXPECT_LT(worst, 1e-4f);
+  for (const char* j : {"Hips", "Spine1", "LeftArm", "RightHandFinger1"}) EXPECT_GE(back.skeleton.find(j), 0) << j;
 }
