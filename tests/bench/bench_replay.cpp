@@ -1,0 +1,79 @@
+// Per-frame cost of `swish replay` on the default scene (assets/scenes/football.json: 22 characters of
+// the default model, CMU mocap) and on the same scene cut to 1 character, in one run, on the selected
+// Vulkan device (lavapipe here). Goal: 22 characters cost <= 6x one character, thanks to batching.
+//
+// Each iteration replays kFrames frames (no GPU-vs-CPU checks: outputs.gpuCheckEvery is set beyond
+// the frame count). Counters per frame: cpu_ms (poses, FK, Theta, MLP, lookup, filter, recording),
+// gpu_ms (GPU timestamps of all passes), wall_ms (CPU + submit-to-fence). BM_ReplayRatio reports
+// ratio_cpu, ratio_gpu and ratio_wall of 22 characters over 1, measured in the same process.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "support/paths.hpp"
+#include "swish/replay/model_library.hpp"
+#include "swish/replay/replay_engine.hpp"
+#include "swish/runtime/scene_file.hpp"
+
+namespace {
+
+using namespace swish;
+constexpr uint32_t kFrames = 8;
+
+struct PerFrame {
+  double cpu = 0, gpu = 0, wall = 0;
+};
+std::map<int, PerFrame> g_results;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? NAN : v[v.size() / 2];
+}
+
+void BM_ReplayDefaultScene(benchmark::State& state) {
+  const int characters = int(state.range(0));
+  runtime::Scene scene = runtime::loadScene(test::sourceDir() / "assets/scenes/football.json");
+  scene.characters.resize(size_t(characters));
+  scene.frameCount = kFrames;
+  scene.outputs.gpuCheckEvery = kFrames + 1;  // frame 0 is still checked once: excluded below
+  replay::ModelLibrary models(scene);
+  replay::ReplayEngine engine(scene, models);
+  std::vector<double> cpu, gpu, wall;
+  for (auto _ : state) {
+    const replay::ReplayResult r = engine.run();
+    for (size_t f = 1; f < r.frames.size(); ++f) {
+      const auto& t = r.frames[f].times;
+      cpu.push_back(t.cpuTotal());
+      gpu.push_back(t.gpuTotal);
+      wall.push_back(t.cpuTotal() + t.gpuWait);
+    }
+  }
+  PerFrame p{median(cpu), median(gpu), median(wall)};
+  g_results[characters] = p;
+  state.counters["cpu_ms"] = p.cpu;
+  state.counters["gpu_ms"] = p.gpu;
+  state.counters["wall_ms"] = p.wall;
+  state.counters["cpu_us_per_character"] = p.cpu * 1000.0 / characters;
+  state.counters["gpu_us_per_character"] = p.gpu * 1000.0 / characters;
+  state.SetLabel(models.entries().front()->procedural ? "procedural stand-in model" : models.entries().front()->label);
+}
+BENCHMARK(BM_ReplayDefaultScene)->Arg(1)->Arg(22)->Iterations(3)->Unit(benchmark::kMillisecond);
+
+void BM_ReplayRatio(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(g_results.size());
+  if (!g_results.count(1) || !g_results.count(22)) {
+    state.SkipWithError("run BM_ReplayDefaultScene/1 and /22 first (same process)");
+    return;
+  }
+  const PerFrame a = g_results[1], b = g_results[22];
+  state.counters["ratio_cpu"] = b.cpu / a.cpu;
+  state.counters["ratio_gpu"] = b.gpu / a.gpu;
+  state.counters["ratio_wall"] = b.wall / a.wall;
+  state.SetLabel(b.wall / a.wall <= 6.0 ? "goal met: 22 characters <= 6x one" : "goal missed: 22 characters > 6x one");
+}
+BENCHMARK(BM_ReplayRatio)->Iterations(1);
+
+}  // namespace
+BENCHMARK_MAIN();

@@ -1,0 +1,254 @@
+// swish replay end to end on a small seeded model (3 characters, a few frames): the report is written
+// and parses, figures repeat exactly, bad poses are reported with frame and character while the other
+// characters go on, a character at 1e4 m gets the local mesh it gets at the origin, leaving normal maps
+// out keeps the meshes unchanged, the planner's memory is the memory really allocated, and an error
+// leaves no partial outputs.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "support/gpu_test.hpp"
+#include "support/random_model.hpp"
+#include "swish/core/error.hpp"
+#include "swish/gpu/frame_recorder.hpp"
+#include "swish/gpu/gpu_model.hpp"
+#include "swish/model/model_file.hpp"
+#include "swish/replay/replay_job.hpp"
+#include "swish/replay/report_writer.hpp"
+#include "swish/runtime/planner.hpp"
+#include "swish/runtime/scene_file.hpp"
+
+namespace {
+
+using namespace swish;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class ReplayE2E : public test::GpuTest {
+ protected:
+  void SetUp() override {
+    test::GpuTest::SetUp();
+    if (IsSkipped()) return;
+    dir_ = fs::temp_directory_path() / ("swish_replay_e2e_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const uint64_t seed = test::testSeed(11);
+    std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+    Rng rng(seed);
+    test::RandomModelSpec spec;
+    spec.joints = 8;
+    spec.vertices = 120;
+    spec.normalMaps = 4;
+    spec.mapSize = 16;
+    model_ = test::makeRandomModel(rng, spec);
+    saveModel(model_, dir_ / "m.swish");
+    writeStream("walk.json", rng, 6, {});
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+    test::GpuTest::TearDown();
+  }
+
+  // A pose stream of `frames` random poses; `edit` may spoil some.
+  void writeStream(const std::string& name, Rng& rng, int frames, const std::function<void(replay::PoseStream&)>& edit) {
+    replay::PoseStream s;
+    s.framesPerSecond = 30;
+    for (const auto& j : model_.skeleton.joints) s.joints.push_back(j.name);
+    for (int f = 0; f < frames; ++f) {
+      const Pose p = test::makeRandomPose(rng, model_.skeleton, 0.6f);
+      replay::PoseStreamFrame fr;
+      fr.root = p.rootTranslation;
+      fr.rotations = p.local;
+      fr.present.assign(p.local.size(), true);
+      s.frames.push_back(fr);
+    }
+    if (edit) edit(s);
+    replay::writePoseStream(dir_ / name, s);
+  }
+
+  json sceneJson(const std::vector<std::string>& streams) const {
+    json j{{"name", "e2e"}, {"frames", {{"count", 5}, {"rate", 30}}},
+           {"outputs", {{"directory", "out"}, {"render", true}, {"gpuCheckEvery", 2}}}};
+    for (size_t i = 0; i < streams.size(); ++i)
+      j["characters"].push_back({{"name", "c" + std::to_string(i)}, {"model", "m.swish"}, {"poseStream", streams[i]},
+                                 {"placement", {{"translation", {double(i), 0.0, 0.0}}, {"yawDegrees", 30.0 * double(i)}}}});
+    return j;
+  }
+  runtime::Scene scene(const json& j) const { return runtime::parseScene(j, dir_ / "scene.json"); }
+
+  replay::ReplayJobOptions jobOptions() {
+    replay::ReplayJobOptions o;
+    o.quiet = true;
+    o.engine.context = &ctx();
+    return o;
+  }
+
+  fs::path dir_;
+  Model model_;
+};
+
+TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
+  const runtime::Scene s = scene(sceneJson({"walk.json", "walk.json", "walk.json"}));
+  const auto r = replay::runReplayJob(s, jobOptions());
+  EXPECT_FALSE(r.result.failed()) << (r.result.failures.empty() ? "" : r.result.failures[0]);
+  ASSERT_EQ(r.directory, dir_ / "out");
+  std::ifstream in(dir_ / "out/report.json");
+  const json rep = json::parse(in);
+  EXPECT_EQ(rep["summary"]["frames"], 5);
+  EXPECT_EQ(rep["summary"]["checkedFrames"], 3);  // frames 0, 2, 4
+  EXPECT_EQ(rep["characters"].size(), 3u);
+  EXPECT_EQ(rep["plan"]["gpuDispatchesPerFrame"], 4);
+  EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxPositionErrorMm"].get<double>(), replay::kPositionToleranceMm);
+  EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxMapErrorSteps"].get<int>(), replay::kMapToleranceSteps);
+  EXPECT_TRUE(rep["frames"][0]["times"]["gpuDeform"].is_number());
+  EXPECT_TRUE(rep["frames"][0]["gpuVsCpu"]["maxPositionErrorMm"].is_number());
+  for (const char* f : {"report.md", "plots/time_per_frame.svg", "plots/time_per_stage.svg", "plots/error_per_frame.svg",
+                        "plots/error_vs_time.svg"})
+    EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".partial-"), std::string::npos);
+  EXPECT_EQ(ctx().validationMessageCount(), 0u);
+}
+
+TEST_F(ReplayE2E, SameSceneGivesTheSameFigures) {
+  const runtime::Scene s = scene(sceneJson({"walk.json", "walk.json"}));
+  auto figures = [&] {
+    replay::ModelLibrary lib(s);
+    replay::ReplayOptions o;
+    o.context = &ctx();
+    replay::ReplayEngine engine(s, lib, o);
+    json j = replay::reportJson(s, lib, engine.run());
+    json keep{{"characters", j["characters"]}, {"plan", j["plan"]}, {"summaryErrors", j["summary"]["gpuVsCpu"]}};
+    for (auto& f : j["frames"]) keep["frames"].push_back(f.value("gpuVsCpu", json()));
+    return keep;
+  };
+  EXPECT_EQ(figures(), figures());
+}
+
+TEST_F(ReplayE2E, BadPosesAreReportedAndTheOthersGoOn) {
+  Rng rng(5);
+  writeStream("bad.json", rng, 6, [](replay::PoseStream& s) {
+    s.frames[1].rotations[2] = Quatf(std::numeric_limits<float>::quiet_NaN(), 0, 0, 0);
+    s.frames[2].rotations[3] = Quatf(2.f, 0, 0, 0);
+    s.frames[3].present[1] = false;
+  });
+  const runtime::Scene s = scene(sceneJson({"walk.json", "bad.json", "walk.json"}));
+  replay::ModelLibrary lib(s);
+  replay::ReplayOptions o;
+  o.context = &ctx();
+  replay::ReplayEngine engine(s, lib, o);
+  const auto r = engine.run();
+  EXPECT_TRUE(r.failed());
+  ASSERT_EQ(r.issueCount, 3u);
+  for (const auto& i : r.issues) EXPECT_EQ(i.character, "c1");
+  EXPECT_EQ(r.issues[0].frame, 1u);
+  EXPECT_EQ(r.issues[0].joint, model_.skeleton.joints[2].name);
+  EXPECT_EQ(r.issues[0].action, "rest rotation");
+  EXPECT_EQ(r.issues[1].frame, 2u);
+  EXPECT_EQ(r.issues[1].action, "normalised");
+  EXPECT_EQ(r.issues[2].frame, 3u);
+  EXPECT_NE(r.issues[2].problem.find("missing"), std::string::npos);
+  ASSERT_EQ(r.frames.size(), 5u);
+  for (const auto& f : r.frames)
+    for (const auto& c : f.checks) EXPECT_TRUE(c.ok) << "frame " << f.frame << " character " << c.character;
+  EXPECT_TRUE(r.failures.empty());
+}
+
+TEST_F(ReplayE2E, FarFromTheOriginTheLocalMeshIsTheSame) {
+  json j = sceneJson({"walk.json", "walk.json"});
+  j["characters"][1]["placement"] = {{"translation", {1e4, 0.0, -1e4}}, {"yawDegrees", 0.0}};
+  j["characters"][0]["placement"] = {{"translation", {0.0, 0.0, 0.0}}, {"yawDegrees", 0.0}};
+  const runtime::Scene s = scene(j);
+  replay::ModelLibrary lib(s);
+  replay::ReplayOptions o;
+  o.context = &ctx();
+  std::map<std::pair<uint32_t, uint32_t>, Points3f> local;
+  o.onCharacterOutput = [&](uint32_t frame, uint32_t c, const runtime::ReferenceFrameOutputs& out, uint32_t i) {
+    local[{frame, c}] = out.positions[i];
+  };
+  replay::ReplayEngine engine(s, lib, o);
+  engine.run();
+  ASSERT_EQ(local.size(), 10u);
+  for (uint32_t f = 0; f < 5; ++f) {
+    const Points3f& a = local[{f, 0}];
+    const Points3f& b = local[{f, 1}];
+    ASSERT_EQ(a.rows(), b.rows());
+    EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.f) << "frame " << f;
+    // World positions in double keep the local detail at 1e4 m (float world coordinates would not:
+    // their spacing there is about 1 mm).
+    const auto& place = s.characters[1].placement;
+    for (Eigen::Index v = 0; v < b.rows(); ++v)
+      EXPECT_NEAR((place.apply(b.row(v).transpose()) - place.translation - b.row(v).transpose().cast<double>()).norm(), 0.0, 1e-9);
+  }
+}
+
+TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
+  json full = sceneJson({"walk.json", "walk.json"});
+  json lean = full;
+  lean["outputs"]["render"] = false;
+  lean["outputs"]["meshes"] = true;
+  auto positions = [&](const runtime::Scene& s, runtime::ReplayPlan* plan) {
+    replay::ModelLibrary lib(s);
+    replay::ReplayOptions o;
+    o.context = &ctx();
+    std::vector<Points3f> out;
+    o.onCharacterOutput = [&](uint32_t, uint32_t, const runtime::ReferenceFrameOutputs& r, uint32_t i) { out.push_back(r.positions[i]); };
+    replay::ReplayEngine engine(s, lib, o);
+    *plan = engine.plan();
+    engine.run();
+    return out;
+  };
+  runtime::ReplayPlan pFull, pLean;
+  const auto a = positions(scene(full), &pFull);
+  const auto b = positions(scene(lean), &pLean);
+  EXPECT_EQ(pFull.gpuDispatchesPerFrame(), 4u);
+  EXPECT_EQ(pLean.gpuDispatchesPerFrame(), 1u);
+  EXPECT_LT(pLean.gpuBytes(), pFull.gpuBytes());
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.f) << i;
+}
+
+TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
+  for (bool maps : {true, false}) {
+    Model m = model_;
+    if (!maps) m.normalMaps = NormalMapDatabase{};
+    gpu::GpuModel g(ctx(), m, "m");
+    gpu::FrameRecorderOptions ro;
+    ro.framesInFlight = 1;
+    ro.normalMaps = ro.tangentFrames = maps;
+    gpu::FrameRecorder rec(ctx(), g, 3, ro);
+    uint64_t model = 0, frame = 0;
+    for (const gpu::Buffer* b : {&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets,
+                                 &g.normalTriangles, &g.tangentOffsets, &g.tangentTriangles, &g.codebook, &g.indices})
+      model += b->size();
+    const auto& f = rec.frame(0);
+    for (const gpu::Buffer* b : {&f.meshWeights, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions, &f.normals,
+                                 &f.tangents, &f.decodedMaps})
+      frame += b->size();
+    frame += uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4;
+    uint64_t plannedModel = 0, plannedFrame = 0;
+    for (const auto& a : runtime::modelAllocations(model_, "m", maps)) plannedModel += a.bytes;
+    for (const auto& a : runtime::frameAllocations(model_, "m", 3, maps, maps)) plannedFrame += a.bytes;
+    EXPECT_EQ(plannedModel, model) << "maps " << maps;
+    EXPECT_EQ(plannedFrame, frame) << "maps " << maps;
+  }
+}
+
+TEST_F(ReplayE2E, AnErrorLeavesNoPartialOutputs) {
+  std::ofstream(dir_ / "broken.json") << "{ \"format\": \"swish-pose-stream\", \"version\": 1, \"joints\": [";
+  const runtime::Scene s = scene(sceneJson({"walk.json", "broken.json"}));
+  try {
+    replay::runReplayJob(s, jobOptions());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("characters[1]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("broken.json"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".partial-"), std::string::npos);
+}
+
+}  // namespace
