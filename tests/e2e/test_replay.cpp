@@ -237,6 +237,27 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
   }
 }
 
+TEST_F(ReplayE2E, WritesPerFrameMeshesAndNormalMaps) {
+  json j = sceneJson({"walk.json", "walk.json"});
+  j["outputs"]["meshes"] = true;
+  j["outputs"]["normalMaps"] = true;
+  j["characters"][1]["placement"] = {{"translation", {1e4, 0.0, 0.0}}, {"yawDegrees", 90.0}};
+  const auto r = replay::runReplayJob(scene(j), jobOptions());
+  EXPECT_FALSE(r.result.failed());
+  for (int f = 0; f < 5; ++f) {
+    char name[64];
+    std::snprintf(name, sizeof name, "meshes/frame_%06d.gltf", f);
+    std::ifstream in(dir_ / "out" / name);
+    ASSERT_TRUE(in) << name;
+    const json g = json::parse(in);
+    ASSERT_EQ(g["meshes"].size(), 2u);
+    EXPECT_EQ(g["accessors"][0]["count"], model_.gameMesh.vertexCount());
+    EXPECT_EQ(g["nodes"][1]["translation"][0].get<double>(), 1e4);  // placement on the node, mesh local
+    std::snprintf(name, sizeof name, "normal_maps/c1_%06d.png", f);
+    EXPECT_TRUE(fs::exists(dir_ / "out" / name)) << name;
+  }
+}
+
 TEST_F(ReplayE2E, AnErrorLeavesNoPartialOutputs) {
   std::ofstream(dir_ / "broken.json") << "{ \"format\": \"swish-pose-stream\", \"version\": 1, \"joints\": [";
   const runtime::Scene s = scene(sceneJson({"walk.json", "broken.json"}));

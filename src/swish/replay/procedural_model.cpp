@@ -27,11 +27,12 @@ Mesh makeJerseyTube(const Skeleton& sk, const ProceduralModelSpec& spec) {
   const auto globals = sk.globalTransforms(sk.restPose());
   std::vector<int> chain;
   for (const auto& n : spineChain()) chain.push_back(sk.find(n));
-  const int neck = sk.find("Neck");
+  // CMU's Neck sits on Spine1 (chest height); Neck1 is the base of the neck, where a collar ends.
+  const int neck = sk.find("Neck1") >= 0 ? sk.find("Neck1") : sk.find("Neck");
   std::vector<Vec3f> pts;
   for (int j : chain) pts.push_back(globals[size_t(j)].translation);
   const Vec3f topPoint = neck >= 0 ? globals[size_t(neck)].translation : pts.back() + Vec3f(0, 0.15f, 0);
-  const float bottom = pts.front().y() - 0.08f, top = topPoint.y() - 0.03f;
+  const float bottom = pts.front().y() - 0.12f, top = topPoint.y() - 0.04f;
   const float height = std::max(top - bottom, 0.1f);
   const float rx = 0.36f * height, rz = 0.24f * height;
 

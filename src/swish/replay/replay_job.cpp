@@ -6,6 +6,7 @@
 
 #include "swish/core/error.hpp"
 #include "swish/io/png.hpp"
+#include "swish/replay/gltf_frame_writer.hpp"
 #include "swish/replay/progress_bar.hpp"
 #include "swish/replay/report_writer.hpp"
 
@@ -35,23 +36,47 @@ void writeNormalMap(const fs::path& file, const runtime::BlendedNormalMap& map) 
 
 ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions& options) {
   const runtime::SceneOutputs& out = scene.outputs;
-  if (out.meshes)
-    throw Error(scene.source.string() + ": outputs.meshes: glTF export needs io/gltf_export, which this build does not have yet");
   ModelLibrary models(scene);
   ReplayOptions eo = options.engine;
-  const bool writes = out.report || out.normalMaps;
+  const bool writes = out.report || out.normalMaps || out.meshes;
   StagingFolder staging;
   if (writes) {
     staging.path = out.directory.string() + ".partial-" + std::to_string(::getpid());
     fs::remove_all(staging.path);
     fs::create_directories(staging.path);
   }
-  if (out.normalMaps) {
+  // Meshes of the frame being read back, written as one glTF when the next frame starts (and at the end).
+  struct PendingMesh {
+    uint32_t character;
+    Points3f positions, normals;
+  };
+  std::vector<PendingMesh> pending;
+  uint32_t pendingFrame = 0;
+  auto flushMeshes = [&] {
+    if (pending.empty()) return;
+    std::vector<GltfCharacterMesh> meshes;
+    for (const auto& p : pending) {
+      const Mesh& g = models.at(scene.characters[p.character].model).model.gameMesh;
+      meshes.push_back({scene.characters[p.character].name, scene.characters[p.character].placement, &p.positions,
+                        p.normals.rows() ? &p.normals : nullptr, &g.uvs, &g.triangles});
+    }
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%06u.gltf", pendingFrame);
+    writeGltfFrame(staging.path / "meshes" / name, meshes);
+    pending.clear();
+  };
+  if (out.meshes) fs::create_directories(staging.path / "meshes");
+  if (out.normalMaps) fs::create_directories(staging.path / "normal_maps");
+  if (out.normalMaps || out.meshes) {
     eo.readBackEveryFrame = true;
-    fs::create_directories(staging.path / "normal_maps");
     eo.onCharacterOutput = [&, user = options.engine.onCharacterOutput](uint32_t frame, uint32_t c,
                                                                         const runtime::ReferenceFrameOutputs& o, uint32_t i) {
-      if (i < o.normalMaps.size()) {
+      if (out.meshes) {
+        if (frame != pendingFrame) flushMeshes();
+        pendingFrame = frame;
+        pending.push_back({c, o.positions[i], i < o.normals.size() ? o.normals[i] : Points3f()});
+      }
+      if (out.normalMaps && i < o.normalMaps.size()) {
         char name[64];
         std::snprintf(name, sizeof name, "_%06u.png", frame);
         writeNormalMap(staging.path / "normal_maps" / (scene.characters[c].name + name), o.normalMaps[i]);
@@ -67,6 +92,7 @@ ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions
   ReplayEngine engine(scene, models, eo);
   ReplayJobResult r;
   r.result = engine.run();
+  flushMeshes();
   bar.finish();
   if (out.report) writeReport(staging.path, scene, models, r.result);
   if (writes) {
