@@ -272,6 +272,9 @@ ReplayResult ReplayEngine::run() {
     r.frames.push_back(I.runFrame(f, r));
     if (I.options.progress) I.options.progress(f + 1, I.scene.frameCount);
   }
+  // With validation on, a validation message is a failure of the run like a wrong output.
+  if (I.ctx && I.ctx->validationEnabled())
+    for (const std::string& m : I.ctx->validationMessages()) r.failures.push_back("Vulkan validation: " + m);
   return r;
 }
 
