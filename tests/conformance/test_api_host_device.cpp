@@ -17,6 +17,8 @@
 #include "swish/runtime/reference_frame.hpp"
 #include "test_api_host_fixture.hpp"
 
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"  // Vulkan structs: other members zero on purpose
+
 namespace swish {
 namespace {
 

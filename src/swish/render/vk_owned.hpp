@@ -1,0 +1,66 @@
+#pragma once
+// The preview renderer's Vulkan objects: buffers and images with their own memory, owned RAII-style.
+// The renderer is a host like any other, so it has its own small helpers rather than swish's private
+// gpu layer.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <utility>
+
+namespace swish::render {
+
+class HostDevice;
+
+// Any handle with a destroy function; move-only.
+template <class H>
+class Owned {
+ public:
+  Owned() = default;
+  Owned(H h, std::function<void(H)> destroy) : h_(h), destroy_(std::move(destroy)) {}
+  Owned(Owned&& o) noexcept : h_(std::exchange(o.h_, H{})), destroy_(std::move(o.destroy_)) {}
+  Owned& operator=(Owned&& o) noexcept {
+    if (this != &o) {
+      reset();
+      h_ = std::exchange(o.h_, H{});
+      destroy_ = std::move(o.destroy_);
+    }
+    return *this;
+  }
+  Owned(const Owned&) = delete;
+  Owned& operator=(const Owned&) = delete;
+  ~Owned() { reset(); }
+  void reset() {
+    if (h_ != H{} && destroy_) destroy_(h_);
+    h_ = H{};
+  }
+  H get() const { return h_; }
+
+ private:
+  H h_{};
+  std::function<void(H)> destroy_;
+};
+
+// A buffer in host-visible, coherent memory, mapped for its lifetime (vertex data written each frame,
+// image readback). The preview moves little data; one allocation per buffer is plenty.
+struct MappedBuffer {
+  Owned<VkBuffer> buffer;
+  Owned<VkDeviceMemory> memory;
+  void* data = nullptr;
+  VkDeviceSize size = 0;
+};
+MappedBuffer makeMappedBuffer(HostDevice& device, VkDeviceSize size, VkBufferUsageFlags usage);
+
+// A 2D device-local image with one view.
+struct OwnedImage {
+  Owned<VkImage> image;
+  Owned<VkDeviceMemory> memory;
+  Owned<VkImageView> view;
+};
+OwnedImage makeImage(HostDevice& device, uint32_t width, uint32_t height, VkFormat format, VkImageUsageFlags usage,
+                     VkImageAspectFlags aspect, VkImageViewType viewType = VK_IMAGE_VIEW_TYPE_2D);
+
+// Throws api::Error(VulkanFailure) naming the call.
+void vkCheck(VkResult r, const char* call);
+
+}  // namespace swish::render
