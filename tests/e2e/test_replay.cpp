@@ -45,6 +45,8 @@ class ReplayE2E : public test::GpuTest {
     spec.normalMaps = 4;
     spec.mapSize = 16;
     model_ = test::makeRandomModel(rng, spec);
+    // What the bake records of its evaluation on held-out poses (bake_training.cpp).
+    model_.metadata = R"({"errors": {"held_out_poses": 7, "vertex_total": {"mean_mm": 1.5, "p95_mm": 3, "max_mm": 4}}})";
     saveModel(model_, dir_ / "m.swish");
     writeStream("walk.json", rng, 6, {});
   }
@@ -105,6 +107,11 @@ TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
   EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxPositionErrorMm"].get<double>(), replay::kPositionToleranceMm);
   EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxMapErrorSteps"].get<int>(), replay::kMapToleranceSteps);
   EXPECT_TRUE(rep["frames"][0]["times"]["gpuDeform"].is_number());
+  EXPECT_EQ(rep["models"][0]["heldOutErrors"]["held_out_poses"], 7);
+  EXPECT_TRUE(rep["truth"]["available"].get<bool>());
+  std::ifstream md(dir_ / "out/report.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("7 held-out poses, simulated): vertex error mean 1.5 mm, p95 3 mm"), std::string::npos) << text;
   EXPECT_TRUE(rep["frames"][0]["gpuVsCpu"]["maxPositionErrorMm"].is_number());
   for (const char* f : {"report.md", "plots/time_per_frame.svg", "plots/time_per_stage.svg", "plots/error_per_frame.svg",
                         "plots/error_vs_time.svg"})

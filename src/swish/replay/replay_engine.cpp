@@ -267,7 +267,11 @@ ReplayResult ReplayEngine::run() {
                   "cloth settings), which a .swish file does not carry, and the bake has no API yet from a model back to its "
                   "recipe";
   else
-    r.truthNote = "no ground truth requested (--truth-every N), and the models' metadata holds no held-out poses";
+    r.truthNote = "no per-frame ground truth requested (--truth-every N); a baked model's held-out-pose errors (its "
+                  "metadata) are quoted under Models";
+  // Per-model ground truth: the bake's error on held-out poses, when the model's metadata has it.
+  for (const auto& e : I.models.entries())
+    if (e->model.metadata.find("\"held_out_poses\"") != std::string::npos) r.truthAvailable = true;
   for (uint32_t f = 0; f < I.scene.frameCount; ++f) {
     r.frames.push_back(I.runFrame(f, r));
     if (I.options.progress) I.options.progress(f + 1, I.scene.frameCount);

@@ -67,6 +67,11 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
                            {"joints", m.skeleton.size()}, {"inputJoints", m.inputJoints.size()},
                            {"meshComponents", m.meshComponents()}, {"normalMaps", m.normalMaps.mapCount()},
                            {"mapSize", m.normalMaps.width}});
+    // The bake measures the model on its held-out poses through the runtime path (metadata "errors",
+    // see bake_training.cpp): the ground-truth error of this model, quoted beside the run times.
+    const json meta = json::parse(m.metadata, nullptr, false);
+    if (!meta.is_discarded() && meta.is_object() && meta.contains("errors") && meta["errors"].is_object())
+      j["models"].back()["heldOutErrors"] = meta["errors"];
   }
   j["plan"] = r.plan.toJson();
   j["truth"] = {{"available", r.truthAvailable}, {"note", r.truthNote}};
@@ -140,6 +145,18 @@ std::string reportMarkdown(const json& j) {
     s << "- `" << m["key"].get<std::string>() << "`: " << m["label"].get<std::string>() << " -- " << m["vertices"]
       << " vertices, " << m["joints"] << " joints (" << m["inputJoints"] << " in Theta), K = " << m["meshComponents"] << ", "
       << m["normalMaps"] << " normal maps of " << m["mapSize"] << " px\n";
+  for (const auto& m : j["models"]) {
+    if (!m.contains("heldOutErrors")) continue;
+    const json& e = m["heldOutErrors"];
+    s << "  - ground truth from the bake (" << e.value("held_out_poses", 0) << " held-out poses, simulated): vertex error";
+    if (e.contains("vertex_total"))
+      s << " mean " << fmt(num(e["vertex_total"]["mean_mm"])) << " mm, p95 " << fmt(num(e["vertex_total"]["p95_mm"]))
+        << " mm, max " << fmt(num(e["vertex_total"]["max_mm"])) << " mm";
+    if (e.contains("normal_total"))
+      s << "; normal-map angular error mean " << fmt(num(e["normal_total"]["mean_deg"])) << " deg, p95 "
+        << fmt(num(e["normal_total"]["p95_deg"])) << " deg";
+    s << "\n";
+  }
   s << "\n## Plan\n\n" << j["plan"]["gpuDispatchesPerFrame"] << " GPU dispatches per frame, "
     << fmt(num(j["plan"]["gpuBytes"]) / 1048576.0, "%.2f") << " MiB of GPU memory, " << j["plan"]["rot6JointsPerFrame"]
     << " joints converted to 6D per frame.\n\nLeft out:\n\n";
