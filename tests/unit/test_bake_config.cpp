@@ -23,7 +23,10 @@ TEST(BakeConfig, DefaultsAndPaths) {
   const BakeConfig c = parseBakeConfig({{"name", "jersey"}, {"output", "out"}, {"train", {{"codebook_size", 2048}}}},
                                        "recipe.json", "/base");
   EXPECT_EQ(c.modelPath(), std::filesystem::path("/base/out/jersey.swish"));
-  EXPECT_EQ(c.dataset, std::filesystem::path("/base/out/dataset"));
+  EXPECT_EQ(c.work, std::filesystem::path("/base/out/work"));
+  EXPECT_EQ(c.dataset, std::filesystem::path("/base/out/work/dataset"));
+  EXPECT_EQ(c.simulationDir(), std::filesystem::path("/base/out/work/simulation"));
+  EXPECT_FALSE(c.part1.has_value());
   EXPECT_EQ(c.train.vq.codebookSize, 2048u);
   EXPECT_EQ(c.train.mlp.hiddenLayers, 5);
   EXPECT_EQ(c.train.mlp.hiddenWidth, 32);
@@ -45,6 +48,91 @@ TEST(BakeConfig, ErrorsNameTheKey) {
   EXPECT_NE(errorOf({{"name", "x"}}).find("output: is required"), std::string::npos);
   EXPECT_NE(errorOf(nlohmann::json::array()).find("must be a JSON object"), std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"part1", 3}}).find("part1: must be a JSON object"), std::string::npos);
+}
+
+namespace {
+// A part 1 section whose clip exists (this very source file stands in: the config only checks that
+// files exist; reading them is part 1's work).
+nlohmann::json part1(nlohmann::json extra = nlohmann::json::object()) {
+  nlohmann::json p = {{"clips", {std::string(__FILE__)}}, {"thinning", {{"target_poses", 200}}}};
+  for (auto it = extra.begin(); it != extra.end(); ++it) p[it.key()] = it.value();
+  return p;
+}
+std::string part1Error(nlohmann::json extra) { return errorOf({{"output", "o"}, {"part1", part1(std::move(extra))}}); }
+bool says(const std::string& error, const std::string& what) {
+  if (error.find(what) != std::string::npos) return true;
+  ADD_FAILURE() << "error '" << error << "' does not say '" << what << "'";
+  return false;
+}
+}  // namespace
+
+TEST(BakeConfig, Part1DefaultsAndValues) {
+  const BakeConfig d = parseBakeConfig({{"output", "o"}, {"part1", part1()}}, "recipe.json", "/base");
+  ASSERT_TRUE(d.part1.has_value());
+  EXPECT_TRUE(d.part1->characterFile.empty());   // the embedded default character
+  EXPECT_TRUE(d.part1->characterRecipe.empty());
+  EXPECT_EQ(d.part1->clips.size(), 1u);
+  EXPECT_EQ(d.part1->targetPoses, 200u);
+  EXPECT_EQ(d.part1->thinningTolerance, 0.f);
+  EXPECT_EQ(d.part1->inputJoints, defaultInputJointNames());
+  EXPECT_EQ(d.part1->simulation.material.name, "jersey");
+  EXPECT_EQ(d.part1->transfer.normalMap.width, 360u);
+
+  const BakeConfig c = parseBakeConfig(
+      {{"output", "o"}, {"work", "/tmp/w"},
+       {"part1", part1({{"character", {{"file", std::string(__FILE__)}, {"garment_mesh", {"shirt"}}}},
+                        {"clips", {{{"file", std::string(__FILE__)}, {"naming", "mixamo"},
+                                    {"joint_map", {{"Hips", "Hips"}}}}}},
+                        {"input_joints", {"Spine", "Spine1"}},
+                        {"thinning", {{"tolerance", 0.25}}},
+                        {"simulation", {{"preset", "stiff"}, {"vertices", 4000}, {"threads", 2}, {"substeps", 4}, {"gravity", 0}}},
+                        {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
+                        {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
+      "recipe.json", "/base");
+  EXPECT_EQ(c.work, std::filesystem::path("/tmp/w"));  // absolute paths stay as they are
+  EXPECT_EQ(c.dataset, std::filesystem::path("/tmp/w/dataset"));
+  const DatasetBuildSettings& s = *c.part1;
+  EXPECT_EQ(s.characterFile, std::filesystem::path(__FILE__));
+  EXPECT_EQ(s.garmentMeshNames, std::vector<std::string>{"shirt"});
+  EXPECT_EQ(s.clips[0].naming, io::JointNaming::Mixamo);
+  ASSERT_EQ(s.clips[0].jointMap.size(), 1u);
+  EXPECT_EQ(s.inputJoints.size(), 2u);
+  EXPECT_FLOAT_EQ(s.thinningTolerance, 0.25f);
+  EXPECT_EQ(s.targetPoses, 0u);
+  EXPECT_EQ(s.simulation.material.name, "stiff");
+  EXPECT_EQ(s.simulationVertices, 4000u);
+  EXPECT_EQ(s.threads, 2);
+  EXPECT_EQ(s.simulation.substeps, 4);
+  EXPECT_EQ(s.simulation.gravity, Vec3f::Zero());
+  EXPECT_FLOAT_EQ(d.part1->simulation.gravity.y(), -9.81f);
+  EXPECT_FLOAT_EQ(s.transfer.smoothing.strength, 0.3f);
+  EXPECT_EQ(s.transfer.smoothing.weights, LaplacianWeights::Uniform);
+  EXPECT_EQ(s.transfer.normalMap.width, 128u);
+  EXPECT_EQ(s.transfer.normalMap.height, 128u);
+  EXPECT_EQ(s.normalMapBitDepth, 8u);
+}
+
+TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
+  says(part1Error({{"colour", 1}}), "part1.colour: unknown key");
+  says(part1Error({{"simulation", {{"subteps", 3}}}}), "part1.simulation.subteps: unknown key");
+  says(part1Error({{"simulation", {{"preset", "silk"}}}}), "part1.simulation.preset");
+  says(part1Error({{"simulation", {{"substeps", 0}}}}), "part1.simulation.substeps: 0 is outside");
+  says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
+  says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");
+  says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");
+  says(part1Error({{"thinning", nlohmann::json::object()}}), "part1.thinning: give exactly one");
+  says(part1Error({{"thinning", {{"target_poses", 1}}}}), "part1.thinning.target_poses: 1 is outside");
+  says(part1Error({{"clips", {"/nonexistent/walk.bvh"}}}), "part1.clips[0]: file /nonexistent/walk.bvh does not exist");
+  says(part1Error({{"clips", nlohmann::json::array()}}), "part1.clips: must be a non-empty array");
+  says(part1Error({{"clips", {{{"file", std::string(__FILE__)}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");
+  says(part1Error({{"character", "mannequin"}}), "part1.character: must be \"default\"");
+  says(part1Error({{"character", {{"file", "/nonexistent/c.glb"}}}}), "part1.character.file: file");
+  says(part1Error({{"character", {{"recipe", std::string(__FILE__)}, {"garment_mesh", {"x"}}}}}),
+       "mesh names apply to an imported");
+  says(part1Error({{"input_joints", {"Spine", 3}}}), "part1.input_joints: must hold non-empty strings");
+  says(part1Error({{"transfer", {{"smoothing_weights", "cubic"}}}}), "part1.transfer.smoothing_weights");
+  says(errorOf({{"output", "o"}, {"part1", {{"thinning", {{"target_poses", 10}}}}}}), "part1.clips: is required");
+  says(errorOf({{"output", "o"}, {"part1", {{"clips", {std::string(__FILE__)}}}}}), "part1.thinning: is required");
 }
 
 TEST(BakeConfig, MissingFileIsAClearError) {

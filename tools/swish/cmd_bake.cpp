@@ -1,6 +1,9 @@
 // swish bake CONFIG: runs the bake described by a JSON recipe (bake/bake_config.hpp) end to end and
-// writes <output>/<name>.swish and <output>/report/. The config is validated before any work.
+// writes <output>/<name>.swish and <output>/report/. The config is validated before any work. Part 1
+// (character + clips -> simulated poses -> dataset) and part 2 (dataset -> model) are both resumable:
+// interrupt it and run the same command again.
 #include <cstdio>
+#include <string>
 
 #include "swish/bake/bake_config.hpp"
 #include "swish/bake/bake_pipeline.hpp"
@@ -20,7 +23,16 @@ swish::cli::RunFn setup(CLI::App& sub) {
   return [o]() -> int {
     const swish::bake::BakeConfig cfg = swish::bake::loadBakeConfig(o->config);
     if (o->checkOnly) {
-      std::printf("%s: valid; model -> %s\n", o->config.c_str(), cfg.modelPath().string().c_str());
+      std::printf("%s: valid; model -> %s, report -> %s\n", o->config.c_str(), cfg.modelPath().string().c_str(),
+                  cfg.reportDir().string().c_str());
+      if (cfg.part1)
+        std::printf("part 1: %zu clip(s) -> %s poses -> simulation (%zu vertices, preset '%s') in %s -> dataset %s\n",
+                    cfg.part1->clips.size(),
+                    cfg.part1->targetPoses ? std::to_string(cfg.part1->targetPoses).c_str() : "thinned",
+                    cfg.part1->simulationVertices, cfg.part1->simulation.material.name.c_str(),
+                    cfg.simulationDir().string().c_str(), cfg.dataset.string().c_str());
+      else
+        std::printf("part 1: none (the dataset %s must exist)\n", cfg.dataset.string().c_str());
       return 0;
     }
     swish::bake::BakeRunOptions run;

@@ -6,10 +6,26 @@
 //   {
 //     "name": "default_jersey",          model file <output>/<name>.swish, report <output>/report/
 //     "output": "out",
-//     "dataset": "out/dataset",          the dataset folder (bake/dataset_io.hpp): part 1 writes it,
+//     "work": "out/work",                intermediate files (default <output>/work): the per-pose
+//                                        simulation results (<work>/simulation) and, unless "dataset"
+//                                        says otherwise, the dataset (<work>/dataset)
+//     "dataset": "out/work/dataset",     the dataset folder (bake/dataset_io.hpp): part 1 writes it,
 //                                        part 2 reads it
-//     "part1": { ... },                  part 1 settings (character, clips, thinning, simulation...);
-//                                        passed through to part 1 as given
+//     "part1": {                         part 1 (bake/dataset_builder.hpp); absent: the dataset must exist
+//       "character": "default" | {"recipe": "recipe.json"} |
+//                    {"file": "x.glb", "body_mesh": [..], "garment_mesh": [..], "simulation_mesh": [..]},
+//       "clips": ["a.bvh", {"file": "b.fbx", "naming": "auto|same|mixamo|unreal",
+//                           "joint_map": {"clip joint": "character joint"}, "fps": 0}],
+//       "input_joints": ["LowerBack", ...],
+//       "sampling": {"characters", "seconds_per_character", "sample_rate", "mirror_odd_characters",
+//                    "speed_jitter", "seed"},
+//       "thinning": {"tolerance": 0.1} | {"target_poses": 200},
+//       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
+//                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y)},
+//       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
+//       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
+//       "preview": {"poses", "size"}
+//     },
 //     "train": {                         part 2 settings (every key optional; defaults in bake_training.hpp)
 //       "mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
 //       "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation",
@@ -17,24 +33,30 @@
 //       "max_training_seconds", "test_fraction", "temporal_time_constant", "seed", "bc5_baseline"
 //     }
 //   }
+// Files named in part1 (character, recipe, clips) must exist when the config is loaded.
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "swish/bake/bake_training.hpp"
+#include "swish/bake/dataset_builder.hpp"
 
 namespace swish::bake {
 
 struct BakeConfig {
   std::string name = "model";
   std::filesystem::path output;
+  std::filesystem::path work;
   std::filesystem::path dataset;
-  nlohmann::json part1;            // null when absent
+  std::optional<DatasetBuildSettings> part1;  // absent: the dataset folder must already exist
   BakeTrainSettings train;
 
   std::filesystem::path modelPath() const { return output / (name + ".swish"); }
   std::filesystem::path reportDir() const { return output / "report"; }
+  std::filesystem::path simulationDir() const { return work / "simulation"; }
+  std::filesystem::path previewDir() const { return reportDir() / "dataset_preview"; }
 };
 
 // `source` names the config in error messages; `baseDir` resolves relative paths.

@@ -7,6 +7,7 @@
 #include "swish/bake/bake_report.hpp"
 #include "swish/bake/dataset_io.hpp"
 #include "swish/core/error.hpp"
+#include "swish/model/atomic_write.hpp"
 #include "swish/model/model_file.hpp"
 
 namespace swish::bake {
@@ -42,16 +43,26 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   res.model = cfg.modelPath();
   res.report = cfg.reportDir() / "report.md";
 
-  // Part 1: the dataset folder.
-  if (!std::filesystem::exists(cfg.dataset / "manifest.json")) {
-    if (cfg.part1.is_null())
-      throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
-                  " (no manifest.json) and no \"part1\" section to make one");
-    throw Error("bake '" + cfg.name + "': part 1 (character, poses, simulation, transfer, normal maps) is not wired "
-                "into `swish bake` yet; the dataset folder " + cfg.dataset.string() +
-                " must be made by part 1's tools first (bake/dataset_io.hpp DatasetWriter)");
+  // Part 1: the dataset folder (resumable: finished simulations and poses are kept).
+  if (cfg.part1) {
+    const auto t1 = Clock::now();
+    log("part 1: building the dataset " + cfg.dataset.string());
+    const DatasetBuildResult part1 = buildDataset(*cfg.part1, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
+    res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+    res.part1 = part1.toJson();
+    res.part1["seconds"] = res.part1Seconds;
+    std::filesystem::create_directories(cfg.reportDir());
+    writeTextFileAtomic(cfg.reportDir() / "part1.json", res.part1.dump(2) + "\n");
+    char line[256];
+    std::snprintf(line, sizeof line, "part 1: done in %.1f s: %zu poses in the dataset, %zu left out", res.part1Seconds,
+                  part1.transferred + part1.transfersReused, part1.failed.size());
+    log(line);
+  } else if (!std::filesystem::exists(cfg.dataset / "manifest.json")) {
+    throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
+                " (no manifest.json) and no \"part1\" section to make one");
+  } else {
+    log("part 1: no \"part1\" section; using the dataset " + cfg.dataset.string() + " as it is");
   }
-  log("part 1: dataset " + cfg.dataset.string() + " present (finished poses are kept; nothing to redo)");
 
   // Part 2.
   if (!opt.force && part2Current(cfg)) {
@@ -82,6 +93,7 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   std::filesystem::create_directories(cfg.output);
   writeBakeReport(out, ds, cfg.reportDir());
   saveModel(model, cfg.modelPath());  // last: its presence marks part 2 done
+  res.part2Seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   char line[256];
   std::snprintf(line, sizeof line, "done in %.1f s: model %s, report %s; held-out vertex error mean %.2f mm, p95 %.2f mm",

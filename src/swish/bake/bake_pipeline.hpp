@@ -20,7 +20,8 @@ struct BakeRunOptions {
 struct BakeRunResult {
   std::filesystem::path model, report;
   bool part2Skipped = false;
-  double seconds = 0.0;
+  double seconds = 0.0, part1Seconds = 0.0, part2Seconds = 0.0;
+  nlohmann::json part1;  // DatasetBuildResult::toJson + "seconds" (also <report>/part1.json); null without part 1
 };
 
 BakeRunResult runBake(const BakeConfig& config, const BakeRunOptions& options = {});
