@@ -5,4 +5,5 @@ cd "$(dirname "$0")/.."
 bash tools/setup.sh
 bash tools/build.sh
 BUILD_DIR=${SWISH_BUILD_DIR:-build}
-exec "$BUILD_DIR/swish" frames "$@"
+# With no arguments: the default 22-character scene, report under ./replay-out/.
+exec "$BUILD_DIR/swish" replay "$@"
