@@ -13,6 +13,7 @@
 #include "swish/core/error.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/replay/replay_job.hpp"
+#include "swish/replay/replay_render.hpp"
 #include "swish/runtime/planner.hpp"
 #include "swish/runtime/scene_file.hpp"
 
@@ -22,8 +23,8 @@ namespace fs = std::filesystem;
 
 struct ReplayCliOptions {
   std::string scene, out, device;
-  bool plan = false, quiet = false, validation = false;
-  uint32_t truthEvery = 0, frames = 0;
+  bool plan = false, quiet = false, validation = false, render = false;
+  uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16;
 };
 
 fs::path defaultScenePath() {
@@ -69,6 +70,22 @@ int runReplay(const ReplayCliOptions& o) {
     std::printf("%zu pose issues, %zu check failures. %s\n", r.result.issueCount, r.result.failures.size(),
                 r.result.truthNote.c_str());
   }
+  if (o.render) {
+    // After the replay's outputs are in place, so that a render failure never loses the report.
+    const fs::path dir = (r.directory.empty() ? fs::path(scene.outputs.directory) : r.directory) / "render";
+    replay::ModelLibrary models(scene);
+    replay::ReplayRenderOptions ro;
+    ro.character = o.renderCharacter;
+    ro.maxFrames = o.renderFrames;
+    ro.device = o.device;
+    ro.validation = o.validation;
+    const replay::ReplayRenderResult rr = replay::renderReplayFrames(scene, models, dir, ro);
+    if (!o.quiet) {
+      std::printf("Rendered %zu frames of character %u: %s\n", rr.frames.size(), o.renderCharacter,
+                  rr.contactSheet.string().c_str());
+      if (!rr.note.empty()) std::printf("%s\n", rr.note.c_str());
+    }
+  }
   return r.result.failed() ? 3 : 0;
 }
 
@@ -84,6 +101,11 @@ swish::cli::CommandRegistration reg{
       app.add_option("--frames", o->frames, "replay only this many frames");
       app.add_flag("--quiet", o->quiet, "no progress bar or summary");
       app.add_flag("--validation", o->validation, "enable the Vulkan validation layers");
+      app.add_flag("--render", o->render,
+                   "also draw one character with the preview renderer: PNG frames + contact_sheet.png in <out>/render/");
+      app.add_option("--render-character", o->renderCharacter, "scene character index to draw with --render (default 0)");
+      app.add_option("--render-frames", o->renderFrames, "at most this many frames, spread over the scene (default 16)")
+          ->check(CLI::Range(1u, 10000u));
       return [o] { return runReplay(*o); };
     }};
 

@@ -1,0 +1,35 @@
+#pragma once
+// `swish replay --render`: draws one scene character's frames with the headless preview renderer (a
+// host of the public API on its own Vulkan device) and writes them as PNG frames plus a contact sheet.
+// The character is drawn in place (its root at the rest position, facing the camera), so the fixed
+// preview camera keeps it framed however far the play carries it across the field.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "swish/replay/model_library.hpp"
+#include "swish/runtime/scene.hpp"
+
+namespace swish::replay {
+
+struct ReplayRenderOptions {
+  uint32_t character = 0;   // scene character index
+  uint32_t maxFrames = 16;  // frames are spread evenly over the scene when it has more
+  uint32_t width = 320, height = 426;
+  std::string device;       // as --device
+  bool validation = false;
+};
+
+struct ReplayRenderResult {
+  std::vector<std::filesystem::path> frames;
+  std::filesystem::path contactSheet;
+  std::string note;  // e.g. why no body was drawn
+};
+
+// Writes `directory`/frame_NNNN.png and `directory`/contact_sheet.png. Throws Error naming the scene
+// and character for a bad index or a character without a clip/stream; on any error the folder is removed.
+ReplayRenderResult renderReplayFrames(const runtime::Scene& scene, ModelLibrary& models,
+                                      const std::filesystem::path& directory, const ReplayRenderOptions& options);
+
+}  // namespace swish::replay
