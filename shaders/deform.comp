@@ -48,7 +48,7 @@ void main() {
   }
 
   FloatsIn weightBuf = FloatsIn(p.weights);
-  Mat4sIn matrices = Mat4sIn(p.skinMatrices);
+  FloatsIn matrices = FloatsIn(p.skinMatrices);
   FloatsOut outBuf = FloatsOut(p.positionsOut);
   for (uint instance = 0u; instance < p.instanceCount; ++instance) {
     precise vec3 x = mean;
@@ -58,10 +58,25 @@ void main() {
     }
     precise vec3 y = x;
     if (APPLY_SKINNING) {
-      precise mat4 b = mat4(0.0);
-      [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i)
-        if (skinW[i] != 0.0) b = b + skinW[i] * matrices.m[instance * p.jointCount + joints[i]];
-      y = ((b[0].xyz * x.x + b[1].xyz * x.y) + b[2].xyz * x.z) + b[3].xyz;
+      // Only the top three rows of each (affine, column-major) matrix are read: 12 loads, not 16.
+      // The zero-weight skip is a select, not a branch: every lane runs the same loads (lavapipe
+      // gathers per lane, masked branches do not save that), and a skipped matrix still cannot
+      // bring its NaN/Inf in.
+      precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
+      [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
+        const uint m = (instance * p.jointCount + joints[i]) * 16u;
+        const float w = skinW[i];
+        const vec3 c0 = vec3(matrices.v[m], matrices.v[m + 1u], matrices.v[m + 2u]);
+        const vec3 c1 = vec3(matrices.v[m + 4u], matrices.v[m + 5u], matrices.v[m + 6u]);
+        const vec3 c2 = vec3(matrices.v[m + 8u], matrices.v[m + 9u], matrices.v[m + 10u]);
+        const vec3 c3 = vec3(matrices.v[m + 12u], matrices.v[m + 13u], matrices.v[m + 14u]);
+        const bool use = w != 0.0;
+        b0 = use ? b0 + w * c0 : b0;
+        b1 = use ? b1 + w * c1 : b1;
+        b2 = use ? b2 + w * c2 : b2;
+        b3 = use ? b3 + w * c3 : b3;
+      }
+      y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
     }
     const uint o = (instance * p.vertexCount + v) * 3u;
     outBuf.v[o] = y.x;

@@ -4,35 +4,16 @@
 // float atomics are needed and every sum runs in the same order as the CPU definition,
 // core/mesh_frames.cpp (computeVertexFrames), which runtime/reference_tangent_frames.cpp calls.
 // Every formula below is written out in that file's operation order; `precise` forbids FMA contraction.
+// TangentFramesPass uses this single-pass kernel when the caller gives no triangle-terms buffer; with
+// one it runs triangle_frames.comp + vertex_frames_gather.comp, which compute each triangle's terms
+// once instead of once per adjacent vertex (same values, same sums).
 #extension GL_GOOGLE_include_directive : require
 #include "swish_buffers.glsl"
+#include "swish_frame_math.glsl"
 #include "swish_layouts.h"
 
 layout(local_size_x_id = 0) in;
 layout(push_constant) uniform Push { TangentFramesParams p; };
-
-// Eigen's cross product, component by component.
-vec3 crossCpu(vec3 a, vec3 b) {
-  precise vec3 c = vec3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-  return c;
-}
-float dotCpu(vec3 a, vec3 b) {
-  precise float d = (a.x * b.x + a.y * b.y) + a.z * b.z;
-  return d;
-}
-float normCpu(vec3 a) { return sqrt(dotCpu(a, a)); }
-bool isFinite(float x) { return !isnan(x) && !isinf(x); }
-
-// core/mesh_frames.cpp anyPerpendicular: normalize(cross(n, e)), e the axis least aligned with n
-// (Eigen's normalized(): unchanged when the squared norm is 0).
-vec3 anyPerpendicular(vec3 n) {
-  const vec3 a = abs(n);
-  vec3 e = (a.x <= a.y && a.x <= a.z) ? vec3(1, 0, 0) : (a.y <= a.z ? vec3(0, 1, 0) : vec3(0, 0, 1));
-  precise vec3 c = crossCpu(n, e);
-  const float z = dotCpu(c, c);
-  if (z > 0.0) c = c / sqrt(z);
-  return c;
-}
 
 FloatsIn positions;
 uint base;  // first float of this instance's positions

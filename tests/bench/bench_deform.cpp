@@ -1,7 +1,9 @@
 // The deform pass on the selected Vulkan device (SWISH_DEVICE; lavapipe here): 1 and 22 instances of a
 // 3000-vertex, K = 30 model, timed with GPU timestamps, its bytes moved per second reported against a
 // plain vec4 copy kernel of the same byte count measured in the same iterations (vs_copy: goal >= 0.5);
-// and the cost of an empty dispatch (one alone, and amortised over 100 back to back).
+// and the cost of an empty dispatch (one alone, and amortised over 100 back to back). Also the
+// tangent-frames pass on the same 22 deformed instances, single-pass kernel vs the two-pass
+// (per-triangle terms + per-vertex gather) that FrameRecorder uses.
 //   ./bench_deform --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -14,6 +16,7 @@
 #include "swish/gpu/deform_pass.hpp"
 #include "swish/gpu/empty_dispatch_pass.hpp"
 #include "swish/gpu/gpu_model.hpp"
+#include "swish/gpu/tangent_frames_pass.hpp"
 #include "swish/gpu/timestamp_queries.hpp"
 
 namespace swish {
@@ -131,6 +134,64 @@ void BM_Deform(benchmark::State& state) {
 }
 // Args: instances, skinning (0: PCA reconstruction only, to see what skinning costs).
 BENCHMARK(BM_Deform)->Args({1, 1})->Args({22, 1})->Args({22, 0})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
+// Normals + tangents of `instances` deformed instances of the 3000-vertex model (a UV-mapped grid,
+// ~5900 triangles), arg 1: 0 = single-pass tangent_frames.comp, 1 = two passes through a
+// triangle-terms buffer (what FrameRecorder records).
+void BM_TangentFrames(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const uint32_t instances = uint32_t(state.range(0));
+  const bool twoPass = state.range(1) != 0;
+  DeformSetup s = makeSetup(*ctx, instances, true);
+  const gpu::GpuModel& g = *s.gpuModel;
+  gpu::TimestampQueries ts(*ctx, 2);
+  gpu::DeformPass::Args d;
+  d.mean = g.mean.address();
+  d.basis = g.basis.address();
+  d.weights = s.weights.address();
+  d.skinMatrices = s.matrices.address();
+  d.skinJoints = g.skinJoints.address();
+  d.skinWeights = g.skinWeights.address();
+  d.positionsOut = s.positions.address();
+  d.vertexCount = g.vertexCount();
+  d.instanceCount = instances;
+  d.jointCount = g.jointCount();
+  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, d); });  // the positions to frame
+  const VkDeviceSize n = g.vertexCount();
+  gpu::Buffer normals(*ctx, instances * n * 12, gpu::MemoryKind::DeviceLocal, "normals");
+  gpu::Buffer tangents(*ctx, instances * n * 16, gpu::MemoryKind::DeviceLocal, "tangents");
+  gpu::Buffer terms(*ctx, gpu::TangentFramesPass::triangleTermsBytes(g.triangleCount(), instances), gpu::MemoryKind::DeviceLocal,
+                    "triangle terms");
+  const gpu::TangentFramesPass pass(*ctx);
+  gpu::TangentFramesPass::Args a;
+  a.positions = s.positions.address();
+  a.uvs = g.uvs.address();
+  a.triangles = g.triangles.address();
+  a.normalOffsets = g.normalOffsets.address();
+  a.normalTriangles = g.normalTriangles.address();
+  a.tangentOffsets = g.tangentOffsets.address();
+  a.tangentTriangles = g.tangentTriangles.address();
+  a.normalsOut = normals.address();
+  a.tangentsOut = tangents.address();
+  a.vertexCount = g.vertexCount();
+  a.instanceCount = instances;
+  a.hasUvs = g.hasUvs();
+  if (twoPass) {
+    a.triangleTerms = terms.address();
+    a.triangleCount = g.triangleCount();
+  }
+  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { pass.record(cmd, a); });  // warm-up (first-use compile)
+  double total = 0;
+  for (auto _ : state) {
+    const double t = gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { pass.record(cmd, a); });
+    state.SetIterationTime(t);
+    total += t;
+  }
+  state.counters["us_per_instance"] = 1e6 * total / double(state.iterations()) / instances;
+}
+BENCHMARK(BM_TangentFrames)->Args({22, 0})->Args({22, 1})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
 
 // One empty dispatch between two timestamps (arg 1), or 100 back to back, reported per dispatch (arg 100).
 void BM_EmptyDispatch(benchmark::State& state) {

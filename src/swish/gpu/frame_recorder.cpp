@@ -97,6 +97,8 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
     t.vertexCount = m.vertexCount();
     t.instanceCount = in.instanceCount;
     t.hasUvs = m.hasUvs();
+    t.triangleTerms = f.triangleTerms.address();  // two-pass: each triangle's terms computed once
+    t.triangleCount = m.triangleCount();
     tangentFramesPass_.record(cmd, t);
     f.timestamps.mark(cmd, kAfterTangentFrames);
   }

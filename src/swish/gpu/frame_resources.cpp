@@ -4,6 +4,7 @@
 #include "swish/core/types.hpp"
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/gpu_model.hpp"
+#include "swish/gpu/tangent_frames_pass.hpp"
 
 namespace swish::gpu {
 
@@ -16,6 +17,8 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
   if (withFrames) {
     normals = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "normals");
     tangents = Buffer(ctx, c * n * 4 * sizeof(float), MemoryKind::DeviceLocal, tag + "tangents");
+    triangleTerms = Buffer(ctx, std::max<VkDeviceSize>(16, TangentFramesPass::triangleTermsBytes(m.triangleCount(), uint32_t(c))),
+                           MemoryKind::DeviceLocal, tag + "triangle terms");
   }
   if (withMaps) {
     decodeSlotMaps = Buffer(ctx, c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode slot maps");

@@ -37,6 +37,7 @@ struct FrameResources {
   Buffer normals;          // float[instances][N][3]
   Buffer tangents;         // float[instances][N][4]
   Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8), scratch of the normal-map passes
+  Buffer triangleTerms;    // vec4[instances][T][3], scratch of the two-pass tangent frames
   NormalMapImages normalMaps;  // one layer per instance
   VkUnique<VkDescriptorSet> blendBinding;  // prev frame's normalMaps -> this frame's normalMaps
   TimestampQueries timestamps;

@@ -1,0 +1,58 @@
+#version 460
+// First half of the two-pass tangent frames: each triangle's face-normal term cross(e1, e2) and UV
+// tangent/bitangent terms, computed ONCE per triangle and instance into a buffer (layout in
+// swish_triangle_frames_layout.h), instead of once per adjacent vertex (about 6 times, and again for
+// the tangent sums) as the single-pass tangent_frames.comp does. vertex_frames_gather.comp then sums
+// them per vertex in the order of core/mesh_frames.cpp. The formulas are those of computeVertexFrames
+// in its operation order, `precise` (no FMA), so the stored terms equal what the CPU adds bit for bit.
+//
+// One thread per triangle, looping over the instances: the triangle's corner indices and UV terms
+// (instance-independent) are loaded and computed once for all instances.
+#extension GL_GOOGLE_include_directive : require
+#include "swish_buffers.glsl"
+#include "swish_frame_math.glsl"
+#include "swish_triangle_frames_layout.h"
+
+layout(local_size_x_id = 0) in;
+layout(push_constant) uniform Push { TriangleFramesParams p; };
+layout(buffer_reference, std430, buffer_reference_align = 16) writeonly buffer Vec4sOut { vec4 v[]; };
+
+void main() {
+  const uint t = gl_GlobalInvocationID.x;
+  if (t >= p.triangleCount) return;
+  UintsIn tris = UintsIn(p.triangles);
+  const uint c0 = tris.v[3u * t], c1 = tris.v[3u * t + 1u], c2 = tris.v[3u * t + 2u];
+
+  const bool hasUvs = p.hasUvs != 0u;
+  precise vec2 d1 = vec2(0.0), d2 = vec2(0.0);
+  precise float r = 0.0;
+  if (hasUvs) {
+    FloatsIn uvs = FloatsIn(p.uvs);
+    const vec2 uv0 = vec2(uvs.v[2u * c0], uvs.v[2u * c0 + 1u]);
+    d1 = vec2(uvs.v[2u * c1], uvs.v[2u * c1 + 1u]) - uv0;
+    d2 = vec2(uvs.v[2u * c2], uvs.v[2u * c2 + 1u]) - uv0;
+    r = d1.x * d2.y - d2.x * d1.y;
+  }
+  // core/mesh_frames.cpp skips a triangle whose UV determinant is 0 or not finite.
+  const bool usable = hasUvs && r != 0.0 && isFinite(r);
+
+  FloatsIn pos = FloatsIn(p.positions);
+  Vec4sOut terms = Vec4sOut(p.termsOut);
+  for (uint instance = 0u; instance < p.instanceCount; ++instance) {
+    const uint base = instance * p.vertexCount * 3u;
+    const vec3 p0 = vec3(pos.v[base + 3u * c0], pos.v[base + 3u * c0 + 1u], pos.v[base + 3u * c0 + 2u]);
+    precise vec3 e1 = vec3(pos.v[base + 3u * c1], pos.v[base + 3u * c1 + 1u], pos.v[base + 3u * c1 + 2u]) - p0;
+    precise vec3 e2 = vec3(pos.v[base + 3u * c2], pos.v[base + 3u * c2 + 1u], pos.v[base + 3u * c2 + 2u]) - p0;
+    const uint o = (instance * p.triangleCount + t) * SWISH_TRIANGLE_TERM_VEC4S;
+    terms.v[o] = vec4(crossCpu(e1, e2), 0.0);
+    if (hasUvs) {
+      precise vec3 tangentTerm = vec3(0.0), bitangentTerm = vec3(0.0);
+      if (usable) {
+        tangentTerm = (e1 * d2.y - e2 * d1.y) / r;
+        bitangentTerm = (e2 * d1.x - e1 * d2.x) / r;
+      }
+      terms.v[o + 1u] = vec4(tangentTerm, usable ? 1.0 : 0.0);
+      terms.v[o + 2u] = vec4(bitangentTerm, 0.0);
+    }
+  }
+}
