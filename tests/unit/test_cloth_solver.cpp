@@ -71,9 +71,9 @@ TEST(ClothSimulationMesh, WeldsSeamsAndSubdividesTowardsTarget) {
   const test::CapsuleSpec spec;
   EXPECT_EQ(welded.vertexCount(), size_t(spec.garmentAround * (spec.garmentRows + 1)));  // seam column merged
   const SimulationMesh sim = buildSimulationMesh(ch, 12000);
-  EXPECT_GT(sim.vertexCount(), 6000u);
-  EXPECT_LT(sim.vertexCount(), 24000u);
-  EXPECT_EQ(sim.triangles.rows(), welded.triangles.rows() << (2 * sim.subdivisionLevels));
+  EXPECT_GT(sim.vertexCount(), 10800u);  // within 10% of the target
+  EXPECT_LT(sim.vertexCount(), 13200u);
+  EXPECT_GT(sim.triangles.rows(), 4 * welded.triangles.rows());
   ASSERT_EQ(sim.gameToSim.size(), ch.garment.vertexCount());
   for (size_t g = 0; g < sim.gameToSim.size(); ++g)
     EXPECT_EQ(sim.restPositions.row(sim.gameToSim[g]), ch.garment.positions.row(Eigen::Index(g)));

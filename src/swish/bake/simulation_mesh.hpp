@@ -1,7 +1,12 @@
 #pragma once
 // The high-resolution cloth the source simulation runs on: the game mesh welded by position (seam-split
-// copies become one cloth vertex, so the cloth does not tear along UV seams) and subdivided until it
-// has about the requested number of vertices; or the character's own simulation mesh when it has one.
+// copies become one cloth vertex, so the cloth does not tear along UV seams) and refined by longest-edge
+// bisection until it has about the requested number of vertices with edges of about one length; or the
+// character's own simulation mesh when it has one.
+//
+// Why even edges and not uniform midpoint subdivision: a game mesh mixes 4 mm and 6 cm edges, and two
+// midpoint levels turn its short ones into 1 mm edges whose stiff constraints a few Gauss-Seidel sweeps
+// cannot reconcile with the long ones (the shared T-shirt exploded at frame 2 that way).
 #include <cstddef>
 #include <vector>
 
@@ -13,8 +18,11 @@ struct SimulationMesh {
   Points3f restPositions;              // character space, rest (A-)pose
   Triangles triangles;                 // welded: neighbours share vertex indices
   SkinWeights skin;                    // per simulation vertex
-  std::vector<uint32_t> gameToSim;     // game-mesh vertex -> simulation vertex at its rest position
-  int subdivisionLevels = 0;           // midpoint levels applied to the welded game mesh
+  // Game-mesh vertex -> simulation vertex at its rest position (within a quarter of the refined edge
+  // length of it where collapseShortEdges merged it into a neighbour).
+  std::vector<uint32_t> gameToSim;
+  int subdivisionLevels = 0;           // midpoint levels applied (subdivideMidpoint only)
+  float refinedEdgeLength = 0.f;       // m: longest edge allowed by refineToEdgeLength (0: not refined)
   bool fromCharacterSimulationMesh = false;
 
   size_t vertexCount() const { return size_t(restPositions.rows()); }
@@ -35,6 +43,19 @@ SimulationMesh buildSimulationMesh(const Character& character,
 // two end points' skin weights averaged, cut back to the mesh's influence count and renormalised.
 // gameToSim is unchanged (old vertices keep their indices).
 SimulationMesh subdivideMidpoint(const SimulationMesh& mesh);
+
+// Longest-edge bisection (Rivara): splits, longest first, every edge longer than `maxEdge` at its
+// midpoint, together with the one or two triangles on it, until none is left. New vertices sit at
+// edge midpoints (the rest shape is kept exactly) with the two end points' skin weights blended as in
+// subdivideMidpoint. Old vertices keep their indices (gameToSim is unchanged). Deterministic.
+SimulationMesh refineToEdgeLength(const SimulationMesh& mesh, float maxEdge);
+
+// Removes edges shorter than `minEdge` by collapsing each onto one end point (the boundary one, else
+// the lower index; it keeps its position), where that keeps the surface manifold (link condition)
+// and flips no triangle. Game mesh corners closer than a fraction of a millimetre (armhole seams) would
+// otherwise be cloth edges whose 400% "strain" under a 2 mm contact push dominates every residual.
+// gameToSim follows the merged vertices; rest positions of the kept vertices are unchanged.
+SimulationMesh collapseShortEdges(const SimulationMesh& mesh, float minEdge);
 
 // Welds by exact position and drops unused vertices. Returns, per input vertex, its welded index.
 // Used for the game mesh and a character's own simulation mesh alike.
