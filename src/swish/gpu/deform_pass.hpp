@@ -17,7 +17,7 @@ namespace swish::gpu {
 
 class DeformPass {
  public:
-  static constexpr uint32_t kWorkgroupSize = 64;
+  static constexpr uint32_t kWorkgroupSize = 256;
 
   struct Args {
     VkDeviceAddress mean = 0;          // float[3N]

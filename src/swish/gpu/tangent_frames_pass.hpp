@@ -21,7 +21,7 @@ namespace swish::gpu {
 
 class TangentFramesPass {
  public:
-  static constexpr uint32_t kWorkgroupSize = 64;
+  static constexpr uint32_t kWorkgroupSize = 256;
 
   struct Args {
     VkDeviceAddress positions = 0;         // float[instances][N][3]
