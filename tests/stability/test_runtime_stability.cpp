@@ -20,11 +20,6 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-std::vector<CpuKernel> kernels() {
-  std::vector<CpuKernel> k{CpuKernel::Portable};
-  if (cpuHasAvx2Fma()) k.push_back(CpuKernel::Avx2Fma);
-  return k;
-}
 
 bool allFinite(std::span<const float> v) {
   for (float x : v)
@@ -87,7 +82,7 @@ TEST(RuntimeStability, ExtremeNetworkInputsAndWeightsStayFinite) {
     in.scale[3] = std::numeric_limits<float>::denorm_min();  // a zero-variance input, as a bake might store it
     in.scale[4] = 1e-30f;
     Normalisation out{VecXf::Constant(9, 0.5f), VecXf::Constant(9, 1e30f)};
-    for (CpuKernel k : kernels()) {
+    for (CpuKernel k : availableCpuKernels()) {
       const MlpEvaluator eval(mlp, in, out, 4, k);
       const std::vector<float> v = nastyFloats();
       std::vector<float> theta;
@@ -110,7 +105,7 @@ TEST(RuntimeStability, ZeroVarianceOutputScaleGivesTheMean) {
   Normalisation out = model.outputNorm;
   out.scale.setConstant(std::numeric_limits<float>::denorm_min());  // positive, so a valid model
   out.mean.setLinSpaced(out.mean.size(), -2.f, 3.f);
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const MlpEvaluator eval(model.mlp, model.inputNorm, out, model.meshComponents(), k);
     std::vector<float> theta(model.thetaSize(), 0.3f), lambda(model.lambdaSize());
     eval.evaluate(theta, lambda);
@@ -124,7 +119,7 @@ TEST(RuntimeStability, ZeroVarianceOutputScaleGivesTheMean) {
 TEST(RuntimeStability, NaNInputIsNotHidden) {
   Rng rng(test::testSeed(503));
   const Model model = test::makeRandomModel(rng);
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const MlpEvaluator eval(model, k);
     std::vector<float> theta(model.thetaSize(), 0.1f), lambda(model.lambdaSize());
     theta[2] = kNaN;
@@ -170,7 +165,7 @@ TEST(RuntimeStability, FrameEvaluatorSurvivesHostileFrames) {
 TEST(RuntimeStability, LookupWithExtremeCodes) {
   MatXf keys(6, 3);
   keys << 0, 0, 0, 1e30f, 0, 0, -1e30f, 0, 0, 0, FLT_MAX, 0, 0, 0, -FLT_MAX, 1, 1, 1;
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const NearestCodeSearch search(keys, k);
     for (float a : nastyFloats())
       for (float b : nastyFloats()) {

@@ -23,12 +23,6 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// The kernels this machine can run: the portable one always, AVX2+FMA when the CPU has it.
-std::vector<CpuKernel> kernels() {
-  std::vector<CpuKernel> k{CpuKernel::Portable};
-  if (cpuHasAvx2Fma()) k.push_back(CpuKernel::Avx2Fma);
-  return k;
-}
 
 // Distance in units in the last place between two finite floats of the same sign region.
 int64_t ulpDistance(float a, float b) {
@@ -272,7 +266,7 @@ TEST(RuntimeMlp, HandComputedTinyNetwork) {
   const double h0 = lambda * 1.0, h1 = lambda * alpha * (std::exp(-0.5) - 1.0);
   const double expect = (2 * h0 + h1 + 0.25) * 3 + 10;  // by hand: (2.10140 - 0.69176 + 0.25) * 3 + 10
   EXPECT_NEAR(expect, 14.97894, 1e-4);                  // the hand arithmetic, to 4 decimals
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const MlpEvaluator eval(mlp, in, out, 0, k);
     const float x[2] = {3, 1};
     float y = 0;
@@ -299,7 +293,7 @@ TEST(RuntimeMlp, MatchesDoubleReferenceWithinTheForwardErrorBound) {
     for (float& t : theta) t = rng.uniformf(-1.f, 1.f);
     std::vector<Reference> refs;
     for (size_t i = 0; i < count; ++i) refs.push_back(referenceMlp(mlp, in, out, theta.data() + i * widths.front()));
-    for (CpuKernel k : kernels()) {
+    for (CpuKernel k : availableCpuKernels()) {
       const MlpEvaluator eval(mlp, in, out, widths.back() / 2, k);
       std::vector<float> lambda(count * widths.back());
       eval.evaluateBatch(theta, lambda, count);
@@ -322,7 +316,7 @@ TEST(RuntimeMlp, BatchEqualsSingleBitwise) {
   const size_t count = 300;  // crosses the evaluator's 128-instance chunks, odd tail
   std::vector<float> theta(count * 24);
   for (float& t : theta) t = rng.uniformf(-1.f, 1.f);
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const MlpEvaluator eval(mlp, in, out, 16, k);
     std::vector<float> batch(count * 26), mesh(count * 16), code(count * 10);
     eval.evaluateBatch(theta, batch, count);

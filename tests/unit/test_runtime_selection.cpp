@@ -22,11 +22,6 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-std::vector<CpuKernel> kernels() {
-  std::vector<CpuKernel> k{CpuKernel::Portable};
-  if (cpuHasAvx2Fma()) k.push_back(CpuKernel::Avx2Fma);
-  return k;
-}
 
 // Brute force in double, lowest index on ties: the specification of the search.
 uint32_t nearestDouble(const MatXf& keys, const float* code, double* best = nullptr) {
@@ -57,7 +52,7 @@ TEST(RuntimeNearestCode, MatchesBruteForceOnRandomDatabases) {
     for (int dims : {1, 3, 8, 17, 32}) {
       MatXf keys(maps, dims);
       for (Eigen::Index i = 0; i < keys.size(); ++i) keys.data()[i] = float(rng.normal());
-      for (CpuKernel k : kernels()) {
+      for (CpuKernel k : availableCpuKernels()) {
         const NearestCodeSearch search(keys, k);
         for (int q = 0; q < 20; ++q) {
           std::vector<float> code(dims);
@@ -84,7 +79,7 @@ TEST(RuntimeNearestCode, TiesGoToTheLowestIndex) {
   // Keys 1 and 3 are duplicates, keys 0 and 2 are at the same distance from the origin as each other.
   MatXf keys(5, 2);
   keys << 3, 0, 1, 1, 0, 3, 1, 1, -1, -1;
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const NearestCodeSearch search(keys, k);
     const float atDuplicate[2] = {1, 1};
     EXPECT_EQ(search.find(atDuplicate).index, 1u) << toString(k);
@@ -100,7 +95,7 @@ TEST(RuntimeNearestCode, TiesGoToTheLowestIndex) {
   // 100 identical keys: always 0; with the first removed from equality, the second.
   MatXf same = MatXf::Constant(100, 4, 0.5f);
   same(0, 0) = 9.f;
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const float code[4] = {0.5f, 0.5f, 0.5f, 0.5f};
     EXPECT_EQ(NearestCodeSearch(same, k).find(code).index, 1u);
   }
@@ -109,7 +104,7 @@ TEST(RuntimeNearestCode, TiesGoToTheLowestIndex) {
 TEST(RuntimeNearestCode, NonFiniteCodeReturnsTheFallbackNotFound) {
   MatXf keys(4, 3);
   keys.setRandom();
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const NearestCodeSearch search(keys, k);
     for (float bad : {kNaN, kInf, -kInf}) {
       const float code[3] = {0.f, bad, 0.f};
@@ -128,7 +123,7 @@ TEST(RuntimeNearestCode, HugeFiniteCodeStillFindsItsTrueNearestKey) {
   // Every key is over 1.9e19 from the code: squared distances above FLT_MAX (3.4e38).
   MatXf keys(3, 2);
   keys << 0, 0, 3e19f, 0, 5e19f, 0;
-  for (CpuKernel k : kernels()) {
+  for (CpuKernel k : availableCpuKernels()) {
     const NearestCodeSearch search(keys, k);
     const float code[2] = {1e20f, 0.f};
     const NearestCode r = search.find(code);

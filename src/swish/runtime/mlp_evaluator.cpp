@@ -47,6 +47,19 @@ const char* toString(CpuKernel k) {
   return "?";
 }
 
+CpuKernel resolveCpuKernel(CpuKernel requested, const char* user) {
+  if (requested == CpuKernel::Auto) return cpuHasAvx2Fma() ? CpuKernel::Avx2Fma : CpuKernel::Portable;
+  if (requested == CpuKernel::Avx2Fma && !cpuHasAvx2Fma())
+    throw Error(std::string(user) + ": the AVX2+FMA kernel was asked for but this CPU lacks it");
+  return requested;
+}
+
+std::vector<CpuKernel> availableCpuKernels() {
+  std::vector<CpuKernel> k{CpuKernel::Portable};
+  if (cpuHasAvx2Fma()) k.push_back(CpuKernel::Avx2Fma);
+  return k;
+}
+
 MlpEvaluator::MlpEvaluator(const Model& model, CpuKernel kernel)
     : MlpEvaluator(model.mlp, model.inputNorm, model.outputNorm, model.meshComponents(), kernel) {}
 
@@ -79,9 +92,7 @@ MlpEvaluator::MlpEvaluator(const Mlp& mlp, const Normalisation& inputNorm, const
     fail("mesh components " + n2s(meshComponents) + " outside 0.." + n2s(outputSize_));
   meshComponents_ = meshComponents;
 
-  if (kernel == CpuKernel::Auto) kernel = cpuHasAvx2Fma() ? CpuKernel::Avx2Fma : CpuKernel::Portable;
-  if (kernel == CpuKernel::Avx2Fma && !cpuHasAvx2Fma()) fail("the AVX2+FMA kernel was asked for but this CPU lacks it");
-  kernel_ = kernel;
+  kernel_ = resolveCpuKernel(kernel, "mlp evaluator");
 
   // Pack everything into one array: transposed, zero-padded weights, so that a kernel reads each
   // layer's weights as contiguous rows of outputsPadded floats.

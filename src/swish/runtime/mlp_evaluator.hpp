@@ -32,6 +32,11 @@ enum class CpuKernel {
   Avx2Fma,   // throws Error at construction when the CPU lacks AVX2 or FMA
 };
 const char* toString(CpuKernel k);
+// Auto -> the best kernel this CPU runs; Avx2Fma on a CPU without AVX2/FMA -> Error
+// "<user>: the AVX2+FMA kernel was asked for but this CPU lacks it". Shared by every CPU kernel user.
+CpuKernel resolveCpuKernel(CpuKernel requested, const char* user);
+// Every kernel this CPU can run: Portable always, Avx2Fma when the CPU has it (tests try each).
+std::vector<CpuKernel> availableCpuKernels();
 
 class MlpEvaluator {
  public:

@@ -32,10 +32,7 @@ NearestCodeSearch::NearestCodeSearch(const MatXf& keys, CpuKernel kernel) : keys
   if (keys.rows() == 0) throw Error("nearest code: the normal-map database has no maps");
   if (keys.cols() == 0) throw Error("nearest code: the normal-map database keys have no dimensions");
   if (!keys.allFinite()) throw Error("nearest code: the normal-map database keys have non-finite values");
-  if (kernel == CpuKernel::Auto) kernel = cpuHasAvx2Fma() ? CpuKernel::Avx2Fma : CpuKernel::Portable;
-  if (kernel == CpuKernel::Avx2Fma && !cpuHasAvx2Fma())
-    throw Error("nearest code: the AVX2+FMA kernel was asked for but this CPU lacks it");
-  kernel_ = kernel;
+  kernel_ = resolveCpuKernel(kernel, "nearest code");
   mapCount_ = uint32_t(keys.rows());
   codeDims_ = uint32_t(keys.cols());
   const size_t pad = padded8(mapCount_);
