@@ -28,15 +28,9 @@ struct ReplayCliOptions {
 };
 
 fs::path defaultScenePath() {
-  std::vector<fs::path> candidates = {fs::current_path() / "assets/scenes/football.json"};
   std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    candidates.push_back(exe.parent_path() / "assets/scenes/football.json");
-    candidates.push_back(exe.parent_path().parent_path() / "assets/scenes/football.json");
-  }
-  for (const auto& c : candidates)
-    if (fs::exists(c, ec)) return c;
+  for (const fs::path& root : swish::replay::assetSearchRoots())
+    if (fs::exists(root / "assets/scenes/football.json", ec)) return root / "assets/scenes/football.json";
   throw swish::Error("no scene given and the default scene assets/scenes/football.json was not found (looked in the "
                      "current folder and beside the swish executable)");
 }

@@ -20,17 +20,23 @@ constexpr float kCmuBvhUnitMetres = 0.0254f / 0.45f;
 const fs::path kDefaultClip = "/usr/share/assimp/models/BVH/01_01.bvh";
 
 std::vector<fs::path> defaultAssetFolders() {
-  std::vector<fs::path> dirs = {fs::current_path() / "assets/default"};
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    dirs.push_back(exe.parent_path() / "assets/default");
-    dirs.push_back(exe.parent_path().parent_path() / "assets/default");
-  }
+  std::vector<fs::path> dirs;
+  for (const fs::path& root : assetSearchRoots()) dirs.push_back(root / "assets/default");
   return dirs;
 }
 
 }  // namespace
+
+std::vector<fs::path> assetSearchRoots() {
+  std::vector<fs::path> roots = {fs::current_path()};
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    roots.push_back(exe.parent_path());
+    roots.push_back(exe.parent_path().parent_path());
+  }
+  return roots;
+}
 
 Skeleton skeletonFromBvh(const fs::path& bvh) {
   const io::SourceAnimation a = io::readBvh(bvh);

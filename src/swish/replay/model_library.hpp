@@ -45,6 +45,10 @@ class ModelLibrary {
   std::map<std::pair<std::string, std::string>, std::shared_ptr<const AnimationClip>> clips_;
 };
 
+// Where the project's assets/ folder is looked for, in order: the current folder, the swish
+// executable's folder, and its parent (a build folder inside the source tree).
+std::vector<std::filesystem::path> assetSearchRoots();
+
 // The default model as described above (never throws for a missing asset when the clip exists).
 ModelEntry loadDefaultModel();
 // The CMU skeleton of a BVH file in metres, standing on y = 0, identity rest rotations.
