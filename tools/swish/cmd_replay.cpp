@@ -42,9 +42,9 @@ int runReplay(const ReplayCliOptions& o) {
   if (!o.out.empty()) scene.outputs.directory = fs::absolute(o.out);
   else if (isDefault) scene.outputs.directory = fs::current_path() / "replay-out";  // not into the source tree
   if (o.frames > 0) scene.frameCount = o.frames;
+  replay::ModelLibrary models(scene);  // loaded once: plan, replay and render share it
 
   if (o.plan) {
-    replay::ModelLibrary models(scene);
     const runtime::ReplayPlan plan = runtime::planReplay(scene, models.modelMap());
     std::printf("Scene '%s' (%s): %zu characters, frames %u..%u at %g fps\n", scene.name.c_str(), scene.source.string().c_str(),
                 scene.characters.size(), scene.firstFrame, scene.firstFrame + scene.frameCount - 1, scene.framesPerSecond);
@@ -54,6 +54,7 @@ int runReplay(const ReplayCliOptions& o) {
   }
   replay::ReplayJobOptions jo;
   jo.quiet = o.quiet;
+  jo.models = &models;
   jo.engine.device.device = o.device;
   if (o.validation) jo.engine.device.validation = true;
   jo.engine.truthEvery = o.truthEvery;
@@ -67,7 +68,6 @@ int runReplay(const ReplayCliOptions& o) {
   if (o.render) {
     // After the replay's outputs are in place, so that a render failure never loses the report.
     const fs::path dir = (r.directory.empty() ? fs::path(scene.outputs.directory) : r.directory) / "render";
-    replay::ModelLibrary models(scene);
     replay::ReplayRenderOptions ro;
     ro.character = o.renderCharacter;
     ro.maxFrames = o.renderFrames;

@@ -1,5 +1,7 @@
 #include "swish/replay/replay_job.hpp"
 
+#include <optional>
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -36,7 +38,8 @@ void writeNormalMap(const fs::path& file, const runtime::BlendedNormalMap& map) 
 
 ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions& options) {
   const runtime::SceneOutputs& out = scene.outputs;
-  ModelLibrary models(scene);
+  std::optional<ModelLibrary> ownModels;
+  ModelLibrary& models = options.models ? *options.models : ownModels.emplace(scene);
   ReplayOptions eo = options.engine;
   const bool writes = out.report || out.normalMaps || out.meshes;
   StagingFolder staging;

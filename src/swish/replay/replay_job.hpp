@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "swish/replay/model_library.hpp"
 #include "swish/replay/replay_engine.hpp"
 #include "swish/runtime/scene.hpp"
 
@@ -13,6 +14,7 @@ namespace swish::replay {
 struct ReplayJobOptions {
   ReplayOptions engine;
   bool quiet = false;
+  ModelLibrary* models = nullptr;  // the scene's models, when the caller already loaded them (else loaded here)
 };
 
 struct ReplayJobResult {
