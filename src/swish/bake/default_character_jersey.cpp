@@ -130,6 +130,22 @@ Mesh buildJersey(const RecipeJersey& r, const SweptEllipseTube& torso, const std
     const float circumference = 2.f * float(M_PI) * (0.5f * (start.halfWidth + start.halfDepth) + r.offset);
     const float vTop = vBase + height + 0.03f;
     std::vector<std::vector<uint32_t>> ring(size_t(K + 1), std::vector<uint32_t>(M + 1));
+    // Each column's angle about the arm, in the start frame (so rings do not twist against each
+    // other): the seam vertex's own angle, then advancing by arc length along the loop. The loop's
+    // own angles would bunch up where a side of its rectangle is seen edge-on from the arm axis, and
+    // left pairs of columns under a millimetre apart along the whole sleeve: cloth edges a hundred
+    // times shorter than their neighbours, which no cloth solver can keep stable.
+    auto angleOf = [&](const Vec3f& p0) {
+      const Vec3f q = p0 - start.center;
+      return std::atan2(q.dot(start.e2), q.dot(start.e1));
+    };
+    std::vector<float> arc(M + 1, 0.f);
+    float turn = 0.f;  // total signed angle around the loop: +-2 pi, its sign is the direction
+    for (size_t j = 0; j < M; ++j) {
+      arc[j + 1] = arc[j] + (b.pos[loop[(j + 1) % M]] - b.pos[loop[j]]).norm();
+      turn += std::remainder(angleOf(b.pos[loop[(j + 1) % M]]) - angleOf(b.pos[loop[j]]), 2.f * float(M_PI));
+    }
+    const float phiSeam = angleOf(b.pos[loop[0]]), direction = turn >= 0.f ? 1.f : -1.f;
     for (int k = 0; k <= K; ++k) {
       const float along = r.sleeveLength * float(k) / float(K);
       const TubeSection s = arm.section(start.param + along / std::max(metresPerParam, 1e-4f));
@@ -137,18 +153,19 @@ Mesh buildJersey(const RecipeJersey& r, const SweptEllipseTube& torso, const std
       const float e = std::min(1.f, float(k) / float(std::max(1, std::min(K, 3))));
       const float blend = e * e * (3.f - 2.f * e);
       for (size_t j = 0; j <= M; ++j) {
-        const Vec3f p0 = b.pos[loop[j % M]];
+        const Vec2f t(sleeveU0[h % 2] + circumference * float(j) / float(M), vTop + along);
+        if (j == M) {  // the seam copy of column 0: bitwise the same position, so it welds
+          ring[size_t(k)][j] = b.add(b.pos[ring[size_t(k)][0]], t);
+          continue;
+        }
+        const Vec3f p0 = b.pos[loop[j]];
         Vec3f p = p0;
         if (k > 0) {
-          // The loop vertex's angle about the arm, measured once in the start frame, so that rings
-          // do not twist against each other.
-          const Vec3f q = p0 - start.center;
-          const float phi = std::atan2(q.dot(start.e2), q.dot(start.e1));
+          const float phi = phiSeam + direction * 2.f * float(M_PI) * arc[j] / arc[M];
           const Vec3f onTube = s.center + (s.halfWidth + r.offset) * std::cos(phi) * s.e1 + (s.halfDepth + r.offset) * std::sin(phi) * s.e2;
           p = (1.f - blend) * p0 + blend * onTube;
           pushOutOfBody(p, bodyParts, r.clearance);
         }
-        const Vec2f t(sleeveU0[h % 2] + circumference * float(j) / float(M), vTop + along);
         ring[size_t(k)][j] = b.add(p, t);
       }
     }
