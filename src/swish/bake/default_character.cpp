@@ -258,6 +258,41 @@ Character makeDefaultCharacter(const DefaultCharacterRecipe& recipe) {
       }
     }
   }
+  // Smooth the transferred weights over the jersey's surface (seam copies welded, so both sides of a
+  // seam get the same weights): each sweep moves a vertex halfway to its neighbours' mean.
+  {
+    const std::vector<uint32_t> rep = weldByPosition(c.garment.positions);
+    std::vector<std::vector<uint32_t>> neighbours(garmentWeights.size());
+    for (Eigen::Index t = 0; t < c.garment.triangles.rows(); ++t)
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = rep[c.garment.triangles(t, e)], b = rep[c.garment.triangles(t, (e + 1) % 3)];
+        neighbours[a].push_back(b);
+        neighbours[b].push_back(a);
+      }
+    for (auto& n : neighbours) {
+      std::sort(n.begin(), n.end());
+      n.erase(std::unique(n.begin(), n.end()), n.end());
+    }
+    for (size_t g = 0; g < garmentWeights.size(); ++g) {  // one normalised map per welded vertex
+      float total = 0.f;
+      for (auto& [j, x] : garmentWeights[g]) total += x;
+      for (auto& [j, x] : garmentWeights[g]) x /= total;
+    }
+    for (int sweep = 0; sweep < recipe.jersey.skinSmoothingIterations; ++sweep) {
+      std::vector<WeightMap> next = garmentWeights;
+      for (size_t g = 0; g < garmentWeights.size(); ++g) {
+        if (rep[g] != g || neighbours[g].empty()) continue;
+        WeightMap m;
+        for (const auto& [j, x] : garmentWeights[g]) m[j] += 0.5f * x;
+        const float share = 0.5f / float(neighbours[g].size());
+        for (uint32_t n : neighbours[g])
+          for (const auto& [j, x] : garmentWeights[n]) m[j] += share * x;
+        next[g] = std::move(m);
+      }
+      for (size_t g = 0; g < garmentWeights.size(); ++g) next[g] = next[rep[g]];
+      garmentWeights = std::move(next);
+    }
+  }
   c.garment.skin = packWeights(garmentWeights, recipe.jersey.maxInfluences);
   computeFrames(c.garment);
 

@@ -106,6 +106,7 @@ constexpr const char* kEmbeddedRecipe = R"recipe({
     "sleeveLength": 0.14,
     "sleeveRings": 8,
     "skinTransferNeighbours": 4,
+    "skinSmoothingIterations": 40,
     "maxInfluences": 4
   }
 }
@@ -233,6 +234,7 @@ DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, cons
   g.sleeveLength = positive(js, "sleeveLength", w, 1e-3f, 1.f);
   g.sleeveRings = count(js, "sleeveRings", w, 1, 256);
   g.skinTransferNeighbours = count(js, "skinTransferNeighbours", w, 1, 16);
+  g.skinSmoothingIterations = count(js, "skinSmoothingIterations", w, 0, 10000);
   g.maxInfluences = count(js, "maxInfluences", w, 1, 8);
   if (!(g.hemY < g.armholeBottomY && g.armholeBottomY < g.armholeTopY && g.armholeTopY < g.collarY))
     throw Error(w + ": need hemY < armholeBottomY < armholeTopY < collarY");

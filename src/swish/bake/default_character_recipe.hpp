@@ -53,6 +53,10 @@ struct RecipeJersey {
   float sleeveLength = 0.17f;
   int sleeveRings = 8;
   int skinTransferNeighbours = 4;
+  // Sweeps of neighbour averaging over the jersey after the transfer: nearest body vertices switch
+  // from arm to torso between neighbouring jersey vertices in the armpit, and skinning alone then
+  // stretched an armpit edge by 340% when the arms came down.
+  int skinSmoothingIterations = 40;
   int maxInfluences = 4;
 };
 
