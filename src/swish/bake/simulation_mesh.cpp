@@ -228,11 +228,16 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
   std::vector<uint8_t> deadTri(tris.size(), 0);
   std::vector<uint32_t> mergedInto(nv);
   for (uint32_t v = 0; v < nv; ++v) mergedInto[v] = v;
-  auto pos = [&](uint32_t v) -> Vec3f { return in.restPositions.row(v); };
+  // Positions and weights change where two interior vertices merge at their midpoint.
+  std::vector<Vec3f> position(nv);
+  for (uint32_t v = 0; v < nv; ++v) position[v] = in.restPositions.row(v);
+  SkinWeights skin = in.skin;
+  const int n = in.skin.influences;
+  auto pos = [&](uint32_t v) -> Vec3f { return position[v]; };
 
   // Passes: a collapse locks its neighbourhood for the rest of the pass (adjacency is rebuilt between
   // passes), so every decision is made on current topology.
-  for (int pass = 0; pass < 16; ++pass) {
+  for (int pass = 0; pass < 32; ++pass) {
     std::vector<std::vector<uint32_t>> around(nv);  // vertex -> live triangles
     std::unordered_map<uint64_t, int> uses;
     for (uint32_t t = 0; t < tris.size(); ++t) {
@@ -265,22 +270,42 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
       const bool edgeOnBoundary = uses[key] == 1;
       if (boundary[keep] && boundary[gone] && !edgeOnBoundary) continue;  // would pinch the surface
       if (boundary[gone] && !boundary[keep]) std::swap(keep, gone);       // the boundary keeps its shape
+      // Interior pairs meet halfway (half the change to every triangle around them, so far fewer
+      // collapses are refused as flips); a boundary vertex keeps its place, and the hem its shape.
+      const bool midpoint = !boundary[keep] && !boundary[gone];
+      const Vec3f target = midpoint ? Vec3f(0.5f * (pos(keep) + pos(gone))) : pos(keep);
       const std::set<uint32_t> nk = neighbours(keep), ng = neighbours(gone);
       size_t common = 0;
       for (uint32_t u : nk) common += ng.count(u);
       if (common != size_t(uses[key])) continue;  // link condition: else the result is non-manifold
       bool flips = false;
-      for (uint32_t t : around[gone]) {
-        const auto& tri = tris[t];
-        if (std::find(tri.begin(), tri.end(), keep) != tri.end()) continue;  // removed with the edge
-        Vec3f p[3], q[3];
-        for (int k = 0; k < 3; ++k) p[k] = q[k] = pos(tri[size_t(k)]);
-        for (int k = 0; k < 3; ++k)
-          if (tri[size_t(k)] == gone) q[k] = pos(keep);
-        const Vec3f before = (p[1] - p[0]).cross(p[2] - p[0]), after = (q[1] - q[0]).cross(q[2] - q[0]);
-        if (!(before.dot(after) > 0.25f * before.squaredNorm())) flips = true;
-      }
+      for (uint32_t end : {gone, keep})
+        for (uint32_t t : around[end]) {
+          const auto& tri = tris[t];
+          if (std::find(tri.begin(), tri.end(), end == gone ? keep : gone) != tri.end()) continue;  // removed with the edge
+          Vec3f p[3], q[3];
+          for (int k = 0; k < 3; ++k) p[k] = q[k] = pos(tri[size_t(k)]);
+          for (int k = 0; k < 3; ++k)
+            if (tri[size_t(k)] == end) q[k] = target;
+          const Vec3f before = (p[1] - p[0]).cross(p[2] - p[0]), after = (q[1] - q[0]).cross(q[2] - q[0]);
+          if (!(before.dot(after) > 0.25f * before.squaredNorm())) flips = true;
+        }
       if (flips) continue;
+      if (midpoint) {
+        SkinWeights ends;
+        ends.influences = n;
+        for (uint32_t v : {keep, gone})
+          for (int k = 0; k < n; ++k) {
+            ends.joints.push_back(skin.joints[size_t(v) * n + k]);
+            ends.weights.push_back(skin.weights[size_t(v) * n + k]);
+          }
+        SkinWeights blended;
+        blended.influences = n;
+        blendWeights(ends, 0, 1, blended);
+        std::copy(blended.joints.begin(), blended.joints.end(), skin.joints.begin() + std::ptrdiff_t(size_t(keep) * n));
+        std::copy(blended.weights.begin(), blended.weights.end(), skin.weights.begin() + std::ptrdiff_t(size_t(keep) * n));
+        position[keep] = target;
+      }
       for (uint32_t t : around[gone]) {
         auto& tri = tris[t];
         if (std::find(tri.begin(), tri.end(), keep) != tri.end()) deadTri[t] = 1;
@@ -311,14 +336,13 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
   out.refinedEdgeLength = in.refinedEdgeLength;
   out.fromCharacterSimulationMesh = in.fromCharacterSimulationMesh;
   out.skin.influences = in.skin.influences;
-  const int n = in.skin.influences;
   out.restPositions.resize(count, 3);
   for (uint32_t v = 0; v < nv; ++v) {
     if (newIndex[v] == UINT32_MAX) continue;
-    out.restPositions.row(newIndex[v]) = in.restPositions.row(v);
+    out.restPositions.row(newIndex[v]) = position[v].transpose();
     for (int k = 0; k < n; ++k) {
-      out.skin.joints.push_back(in.skin.joints[size_t(v) * n + k]);
-      out.skin.weights.push_back(in.skin.weights[size_t(v) * n + k]);
+      out.skin.joints.push_back(skin.joints[size_t(v) * n + k]);
+      out.skin.weights.push_back(skin.weights[size_t(v) * n + k]);
     }
   }
   size_t live = 0;
@@ -369,7 +393,17 @@ SimulationMesh buildSimulationMesh(const Character& character, size_t targetVert
   SimulationMesh s = weldedSimulationMesh(character.garment, gameToWelded);
   requireManifoldEdges(s.triangles, what);
   s.gameToSim = gameToWelded;
-  if (targetVertices == 0 || s.vertexCount() >= targetVertices) return s;
+  if (targetVertices == 0) return s;
+  if (s.vertexCount() >= targetVertices) {
+    // Fine enough already; still, edges far shorter than the typical one (seams, hems) would be the
+    // stiffest constraints of the solve and the first to fail: collapse them.
+    std::vector<float> lengths;
+    for (Eigen::Index t = 0; t < s.triangles.rows(); ++t)
+      for (int k = 0; k < 3; ++k)
+        lengths.push_back((s.restPositions.row(s.triangles(t, k)) - s.restPositions.row(s.triangles(t, (k + 1) % 3))).norm());
+    std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+    return collapseShortEdges(s, 0.25f * lengths[lengths.size() / 2]);
+  }
   // A mesh of even edges h has about area / (0.43 h^2) vertices (equilateral triangles, two per
   // vertex); bisection leaves edges between h/2 and h, so start there and correct the length by the
   // count it gave until the count is within 10% of the target (a few tries; each takes milliseconds).

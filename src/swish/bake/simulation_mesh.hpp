@@ -33,8 +33,10 @@ constexpr size_t kDefaultSimulationVertices = 12000;
 // Builds the simulation mesh of `character` (validated first: skin weights present, indices in range,
 // every edge shared by at most two triangles). With character.simulationMesh, that mesh is welded and
 // used as is, and each game vertex maps to the nearest simulation vertex. Otherwise the welded game
-// mesh is midpoint-subdivided the number of times that brings its vertex count closest to
-// `targetVertices` (0: no subdivision). Throws Error naming the mesh and the problem.
+// mesh is refined to even edges (refineToEdgeLength, then collapseShortEdges at a quarter of that
+// length) with a vertex count within about 10% of `targetVertices`; a game mesh that already has
+// that many keeps its vertices except edges under a quarter of its median edge, which collapse
+// (0: the welded mesh as is). Throws Error naming the mesh and the problem.
 SimulationMesh buildSimulationMesh(const Character& character,
                                    size_t targetVertices = kDefaultSimulationVertices);
 
@@ -50,11 +52,12 @@ SimulationMesh subdivideMidpoint(const SimulationMesh& mesh);
 // subdivideMidpoint. Old vertices keep their indices (gameToSim is unchanged). Deterministic.
 SimulationMesh refineToEdgeLength(const SimulationMesh& mesh, float maxEdge);
 
-// Removes edges shorter than `minEdge` by collapsing each onto one end point (the boundary one, else
-// the lower index; it keeps its position), where that keeps the surface manifold (link condition)
-// and flips no triangle. Game mesh corners closer than a fraction of a millimetre (armhole seams) would
-// otherwise be cloth edges whose 400% "strain" under a 2 mm contact push dominates every residual.
-// gameToSim follows the merged vertices; rest positions of the kept vertices are unchanged.
+// Removes edges shorter than `minEdge` by collapsing them, where that keeps the surface manifold
+// (link condition) and flips or squashes no triangle: two interior vertices merge at their midpoint
+// (skin weights blended as in subdivideMidpoint), an edge with a boundary end point collapses onto
+// that end point, which keeps its position (hems keep their shape). Game mesh corners closer than a
+// fraction of a millimetre (armhole seams) would otherwise be cloth edges whose 400% "strain" under a
+// 2 mm contact push dominates every residual. gameToSim follows the merged vertices.
 SimulationMesh collapseShortEdges(const SimulationMesh& mesh, float minEdge);
 
 // Welds by exact position and drops unused vertices. Returns, per input vertex, its welded index.
