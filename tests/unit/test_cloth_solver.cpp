@@ -117,6 +117,45 @@ TEST(ClothBodyCollider, SignedDistanceMatchesTheAnalyticCapsule) {
   EXPECT_FALSE(collider.closest(Vec3f(1.f, 0.3f, 0.f), 0.1f).found);  // nothing within reach
 }
 
+TEST(ClothBodyCollider, OverlappingPartsAnswerAsTheirUnion) {
+  // Two capsules (separate closed parts of one body mesh, as a mannequin's arm tube pushed into its
+  // torso) crossing each other: the second one is the first moved by 0.15 m along x, so each has a
+  // wall buried inside the other. The union's signed distance is the smaller of the two exact ones;
+  // the closest triangle of the soup alone would answer with a buried wall and the wrong sign.
+  const test::CapsuleSpec spec;
+  Mesh a = test::capsuleBody(spec), b = a;
+  b.positions.col(0).array() += 0.15f;
+  Mesh body = a;
+  body.positions.resize(a.positions.rows() + b.positions.rows(), 3);
+  body.positions << a.positions, b.positions;
+  body.triangles.resize(a.triangles.rows() + b.triangles.rows(), 3);
+  body.triangles << a.triangles, (b.triangles.array() + uint32_t(a.positions.rows())).matrix();
+  body.skin.influences = a.skin.influences;
+  body.skin.joints = a.skin.joints;
+  body.skin.joints.insert(body.skin.joints.end(), b.skin.joints.begin(), b.skin.joints.end());
+  body.skin.weights = a.skin.weights;
+  body.skin.weights.insert(body.skin.weights.end(), b.skin.weights.begin(), b.skin.weights.end());
+  BodyCollider collider(body, 0.03f);
+  Rng rng(test::testSeed(37));
+  int buriedWallsNear = 0;
+  for (int tested = 0; tested < 400;) {
+    const Vec3f p(rng.uniformf(-0.16f, 0.31f), rng.uniformf(0.1f, 0.6f), rng.uniformf(-0.16f, 0.16f));
+    const float da = test::capsuleSignedDistance(spec, p);
+    const float db = test::capsuleSignedDistance(spec, p - Vec3f(0.15f, 0.f, 0.f));
+    const float exact = std::min(da, db);
+    if (std::abs(exact) > 0.03f) continue;
+    ++tested;
+    // Points where a buried wall is nearer than the union's surface: the case this test is about.
+    buriedWallsNear += std::max(da, db) < 0.f && std::abs(std::max(da, db)) < std::abs(exact);
+    const BodyCollider::Hit hit = collider.closest(p, 0.1f);
+    ASSERT_TRUE(hit.found) << "point " << p.transpose();
+    // Tessellation as in the single capsule test (0.6 mm on the cylinders).
+    EXPECT_NEAR(hit.signedDistance, exact, 2.5e-3f) << "point " << p.transpose();
+    EXPECT_NEAR((hit.point + hit.normal * hit.signedDistance - p).norm(), 0.f, 1e-4f);
+  }
+  EXPECT_GT(buriedWallsNear, 10) << "the sample must include points nearer a buried wall than the union's surface";
+}
+
 TEST(ClothConstraints, ProjectionReducesViolation) {
   const Character ch = test::capsuleCharacter();
   const SimulationMesh sim = buildSimulationMesh(ch, 0);

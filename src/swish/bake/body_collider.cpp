@@ -1,6 +1,7 @@
 #include "swish/bake/body_collider.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -63,6 +64,20 @@ BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& 
       else if (edgeTriangles_[it->second][1] < 0) edgeTriangles_[it->second][1] = int32_t(t);
       triangleEdges_[size_t(t) * 3 + k] = it->second;
     }
+  // Connected parts, by union-find over the triangles' corners.
+  std::vector<uint32_t> parent(size_t(restPositions_.rows()));
+  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
+  auto find = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (Eigen::Index t = 0; t < triangles_.rows(); ++t)
+    for (int k = 1; k < 3; ++k) {
+      const uint32_t a = find(triangles_(t, 0)), b = find(triangles_(t, k));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  triangleComponent_.resize(size_t(triangles_.rows()));
+  for (Eigen::Index t = 0; t < triangles_.rows(); ++t) triangleComponent_[size_t(t)] = find(triangles_(t, 0));
   positions_ = restPositions_;
   rebuild();
 }
@@ -163,9 +178,16 @@ BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance) const
     a[k] = std::clamp(int(std::floor(lo)), 0, gridDims_[k] - 1);
     b[k] = std::clamp(int(std::floor(hi)), 0, gridDims_[k] - 1);
   }
-  float best = maxDistance;
-  int bestTri = -1;
-  ClosestOnTriangle bestPoint{};
+  // The closest triangle of each part met within the ball (a query meets a handful of parts).
+  struct PartBest {
+    uint32_t part;
+    float distance;
+    int tri;
+    ClosestOnTriangle point;
+  };
+  constexpr size_t kMaxParts = 16;
+  std::array<PartBest, kMaxParts> parts;
+  size_t partCount = 0;
   for (int z = a[2]; z <= b[2]; ++z)
     for (int y = a[1]; y <= b[1]; ++y)
       for (int x = a[0]; x <= b[0]; ++x) {
@@ -173,33 +195,58 @@ BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance) const
         for (uint32_t i = cellStart_[c]; i < cellStart_[c + 1]; ++i) {
           const uint32_t t = cellTriangles_[i];
           const Vec4f& s = triangleSpheres_[t];
-          if ((p - s.head<3>()).norm() - s[3] > best) continue;
+          const float lower = (p - s.head<3>()).norm() - s[3];
+          if (lower > maxDistance) continue;
+          const uint32_t part = triangleComponent_[t];
+          size_t slot = 0;
+          while (slot < partCount && parts[slot].part != part) ++slot;
+          if (slot < partCount && lower > parts[slot].distance) continue;
           const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
                                                         positions_.row(triangles_(t, 1)),
                                                         positions_.row(triangles_(t, 2)));
           const float d = (p - q.point).norm();
+          if (!(d <= maxDistance)) continue;
+          if (slot == partCount) {
+            if (partCount == kMaxParts) {
+              // More parts within reach than kept: replace the farthest answer if this is nearer.
+              size_t worst = 0;
+              for (size_t k = 1; k < partCount; ++k)
+                if (parts[k].distance > parts[worst].distance) worst = k;
+              if (!(d < parts[worst].distance)) continue;
+              parts[worst] = {part, d, int(t), q};
+              continue;
+            }
+            parts[partCount++] = {part, d, int(t), q};
+            continue;
+          }
           // Ties (a triangle seen from two cells, or two triangles sharing the closest feature) keep
           // the lowest triangle index, so the answer does not depend on the visiting order.
-          if (d < best || (d == best && int(t) < bestTri)) {
-            best = d;
-            bestTri = int(t);
-            bestPoint = q;
-          }
+          PartBest& pb = parts[slot];
+          if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {part, d, int(t), q};
         }
       }
-  if (bestTri < 0) return hit;
-  Vec3f pseudo;
-  switch (bestPoint.feature) {
-    case Feature::Face: pseudo = faceNormals_[size_t(bestTri)]; break;
-    case Feature::Vertex: pseudo = vertexNormals_[triangles_(bestTri, bestPoint.index)]; break;
-    default: pseudo = edgeNormals_[triangleEdges_[size_t(bestTri) * 3 + bestPoint.index]]; break;
+  if (partCount == 0) return hit;
+  uint32_t bestPart = 0;
+  // Union of the parts: the smallest signed distance wins (ties: the lower part id, deterministic).
+  for (size_t k = 0; k < partCount; ++k) {
+    const PartBest& pb = parts[k];
+    Vec3f pseudo;
+    switch (pb.point.feature) {
+      case Feature::Face: pseudo = faceNormals_[size_t(pb.tri)]; break;
+      case Feature::Vertex: pseudo = vertexNormals_[triangles_(pb.tri, pb.point.index)]; break;
+      default: pseudo = edgeNormals_[triangleEdges_[size_t(pb.tri) * 3 + pb.point.index]]; break;
+    }
+    const Vec3f diff = p - pb.point.point;
+    const float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
+    const float sd = sign * pb.distance;
+    if (hit.found && (sd > hit.signedDistance || (sd == hit.signedDistance && pb.part > bestPart))) continue;
+    hit.found = true;
+    hit.signedDistance = sd;
+    hit.point = pb.point.point;
+    hit.triangle = pb.tri;
+    hit.normal = pb.distance > 1e-7f ? Vec3f(sign * diff / pb.distance) : pseudo;
+    bestPart = pb.part;
   }
-  const Vec3f diff = p - bestPoint.point;
-  const float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
-  hit.found = true;
-  hit.signedDistance = sign * best;
-  hit.point = bestPoint.point;
-  hit.normal = best > 1e-7f ? Vec3f(sign * diff / best) : pseudo;
   return hit;
 }
 

@@ -3,6 +3,12 @@
 // surface. Signs come from angle-weighted pseudo-normals (Baerentzen & Aanaes 2005), which are exact
 // for closed manifold meshes whatever feature (face, edge, vertex) is closest. Triangles are binned in
 // a uniform grid rebuilt at every pose; queries visit only the cells that overlap their search ball.
+//
+// A body made of several closed parts that overlap (a mannequin's arm tubes pushed into its torso) is
+// the union of the parts: the signed distance is the smallest of the parts' own signed distances, each
+// part answered by its own closest triangle. Taking the single closest triangle of the whole soup
+// instead would answer, in an armpit, with the arm tube's buried wall inside the torso, whose normal
+// points the wrong way, and push the cloth into the body.
 #include <string>
 #include <vector>
 
@@ -17,6 +23,7 @@ class BodyCollider {
     float signedDistance = 0.f;  // > 0 outside the body, < 0 inside
     Vec3f point = Vec3f::Zero();   // closest point on the surface
     Vec3f normal = Vec3f::Zero();  // unit, pointing out of the body at `point`
+    int triangle = -1;  // the body triangle `point` lies on
   };
 
   // `body`: rest positions, triangles, skin weights (validated, naming `what`). `cellSize`: grid
@@ -33,6 +40,7 @@ class BodyCollider {
 
   const Points3f& positions() const { return positions_; }
   size_t triangleCount() const { return size_t(triangles_.rows()); }
+  const Triangles& triangles() const { return triangles_; }
 
  private:
   void rebuild();
@@ -42,6 +50,7 @@ class BodyCollider {
   SkinWeights skin_;
   std::vector<uint32_t> triangleEdges_;  // 3 per triangle: edge index of sides ab, bc, ca
   std::vector<std::array<int32_t, 2>> edgeTriangles_;  // up to two triangles per edge (-1: none)
+  std::vector<uint32_t> triangleComponent_;  // connected part (by shared vertices) of each triangle
   float cellSize_;
 
   Points3f positions_;
