@@ -36,6 +36,23 @@ Vec3f garmentCentre(const SimulationMesh& mesh) {
   return 0.5f * (lo + hi);
 }
 
+// An orthonormal frame of a triangle: its first edge, the normal crossed with it, the normal.
+Mat3f triangleFrame(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const Vec3f e = (b - a).normalized(), n = (b - a).cross(c - a).normalized();
+  Mat3f f;
+  f << e, n.cross(e), n;
+  return f;
+}
+
+Vec3f barycentricOf(const Vec3f& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const Vec3f v0 = b - a, v1 = c - a, v2 = p - a;
+  const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
+  const float den = d00 * d11 - d01 * d01;
+  if (!(std::abs(den) > 0.f)) return Vec3f(1.f, 0.f, 0.f);
+  const float v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+  return Vec3f(1.f - v - w, v, w);
+}
+
 Mesh shiftedBody(const Character& ch, const Vec3f& origin) {
   Mesh body = ch.body;
   body.validate("body of character '" + ch.name + "'", ch.skeleton.size());
@@ -89,6 +106,12 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
 
   restLocal_ = mesh_.restPositions.rowwise() - origin_.transpose();
   constraints_ = buildClothConstraints(mesh_, restLocal_, settings_.material);
+  if (!constraints_.stretch.empty()) {
+    std::vector<float> rest;
+    for (const DistanceConstraint& c : constraints_.stretch) rest.push_back(c.rest);
+    std::nth_element(rest.begin(), rest.begin() + std::ptrdiff_t(rest.size() / 2), rest.end());
+    shortEdgeFloor_ = 0.5f * rest[rest.size() / 2];
+  }
 
   // The top band (collar and shoulders of a shirt) hangs on the body: attach it softly to skinning.
   const float top = restLocal_.col(1).maxCoeff(), bottom = restLocal_.col(1).minCoeff();
@@ -111,6 +134,22 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
 
   // A garment that starts inside the body cannot be simulated meaningfully: say so up front.
   colliderPrototype_.pose(localSkinMatrices(skeleton_.restPose()));
+  for (uint32_t v : attached_) {
+    BodyAnchor anchor;
+    const Vec3f p = restLocal_.row(v);
+    const BodyCollider::Hit hit = colliderPrototype_.closest(p, 0.1f);
+    if (hit.found && hit.triangle >= 0) {
+      const Points3f& b = colliderPrototype_.positions();
+      const auto& t = colliderPrototype_.triangles().row(hit.triangle);
+      const Vec3f a0 = b.row(t(0)), a1 = b.row(t(1)), a2 = b.row(t(2));
+      if ((a1 - a0).cross(a2 - a0).norm() > 0.f) {
+        anchor.triangle = hit.triangle;
+        anchor.barycentric = barycentricOf(hit.point, a0, a1, a2);
+        anchor.offset = triangleFrame(a0, a1, a2).transpose() * (p - hit.point);
+      }
+    }
+    anchors_.push_back(anchor);
+  }
   float worst = 0.f;
   uint32_t worstVertex = 0;
   for (uint32_t v = 0; v < mesh_.vertexCount(); ++v) {
@@ -237,7 +276,15 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     }
     for (size_t a = 0; a < attached_.size(); ++a) {
       const uint32_t v = attached_[a];
-      attachTarget[a] = blendNew[v].leftCols<3>() * restLocal_.row(v).transpose() + blendNew[v].col(3);
+      const BodyAnchor& anchor = anchors_[a];
+      if (anchor.triangle < 0) {
+        attachTarget[a] = blendNew[v].leftCols<3>() * restLocal_.row(v).transpose() + blendNew[v].col(3);
+        continue;
+      }
+      const auto& t = body.triangles().row(anchor.triangle);
+      const Vec3f a0 = body.positions().row(t(0)), a1 = body.positions().row(t(1)), a2 = body.positions().row(t(2));
+      attachTarget[a] = anchor.barycentric.x() * a0 + anchor.barycentric.y() * a1 + anchor.barycentric.z() * a2 +
+                        triangleFrame(a0, a1, a2) * anchor.offset;
     }
 
     float frameSpeed = 0.f;
@@ -291,7 +338,7 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     if (!x.allFinite()) return fail("the solve produced non-finite positions at frame " + std::to_string(frame));
     float stretch = 0.f;
     for (const DistanceConstraint& c : cc.stretch)
-      stretch = std::max(stretch, ((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
+      stretch = std::max(stretch, ((x.row(c.i) - x.row(c.j)).norm() - c.rest) / std::max(c.rest, shortEdgeFloor_));
     if (stretch > s.failStrain)
       return fail("the solve exploded at frame " + std::to_string(frame) + ": an edge stretched by " +
                   std::to_string(100.f * stretch) + "%");

@@ -43,7 +43,8 @@ struct ClothSimSettings {
   float convergedSpeed = 0.05f;      // m/s: the fastest vertex in the last frame, to count as settled
   float convergedStrain = 0.25f;     // worst edge strain to count as converged
   float failPenetration = 0.01f;     // m inside the thick surface: the pose fails beyond this
-  float failStrain = 1.0f;           // worst edge strain beyond which the solve has exploded
+  float failStrain = 1.0f;           // worst edge stretch beyond which the solve has exploded, relative
+                                     // to the edge's rest length or half the median one if longer
 
   // Throws Error naming the field that is out of range.
   void validate() const;
@@ -88,6 +89,20 @@ class ClothSolver {
   ClothConstraints constraints_;
   std::vector<uint32_t> attached_;
   std::vector<float> attachCompliance_;  // per attached vertex: 1 / its share of the band's stiffness
+  // Where each attached vertex sits relative to the body in the rest pose: its closest body triangle
+  // and the offset in that triangle's frame. The band follows the posed body surface, not the
+  // garment's own skinning, which disagrees with the body's (different weights) and put shoulder
+  // targets a centimetre inside the body, to be fought over by the attachment and the contacts.
+  struct BodyAnchor {
+    int triangle = -1;           // -1: no body within reach; the vertex follows its own skinning
+    Vec3f barycentric = Vec3f::Zero();
+    Vec3f offset = Vec3f::Zero();  // in the triangle's (edge, normal x edge, normal) frame
+  };
+  std::vector<BodyAnchor> anchors_;
+  // Half the median rest edge: the explosion test measures an edge's stretch relative to at least
+  // this. A 1 mm edge moved 2 mm by a contact push reads as 200% relative to itself, yet it is
+  // nothing like an explosion; what is, is a typical edge doubling.
+  float shortEdgeFloor_ = 0.f;
   std::vector<Tether> tethers_;
   BodyCollider colliderPrototype_;
   uint64_t fingerprint_ = 0;
