@@ -7,20 +7,34 @@
 
 #include "swish/bake/bake_config.hpp"
 #include "swish/bake/bake_pipeline.hpp"
+#include "swish/bake/default_character.hpp"
+#include "swish/io/gltf_export.hpp"
 #include "swish/command.hpp"
 
 namespace {
 
 swish::cli::RunFn setup(CLI::App& sub) {
   struct Opts {
-    std::string config;
+    std::string config, defaultCharacterGlb;
     bool force = false, checkOnly = false;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("config", o->config, "bake recipe (JSON)")->required();
+  sub.add_option("config", o->config, "bake recipe (JSON)");
+  sub.add_option("--write-default-character", o->defaultCharacterGlb,
+                 "write the embedded default character (mannequin + jersey, skinned) to a .glb file to look at "
+                 "or to use as a starting point, and stop (regenerates assets/default/default_character.glb)");
   sub.add_flag("--force", o->force, "re-train part 2 even when the model is current");
   sub.add_flag("--check", o->checkOnly, "validate the config and stop");
   return [o]() -> int {
+    if (!o->defaultCharacterGlb.empty()) {
+      swish::io::writeCharacterGlb(o->defaultCharacterGlb, swish::bake::makeDefaultCharacter());
+      std::printf("wrote the default character to %s\n", o->defaultCharacterGlb.c_str());
+      return 0;
+    }
+    if (o->config.empty()) {
+      std::fprintf(stderr, "swish bake: give a bake recipe (JSON), e.g. 'swish bake assets/default/bake.json'; see --help\n");
+      return 2;
+    }
     const swish::bake::BakeConfig cfg = swish::bake::loadBakeConfig(o->config);
     if (o->checkOnly) {
       std::printf("%s: valid; model -> %s, report -> %s\n", o->config.c_str(), cfg.modelPath().string().c_str(),
