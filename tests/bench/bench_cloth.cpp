@@ -6,6 +6,8 @@
 // subdivided to ~12.9k) when present, and always the capsule torso with a 3,000-vertex tube.
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -43,6 +45,7 @@ void runPoses(benchmark::State& state, const Character& ch) {
   for (auto _ : state) {
     const PoseSimulation r = solver.simulate(poses[i++ % poses.size()]);
     failed += !r.ok;
+    if (!r.ok && std::getenv("SWISH_BENCH_VERBOSE")) std::fprintf(stderr, "pose failed: %s\n", r.failure.c_str());
     penetration = std::max(penetration, double(r.residuals.maxPenetration));
     violation = std::max(violation, double(r.residuals.maxConstraintViolation));
   }
