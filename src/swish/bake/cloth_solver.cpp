@@ -162,6 +162,9 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
                 " m below the body surface in the rest pose");
 
   Fnv f;
+  // The solver's own revision: results of an older solver are never resumed into a new run.
+  // 2: body-anchored top band, union-of-parts collider, explosion test against the median edge.
+  f.value(uint32_t(2));
   f.matrix(mesh_.restPositions);
   f.matrix(mesh_.triangles);
   f.vec(mesh_.skin.joints);
@@ -283,6 +286,10 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
       }
       const auto& t = body.triangles().row(anchor.triangle);
       const Vec3f a0 = body.positions().row(t(0)), a1 = body.positions().row(t(1)), a2 = body.positions().row(t(2));
+      if (!((a1 - a0).cross(a2 - a0).norm() > 0.f) || !((a1 - a0).norm() > 0.f)) {  // skinning collapsed it
+        attachTarget[a] = blendNew[v].leftCols<3>() * restLocal_.row(v).transpose() + blendNew[v].col(3);
+        continue;
+      }
       attachTarget[a] = anchor.barycentric.x() * a0 + anchor.barycentric.y() * a1 + anchor.barycentric.z() * a2 +
                         triangleFrame(a0, a1, a2) * anchor.offset;
     }
