@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "swish/bake/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rotation.hpp"
 #include "swish/core/skinning.hpp"
@@ -36,21 +37,14 @@ Vec3f garmentCentre(const SimulationMesh& mesh) {
   return 0.5f * (lo + hi);
 }
 
-// An orthonormal frame of a triangle: its first edge, the normal crossed with it, the normal.
-Mat3f triangleFrame(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
-  const Vec3f e = (b - a).normalized(), n = (b - a).cross(c - a).normalized();
-  Mat3f f;
-  f << e, n.cross(e), n;
-  return f;
-}
-
-Vec3f barycentricOf(const Vec3f& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
-  const Vec3f v0 = b - a, v1 = c - a, v2 = p - a;
-  const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
-  const float den = d00 * d11 - d01 * d01;
-  if (!(std::abs(den) > 0.f)) return Vec3f(1.f, 0.f, 0.f);
-  const float v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
-  return Vec3f(1.f - v - w, v, w);
+// An orthonormal frame of a triangle: its first edge, the normal crossed with it, the normal; false
+// for a triangle without area (none at rest, or one that skinning collapsed).
+bool triangleFrame(const Vec3f& a, const Vec3f& b, const Vec3f& c, Mat3f& frame) {
+  const Vec3f n = (b - a).cross(c - a);
+  if (!(n.norm() > 0.f)) return false;
+  const Vec3f e = (b - a).normalized(), nn = n.normalized();
+  frame << e, nn.cross(e), nn;
+  return true;
 }
 
 Mesh shiftedBody(const Character& ch, const Vec3f& origin) {
@@ -138,14 +132,15 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
     BodyAnchor anchor;
     const Vec3f p = restLocal_.row(v);
     const BodyCollider::Hit hit = colliderPrototype_.closest(p, 0.1f);
-    if (hit.found && hit.triangle >= 0) {
-      const Points3f& b = colliderPrototype_.positions();
+    Mat3f frame;
+    if (hit.found) {
       const auto& t = colliderPrototype_.triangles().row(hit.triangle);
+      const Points3f& b = colliderPrototype_.positions();
       const Vec3f a0 = b.row(t(0)), a1 = b.row(t(1)), a2 = b.row(t(2));
-      if ((a1 - a0).cross(a2 - a0).norm() > 0.f) {
+      if (triangleFrame(a0, a1, a2, frame)) {
         anchor.triangle = hit.triangle;
-        anchor.barycentric = barycentricOf(hit.point, a0, a1, a2);
-        anchor.offset = triangleFrame(a0, a1, a2).transpose() * (p - hit.point);
+        anchor.uv = closestPointOnTriangle(p, a0, a1, a2);
+        anchor.offset = frame.transpose() * (p - hit.point);
       }
     }
     anchors_.push_back(anchor);
@@ -197,6 +192,17 @@ std::vector<Mat4f> ClothSolver::localSkinMatrices(const Pose& pose) const {
   std::vector<Mat4f> m = skeleton_.skinningMatrices(pose);
   for (Mat4f& x : m) x.topRightCorner<3, 1>() += x.topLeftCorner<3, 3>() * origin_ - origin_;
   return m;
+}
+
+bool ClothSolver::anchorTarget(const BodyAnchor& anchor, const BodyCollider& body, Vec3f& target) const {
+  if (anchor.triangle < 0) return false;
+  const auto& t = body.triangles().row(anchor.triangle);
+  const Vec3f a0 = body.positions().row(t(0)), a1 = body.positions().row(t(1)), a2 = body.positions().row(t(2));
+  Mat3f frame;
+  if (!triangleFrame(a0, a1, a2, frame)) return false;
+  const float u = anchor.uv.x(), v = anchor.uv.y();
+  target = (1.f - u - v) * a0 + u * a1 + v * a2 + frame * anchor.offset;
+  return true;
 }
 
 float ClothSolver::penetrationOf(const BodyCollider& body, const Vec3f& p) const {
@@ -279,19 +285,8 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     }
     for (size_t a = 0; a < attached_.size(); ++a) {
       const uint32_t v = attached_[a];
-      const BodyAnchor& anchor = anchors_[a];
-      if (anchor.triangle < 0) {
+      if (!anchorTarget(anchors_[a], body, attachTarget[a]))  // no body near, or skinning collapsed it
         attachTarget[a] = blendNew[v].leftCols<3>() * restLocal_.row(v).transpose() + blendNew[v].col(3);
-        continue;
-      }
-      const auto& t = body.triangles().row(anchor.triangle);
-      const Vec3f a0 = body.positions().row(t(0)), a1 = body.positions().row(t(1)), a2 = body.positions().row(t(2));
-      if (!((a1 - a0).cross(a2 - a0).norm() > 0.f) || !((a1 - a0).norm() > 0.f)) {  // skinning collapsed it
-        attachTarget[a] = blendNew[v].leftCols<3>() * restLocal_.row(v).transpose() + blendNew[v].col(3);
-        continue;
-      }
-      attachTarget[a] = anchor.barycentric.x() * a0 + anchor.barycentric.y() * a1 + anchor.barycentric.z() * a2 +
-                        triangleFrame(a0, a1, a2) * anchor.offset;
     }
 
     float frameSpeed = 0.f;

@@ -80,6 +80,9 @@ class ClothSolver {
  private:
   std::vector<Mat4f> localSkinMatrices(const Pose& pose) const;
   float penetrationOf(const BodyCollider& body, const Vec3f& p) const;
+  struct BodyAnchor;
+  // Where an anchored vertex belongs on the posed body; false when it follows its own skinning.
+  bool anchorTarget(const BodyAnchor& anchor, const BodyCollider& body, Vec3f& target) const;
 
   Skeleton skeleton_;
   SimulationMesh mesh_;
@@ -94,8 +97,8 @@ class ClothSolver {
   // garment's own skinning, which disagrees with the body's (different weights) and put shoulder
   // targets a centimetre inside the body, to be fought over by the attachment and the contacts.
   struct BodyAnchor {
-    int triangle = -1;           // -1: no body within reach; the vertex follows its own skinning
-    Vec3f barycentric = Vec3f::Zero();
+    int triangle = -1;             // -1: no body within reach; the vertex follows its own skinning
+    Vec2f uv = Vec2f::Zero();      // barycentrics of the triangle's corners 1 and 2
     Vec3f offset = Vec3f::Zero();  // in the triangle's (edge, normal x edge, normal) frame
   };
   std::vector<BodyAnchor> anchors_;
