@@ -89,14 +89,6 @@ void BodyCollider::pose(const std::vector<Mat4f>& skinMatrices) {
   rebuild();
 }
 
-void BodyCollider::setPositions(const Points3f& positions) {
-  if (positions.rows() != restPositions_.rows())
-    throw Error("body collider: " + std::to_string(positions.rows()) + " positions for a body of " +
-                std::to_string(restPositions_.rows()) + " vertices");
-  positions_ = positions;
-  rebuild();
-}
-
 void BodyCollider::rebuild() {
   const size_t nt = size_t(triangles_.rows()), nv = size_t(positions_.rows());
   if (!positions_.allFinite()) throw Error("body collider: posed body has non-finite positions");

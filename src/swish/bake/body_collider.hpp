@@ -32,14 +32,11 @@ class BodyCollider {
 
   // Poses the body by linear blend skinning and rebuilds normals and the grid.
   void pose(const std::vector<Mat4f>& skinMatrices);
-  // Places the body at explicit positions (same vertex count) and rebuilds: for analytic test shapes.
-  void setPositions(const Points3f& positions);
 
   // Closest surface point to p within maxDistance (metres). Thread-safe (const, no scratch state).
   Hit closest(const Vec3f& p, float maxDistance) const;
 
   const Points3f& positions() const { return positions_; }
-  size_t triangleCount() const { return size_t(triangles_.rows()); }
   const Triangles& triangles() const { return triangles_; }
 
  private:

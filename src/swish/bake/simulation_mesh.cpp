@@ -90,52 +90,12 @@ SimulationMesh weldedSimulationMesh(const Mesh& mesh, std::vector<uint32_t>& inp
   return s;
 }
 
-SimulationMesh subdivideMidpoint(const SimulationMesh& in) {
-  SimulationMesh out;
-  out.gameToSim = in.gameToSim;
-  out.subdivisionLevels = in.subdivisionLevels + 1;
-  out.fromCharacterSimulationMesh = in.fromCharacterSimulationMesh;
-  out.skin.influences = in.skin.influences;
-  out.skin.joints = in.skin.joints;
-  out.skin.weights = in.skin.weights;
-
-  // Midpoints numbered in first-visit order over the triangles: deterministic.
-  std::unordered_map<uint64_t, uint32_t> midpoint;
-  midpoint.reserve(size_t(in.triangles.rows()) * 2);
-  std::vector<std::pair<uint32_t, uint32_t>> newEdges;
-  const uint32_t base = uint32_t(in.vertexCount());
-  auto mid = [&](uint32_t a, uint32_t b) {
-    auto [it, inserted] = midpoint.try_emplace(edgeKey(a, b), base + uint32_t(newEdges.size()));
-    if (inserted) newEdges.push_back({a, b});
-    return it->second;
-  };
-  out.triangles.resize(in.triangles.rows() * 4, 3);
-  for (Eigen::Index t = 0; t < in.triangles.rows(); ++t) {
-    const uint32_t a = in.triangles(t, 0), b = in.triangles(t, 1), c = in.triangles(t, 2);
-    const uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
-    out.triangles.row(4 * t + 0) << a, ab, ca;
-    out.triangles.row(4 * t + 1) << ab, b, bc;
-    out.triangles.row(4 * t + 2) << ca, bc, c;
-    out.triangles.row(4 * t + 3) << ab, bc, ca;
-  }
-  out.restPositions.resize(base + newEdges.size(), 3);
-  out.restPositions.topRows(base) = in.restPositions;
-  for (size_t e = 0; e < newEdges.size(); ++e) {
-    out.restPositions.row(base + e) =
-        0.5f * (in.restPositions.row(newEdges[e].first) + in.restPositions.row(newEdges[e].second));
-    blendWeights(in.skin, newEdges[e].first, newEdges[e].second, out.skin);
-  }
-  return out;
-}
-
 SimulationMesh refineToEdgeLength(const SimulationMesh& in, float maxEdge) {
   if (!std::isfinite(maxEdge) || !(maxEdge > 0.f))
     throw Error("simulation mesh refinement: the longest edge allowed must be finite and positive, got " +
                 std::to_string(maxEdge));
   SimulationMesh out;
   out.gameToSim = in.gameToSim;
-  out.subdivisionLevels = in.subdivisionLevels;
-  out.fromCharacterSimulationMesh = in.fromCharacterSimulationMesh;
   out.refinedEdgeLength = maxEdge;
   out.skin = in.skin;
   const int n = in.skin.influences;
@@ -292,16 +252,9 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
         }
       if (flips) continue;
       if (midpoint) {
-        SkinWeights ends;
-        ends.influences = n;
-        for (uint32_t v : {keep, gone})
-          for (int k = 0; k < n; ++k) {
-            ends.joints.push_back(skin.joints[size_t(v) * n + k]);
-            ends.weights.push_back(skin.weights[size_t(v) * n + k]);
-          }
         SkinWeights blended;
         blended.influences = n;
-        blendWeights(ends, 0, 1, blended);
+        blendWeights(skin, keep, gone, blended);
         std::copy(blended.joints.begin(), blended.joints.end(), skin.joints.begin() + std::ptrdiff_t(size_t(keep) * n));
         std::copy(blended.weights.begin(), blended.weights.end(), skin.weights.begin() + std::ptrdiff_t(size_t(keep) * n));
         position[keep] = target;
@@ -332,9 +285,7 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
   for (uint32_t v = 0; v < nv; ++v)
     if (mergedInto[v] == v) newIndex[v] = count++;
   SimulationMesh out;
-  out.subdivisionLevels = in.subdivisionLevels;
   out.refinedEdgeLength = in.refinedEdgeLength;
-  out.fromCharacterSimulationMesh = in.fromCharacterSimulationMesh;
   out.skin.influences = in.skin.influences;
   out.restPositions.resize(count, 3);
   for (uint32_t v = 0; v < nv; ++v) {
@@ -378,7 +329,6 @@ SimulationMesh buildSimulationMesh(const Character& character, size_t targetVert
     std::vector<uint32_t> simToWelded;
     SimulationMesh s = weldedSimulationMesh(m, simToWelded);
     requireManifoldEdges(s.triangles, simWhat);
-    s.fromCharacterSimulationMesh = true;
     // Nearest simulation vertex per game vertex. Brute force: a few thousand by ~10^4, done once.
     s.gameToSim.resize(character.garment.vertexCount());
     for (size_t g = 0; g < s.gameToSim.size(); ++g) {

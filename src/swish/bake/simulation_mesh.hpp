@@ -21,9 +21,7 @@ struct SimulationMesh {
   // Game-mesh vertex -> simulation vertex at its rest position (within a quarter of the refined edge
   // length of it where collapseShortEdges merged it into a neighbour).
   std::vector<uint32_t> gameToSim;
-  int subdivisionLevels = 0;           // midpoint levels applied (subdivideMidpoint only)
   float refinedEdgeLength = 0.f;       // m: longest edge allowed by refineToEdgeLength (0: not refined)
-  bool fromCharacterSimulationMesh = false;
 
   size_t vertexCount() const { return size_t(restPositions.rows()); }
 };
@@ -40,21 +38,16 @@ constexpr size_t kDefaultSimulationVertices = 12000;
 SimulationMesh buildSimulationMesh(const Character& character,
                                    size_t targetVertices = kDefaultSimulationVertices);
 
-// One level of midpoint (1 -> 4) subdivision. New vertices sit at edge midpoints (the rest shape is
-// kept exactly, so a garment that clears the body keeps clearing it up to the chord sag), with the
-// two end points' skin weights averaged, cut back to the mesh's influence count and renormalised.
-// gameToSim is unchanged (old vertices keep their indices).
-SimulationMesh subdivideMidpoint(const SimulationMesh& mesh);
-
 // Longest-edge bisection (Rivara): splits, longest first, every edge longer than `maxEdge` at its
 // midpoint, together with the one or two triangles on it, until none is left. New vertices sit at
-// edge midpoints (the rest shape is kept exactly) with the two end points' skin weights blended as in
-// subdivideMidpoint. Old vertices keep their indices (gameToSim is unchanged). Deterministic.
+// edge midpoints (the rest shape is kept exactly) with the two end points' skin weights averaged, cut
+// back to the mesh's influence count and renormalised. Old vertices keep their indices (gameToSim is
+// unchanged). Deterministic.
 SimulationMesh refineToEdgeLength(const SimulationMesh& mesh, float maxEdge);
 
 // Removes edges shorter than `minEdge` by collapsing them, where that keeps the surface manifold
 // (link condition) and flips or squashes no triangle: two interior vertices merge at their midpoint
-// (skin weights blended as in subdivideMidpoint), an edge with a boundary end point collapses onto
+// (skin weights averaged as in refineToEdgeLength), an edge with a boundary end point collapses onto
 // that end point, which keeps its position (hems keep their shape). Game mesh corners closer than a
 // fraction of a millimetre (armhole seams) would otherwise be cloth edges whose 400% "strain" under a
 // 2 mm contact push dominates every residual. gameToSim follows the merged vertices.
