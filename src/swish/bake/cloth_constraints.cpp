@@ -93,17 +93,7 @@ ClothConstraints buildClothConstraints(const SimulationMesh& mesh, const Points3
 std::vector<Tether> buildTethers(const SimulationMesh& mesh, const Points3f& x,
                                  const std::vector<uint32_t>& attached) {
   const size_t nv = size_t(x.rows());
-  std::vector<std::vector<uint32_t>> neighbours(nv);
-  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = mesh.triangles(t, k), b = mesh.triangles(t, (k + 1) % 3);
-      neighbours[a].push_back(b);
-      neighbours[b].push_back(a);
-    }
-  for (auto& n : neighbours) {
-    std::sort(n.begin(), n.end());
-    n.erase(std::unique(n.begin(), n.end()), n.end());
-  }
+  const std::vector<std::vector<uint32_t>> neighbours = buildVertexNeighbours(mesh.triangles, nv);
   std::vector<double> dist(nv, std::numeric_limits<double>::infinity());
   std::vector<uint32_t> anchor(nv, UINT32_MAX);
   using Item = std::pair<double, uint32_t>;

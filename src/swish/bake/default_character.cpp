@@ -262,17 +262,8 @@ Character makeDefaultCharacter(const DefaultCharacterRecipe& recipe) {
   // seam get the same weights): each sweep moves a vertex halfway to its neighbours' mean.
   {
     const std::vector<uint32_t> rep = weldByPosition(c.garment.positions);
-    std::vector<std::vector<uint32_t>> neighbours(garmentWeights.size());
-    for (Eigen::Index t = 0; t < c.garment.triangles.rows(); ++t)
-      for (int e = 0; e < 3; ++e) {
-        const uint32_t a = rep[c.garment.triangles(t, e)], b = rep[c.garment.triangles(t, (e + 1) % 3)];
-        neighbours[a].push_back(b);
-        neighbours[b].push_back(a);
-      }
-    for (auto& n : neighbours) {
-      std::sort(n.begin(), n.end());
-      n.erase(std::unique(n.begin(), n.end()), n.end());
-    }
+    const std::vector<std::vector<uint32_t>> neighbours =
+        buildVertexNeighbours(c.garment.triangles, garmentWeights.size(), &rep);
     for (size_t g = 0; g < garmentWeights.size(); ++g) {  // one normalised map per welded vertex
       float total = 0.f;
       for (auto& [j, x] : garmentWeights[g]) total += x;

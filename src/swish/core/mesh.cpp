@@ -1,5 +1,6 @@
 #include "swish/core/mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -64,6 +65,23 @@ std::vector<uint32_t> weldByPosition(const Points3f& p) {
     weld[size_t(i)] = it->second;
   }
   return weld;
+}
+
+std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, size_t n,
+                                                         const std::vector<uint32_t>* weld) {
+  auto rep = [&](uint32_t v) { return weld ? (*weld)[v] : v; };
+  std::vector<std::vector<uint32_t>> neighbours(n);
+  for (Eigen::Index t = 0; t < tris.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = rep(tris(t, k)), b = rep(tris(t, (k + 1) % 3));
+      neighbours[a].push_back(b);
+      neighbours[b].push_back(a);
+    }
+  for (auto& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
 }
 
 VertexTriangleAdjacency buildVertexTriangleAdjacency(const Triangles& tris, size_t n,

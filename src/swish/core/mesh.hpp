@@ -46,4 +46,10 @@ struct VertexTriangleAdjacency {
 VertexTriangleAdjacency buildVertexTriangleAdjacency(const Triangles& tris, size_t vertexCount,
                                                      const std::vector<uint32_t>* weld = nullptr);
 
+// Vertex -> the vertices it shares a triangle edge with, ascending, without repeats. With `weld` (from
+// weldByPosition) both ends of every edge are mapped to their representatives first: the lists of the
+// representatives hold representatives, and every other vertex's list is empty.
+std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, size_t vertexCount,
+                                                         const std::vector<uint32_t>* weld = nullptr);
+
 }  // namespace swish
