@@ -7,6 +7,7 @@
 
 #include "swish/bake/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/hash.hpp"
 #include "swish/core/rotation.hpp"
 #include "swish/core/skinning.hpp"
 
@@ -15,21 +16,6 @@ namespace {
 
 using Affine34 = Eigen::Matrix<float, 3, 4>;
 using V3 = Eigen::Map<Vec3f>;
-
-// FNV-1a over raw bytes: the fingerprint of a setup (not cryptographic; it only tells setups apart).
-struct Fnv {
-  uint64_t h = 1469598103934665603ull;
-  void bytes(const void* p, size_t n) {
-    const auto* c = static_cast<const uint8_t*>(p);
-    for (size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
-  }
-  template <class T>
-  void value(const T& v) { bytes(&v, sizeof v); }
-  template <class M>
-  void matrix(const M& m) { bytes(m.data(), size_t(m.size()) * sizeof(typename M::Scalar)); }
-  template <class T>
-  void vec(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
-};
 
 Vec3f garmentCentre(const SimulationMesh& mesh) {
   if (mesh.vertexCount() == 0) return Vec3f::Zero();
@@ -156,7 +142,7 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
                 std::to_string(worstVertex) + " is " + std::to_string(worst - settings_.thickness) +
                 " m below the body surface in the rest pose");
 
-  Fnv f;
+  Fnv1a f;
   // The solver's own revision: results of an older solver are never resumed into a new run.
   // 2: body-anchored top band, union-of-parts collider, explosion test against the median edge.
   f.value(uint32_t(2));

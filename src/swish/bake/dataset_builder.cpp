@@ -15,6 +15,7 @@
 #include "swish/bake/pose_simulation.hpp"
 #include "swish/bake/pose_thinning.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/hash.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/io/character_import.hpp"
 #include "swish/model/atomic_write.hpp"
@@ -71,16 +72,12 @@ Pose canonicalPose(const Skeleton& skeleton, Pose p) {
 
 // A digest of the thinned pose list: a different list means different pose ids.
 uint64_t poseListDigest(const std::vector<Pose>& poses) {
-  uint64_t h = 1469598103934665603ull;
-  auto mix = [&](const void* data, size_t n) {
-    const auto* b = static_cast<const uint8_t*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-  };
+  Fnv1a f;
   for (const Pose& p : poses) {
-    mix(p.local.data(), p.local.size() * sizeof(Quatf));
-    mix(p.rootTranslation.data(), sizeof(float) * 3);
+    f.vec(p.local);
+    f.matrix(p.rootTranslation);
   }
-  return h;
+  return f.h;
 }
 
 // Deletes the dataset's pose files when they were made with other settings; returns true if it did.

@@ -9,18 +9,15 @@
 #include <tbb/task_arena.h>
 
 #include "swish/core/error.hpp"
+#include "swish/core/hash.hpp"
 
 namespace swish::bake {
 
 uint64_t poseFingerprint(const ClothSolver& solver, const Pose& pose) {
-  uint64_t h = solver.fingerprint() ^ 0x9E3779B97F4A7C15ull;
-  auto mix = [&](const void* p, size_t n) {
-    const auto* c = static_cast<const uint8_t*>(p);
-    for (size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
-  };
-  for (const Quatf& q : pose.local) mix(q.coeffs().data(), 4 * sizeof(float));
+  Fnv1a f(solver.fingerprint() ^ 0x9E3779B97F4A7C15ull);
+  for (const Quatf& q : pose.local) f.matrix(q.coeffs());
   // The root translation is ignored by the solve, so it is not part of the fingerprint.
-  return h;
+  return f.h;
 }
 
 std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path& dir, uint32_t poseId,

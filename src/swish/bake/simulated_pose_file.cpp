@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "swish/core/error.hpp"
+#include "swish/core/hash.hpp"
 #include "swish/model/atomic_write.hpp"
 
 namespace swish::bake {
@@ -15,12 +16,6 @@ namespace {
 constexpr char kMagic[8] = {'S', 'W', 'C', 'L', 'O', 'T', 'H', '1'};
 constexpr uint32_t kVersion = 1;
 constexpr uint32_t kMaxVertices = 50'000'000;
-
-uint64_t fnv1a(const uint8_t* p, size_t n) {
-  uint64_t h = 1469598103934665603ull;
-  for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-  return h;
-}
 
 template <class T>
 void put(std::vector<uint8_t>& out, const T& v) {
