@@ -6,6 +6,7 @@
 #include <set>
 
 #include "swish/core/error.hpp"
+#include "swish/core/skeleton.hpp"
 
 namespace swish::bake {
 namespace {
@@ -149,14 +150,6 @@ Vec3f vec3(const nlohmann::json& j, const char* key, const std::string& what) {
 }
 
 }  // namespace
-
-std::string mirroredJointName(const std::string& name) {
-  if (name.rfind("Left", 0) == 0) return "Right" + name.substr(4);
-  if (name.rfind("Right", 0) == 0) return "Left" + name.substr(5);
-  if (name.size() > 1 && (name[0] == 'L' || name[0] == 'R') && std::isupper(static_cast<unsigned char>(name[1])))
-    return std::string(1, name[0] == 'L' ? 'R' : 'L') + name.substr(1);
-  return name;
-}
 
 DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, const std::string& what) {
   if (get<std::string>(j, "format", what) != "swish-default-character-recipe")

@@ -76,7 +76,4 @@ DefaultCharacterRecipe loadDefaultCharacterRecipe(const std::filesystem::path& f
 const char* embeddedDefaultRecipeJson();
 DefaultCharacterRecipe embeddedDefaultRecipe();
 
-// Left/Right (and CMU's L/R prefix) swapped; the name itself when it has no side.
-std::string mirroredJointName(const std::string& name);
-
 }  // namespace swish::bake

@@ -11,24 +11,10 @@
 namespace swish::bake {
 namespace {
 
-// The counterpart name across the body's mid-plane, or the name itself for centre joints.
-std::string mirroredName(const std::string& name) {
-  auto swapPrefix = [&](const std::string& a, const std::string& b) -> std::string {
-    if (name.rfind(a, 0) == 0) return b + name.substr(a.size());
-    return {};
-  };
-  if (auto s = swapPrefix("Left", "Right"); !s.empty()) return s;
-  if (auto s = swapPrefix("Right", "Left"); !s.empty()) return s;
-  // CMU's short prefixes: LHipJoint, RThumb (an upper-case letter follows the L/R).
-  if (name.size() > 1 && (name[0] == 'L' || name[0] == 'R') && std::isupper(static_cast<unsigned char>(name[1])))
-    return std::string(1, name[0] == 'L' ? 'R' : 'L') + name.substr(1);
-  return name;
-}
-
 std::vector<int> mirrorMap(const Skeleton& skeleton) {
   std::vector<int> map(skeleton.size());
   for (size_t j = 0; j < skeleton.size(); ++j) {
-    const int m = skeleton.find(mirroredName(skeleton.joints[j].name));
+    const int m = skeleton.find(mirroredJointName(skeleton.joints[j].name));
     map[j] = m >= 0 ? m : int(j);
   }
   return map;

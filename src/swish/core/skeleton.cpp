@@ -1,5 +1,6 @@
 #include "swish/core/skeleton.hpp"
 
+#include <cctype>
 #include <unordered_set>
 
 #include "swish/core/error.hpp"
@@ -65,6 +66,14 @@ void Skeleton::computeInverseBindFromRest() {
   auto g = globalTransforms(restPose());
   inverseBind.resize(g.size());
   for (size_t i = 0; i < g.size(); ++i) inverseBind[i] = g[i].inverse().matrix();
+}
+
+std::string mirroredJointName(const std::string& name) {
+  if (name.rfind("Left", 0) == 0) return "Right" + name.substr(4);
+  if (name.rfind("Right", 0) == 0) return "Left" + name.substr(5);
+  if (name.size() > 1 && (name[0] == 'L' || name[0] == 'R') && std::isupper(static_cast<unsigned char>(name[1])))
+    return std::string(1, name[0] == 'L' ? 'R' : 'L') + name.substr(1);
+  return name;
 }
 
 }  // namespace swish

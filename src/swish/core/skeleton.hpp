@@ -44,4 +44,8 @@ class Skeleton {
   void computeInverseBindFromRest();
 };
 
+// The joint's counterpart across the body's mid-plane: Left/Right swapped, and CMU's short L/R prefix
+// (LHipJoint, RThumb: an upper-case letter follows); the name itself for a centre joint.
+std::string mirroredJointName(const std::string& name);
+
 }  // namespace swish
