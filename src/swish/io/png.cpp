@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "swish/core/error.hpp"
+#include "swish/model/crc32.hpp"
 
 // stb in static mode: its symbols stay private to this file, so another file of the project may use
 // stb too without duplicate-symbol clashes.
@@ -30,20 +31,6 @@ namespace {
 
 constexpr uint32_t kMaxDimension = 1u << 15;  // 32768: far beyond any normal map or preview
 
-uint32_t crc32Update(uint32_t crc, const uint8_t* data, size_t n) {
-  static const std::array<uint32_t, 256> table = [] {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-      uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  for (size_t i = 0; i < n; ++i) crc = table[(crc ^ data[i]) & 0xFFu] ^ (crc >> 8);
-  return crc;
-}
-
 void putU32(std::vector<uint8_t>& out, uint32_t v) {
   out.push_back(uint8_t(v >> 24));
   out.push_back(uint8_t(v >> 16));
@@ -56,8 +43,7 @@ void putChunk(std::vector<uint8_t>& out, const char type[4], const uint8_t* data
   const size_t typeAt = out.size();
   out.insert(out.end(), type, type + 4);
   if (n) out.insert(out.end(), data, data + n);
-  const uint32_t crc = crc32Update(0xFFFFFFFFu, out.data() + typeAt, n + 4) ^ 0xFFFFFFFFu;
-  putU32(out, crc);
+  putU32(out, crc32({out.data() + typeAt, n + 4}));
 }
 
 uint8_t paeth(int a, int b, int c) {
