@@ -7,4 +7,3 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Flo
 layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer FloatsOut { float v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer UintsIn { uint v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer UintsOut { uint v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Mat4sIn { mat4 m[]; };

@@ -70,7 +70,7 @@ DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning) {
   spec.normalMaps = 0;
   s.model = test::makeRandomModel(rng, spec);
   s.gpuModel = std::make_unique<gpu::GpuModel>(ctx, s.model);
-  const size_t n = 3000, k = 30, j = s.model.skeleton.size();
+  const size_t n = 3000, k = 30;
   std::vector<float> w(instances * k);
   for (auto& x : w) x = float(rng.normal());
   std::vector<Mat4f> m;

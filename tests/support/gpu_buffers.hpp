@@ -49,7 +49,6 @@ class GuardedOutput {
   }
   // "" when every guard word is intact, else which ones were overwritten.
   std::string guardsIntact(gpu::Context& ctx) const;
-  const std::string& name() const { return buffer_.name(); }
 
  private:
   void readBytes(gpu::Context& ctx, void* dst) const;

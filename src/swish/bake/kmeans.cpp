@@ -137,7 +137,6 @@ KMeansResult kMeans(const RowMatXf& points, const KMeansOptions& o) {
       }
       const size_t taken = emptyThisIteration++ % order.size();
       r.centres.row(c) = points.row(order[taken]);
-      ++r.reseededClusters;
     }
   }
   r.clusterSizes.assign(size_t(k), 0);

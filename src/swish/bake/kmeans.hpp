@@ -35,7 +35,6 @@ struct KMeansResult {
   std::vector<uint32_t> clusterSizes;
   double inertia = 0.0;             // sum of squared distances to the assigned centre
   int iterations = 0;
-  int reseededClusters = 0;         // empty clusters re-seeded over the run
 };
 
 KMeansResult kMeans(const RowMatXf& points, const KMeansOptions& options);

@@ -47,7 +47,6 @@ class Buffer {
   VkDeviceSize size_ = 0;
   VkDeviceAddress address_ = 0;
   void* mapped_ = nullptr;
-  bool coherent_ = true;
   VkDevice device_ = VK_NULL_HANDLE;
   std::string name_;
 };

@@ -7,8 +7,7 @@
 namespace swish::gpu {
 
 ComputePipeline::ComputePipeline(Context& ctx, const std::string& shaderName, const std::vector<uint32_t>& spec,
-                                 uint32_t pushBytes, VkDescriptorSetLayout setLayout)
-    : name_(shaderName) {
+                                 uint32_t pushBytes, VkDescriptorSetLayout setLayout) {
   const auto* shader = shaders::find(shaderName);
   if (!shader) throw Error("shader '" + shaderName + "' is not embedded in this build of swish");
   const VkDevice dev = ctx.device();

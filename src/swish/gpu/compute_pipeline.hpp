@@ -22,7 +22,6 @@ class ComputePipeline {
 
   VkPipeline pipeline() const { return pipeline_.get(); }
   VkPipelineLayout layout() const { return layout_.get(); }
-  const std::string& shaderName() const { return name_; }
 
   // Binds the pipeline and pushes `bytes` of push constants.
   void bind(VkCommandBuffer cmd, const void* push, uint32_t bytes) const;
@@ -30,7 +29,6 @@ class ComputePipeline {
  private:
   VkUnique<VkPipelineLayout> layout_;
   VkUnique<VkPipeline> pipeline_;
-  std::string name_;
 };
 
 inline uint32_t groupCount(uint64_t items, uint32_t groupSize) { return uint32_t((items + groupSize - 1) / groupSize); }

@@ -6,7 +6,7 @@
 
 namespace swish::gpu {
 
-DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning) : k_(k), influences_(influences) {
+DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
     throw Error("deform pass: " + std::to_string(k) + " mesh components; the kernel supports 1.." +
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));

@@ -37,13 +37,10 @@ class DeformPass {
   // the pre-skinning shape (used to check the PCA reconstruction on its own).
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true);
 
-  uint32_t meshComponents() const { return k_; }
-  uint32_t influences() const { return influences_; }
   void record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
   ComputePipeline pipeline_;
-  uint32_t k_ = 0, influences_ = 0;
 };
 
 }  // namespace swish::gpu

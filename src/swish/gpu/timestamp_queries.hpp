@@ -20,8 +20,6 @@ class TimestampQueries {
   TimestampQueries() = default;
   TimestampQueries(Context& ctx, uint32_t capacity);
 
-  bool enabled() const { return bool(pool_); }
-  uint32_t capacity() const { return capacity_; }
   void reset(VkCommandBuffer cmd);
   void mark(VkCommandBuffer cmd, uint32_t index);
   std::vector<double> readNs() const;

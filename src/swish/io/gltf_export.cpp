@@ -1,7 +1,6 @@
 #include "swish/io/gltf_export.hpp"
 
 #include <cstring>
-#include <fstream>
 
 #include <nlohmann/json.hpp>
 
@@ -75,12 +74,6 @@ class GlbBuilder {
   std::vector<uint8_t> bin_;
 };
 
-std::vector<uint8_t> readFileBytes(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw Error(p.string() + ": cannot open the normal-map PNG");
-  return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), {});
-}
-
 nlohmann::json quatJson(const Quatf& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 nlohmann::json vecJson(const Vec3f& v) { return {v.x(), v.y(), v.z()}; }
 
@@ -131,8 +124,7 @@ std::vector<uint8_t> encodeGlb(const GltfScene& scene) {
                            {{"baseColorFactor", {m.baseColor[0], m.baseColor[1], m.baseColor[2], m.baseColor[3]}},
                             {"metallicFactor", 0.0},
                             {"roughnessFactor", m.roughness}}}};
-    std::vector<uint8_t> png = m.normalMapPng;
-    if (png.empty() && !m.normalMapPngPath.empty()) png = readFileBytes(m.normalMapPngPath);
+    const std::vector<uint8_t>& png = m.normalMapPng;
     if (!png.empty()) {
       static const uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
       if (png.size() < 8 || std::memcmp(png.data(), kSignature, 8) != 0)
@@ -200,8 +192,8 @@ std::vector<uint8_t> encodeCharacterGlb(const Character& c, const std::vector<ui
   GltfScene s;
   s.skeleton = &c.skeleton;
   s.generator = "swish (character " + c.name + ")";
-  s.materials.push_back({"skin", Vec4f(0.80f, 0.66f, 0.55f, 1.f), 0.7f, {}, {}});
-  s.materials.push_back({"cloth", Vec4f(0.15f, 0.25f, 0.65f, 1.f), 0.9f, garmentNormalMapPng, {}});
+  s.materials.push_back({"skin", Vec4f(0.80f, 0.66f, 0.55f, 1.f), 0.7f, {}});
+  s.materials.push_back({"cloth", Vec4f(0.15f, 0.25f, 0.65f, 1.f), 0.9f, garmentNormalMapPng});
   s.meshes.push_back({"body", &c.body, true, 0, {}});
   s.meshes.push_back({"shirt", &c.garment, true, 1, {}});
   if (c.simulationMesh) s.meshes.push_back({"simulation", &*c.simulationMesh, true, 1, {}});

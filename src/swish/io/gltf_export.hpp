@@ -21,9 +21,8 @@ struct GltfMaterial {
   std::string name = "material";
   Vec4f baseColor = Vec4f(0.8f, 0.8f, 0.8f, 1.f);
   float roughness = 0.8f;
-  // Tangent-space normal map as PNG: either bytes (embedded in the .glb) or a file read at export.
+  // Tangent-space normal map as PNG bytes, embedded in the .glb (empty: none).
   std::vector<uint8_t> normalMapPng;
-  std::filesystem::path normalMapPngPath;
 };
 
 struct GltfMeshEntry {

@@ -25,14 +25,10 @@ CharacterCheck compareInstance(const runtime::ReferenceFrameOutputs& gpu, const 
   c.character = character;
   const Points3f& gp = gpu.positions.at(i);
   const Points3f& cp = cpu.positions.at(i);
-  double sum = 0;
   for (Eigen::Index v = 0; v < gp.rows(); ++v) {
     const double d = (gp.row(v).cast<double>() - cp.row(v).cast<double>()).norm() * 1000.0;
-    const double e = std::isfinite(d) ? d : 1e30;
-    c.maxPositionErrorMm = std::max(c.maxPositionErrorMm, e);
-    sum += e * e;
+    c.maxPositionErrorMm = std::max(c.maxPositionErrorMm, std::isfinite(d) ? d : 1e30);
   }
-  c.rmsPositionErrorMm = gp.rows() ? std::sqrt(sum / double(gp.rows())) : 0.0;
   if (i < gpu.normals.size() && i < cpu.normals.size())
     for (Eigen::Index v = 0; v < gp.rows(); ++v) {
       c.maxNormalErrorDeg = std::max(c.maxNormalErrorDeg, angleDeg(gpu.normals[i].row(v), cpu.normals[i].row(v)));

@@ -183,7 +183,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
   }
 
   const bool check = plan.gpuWork && index % scene.outputs.gpuCheckEvery == 0;
-  const bool readBack = plan.gpuWork && (check || options.readBackEveryFrame || options.onCharacterOutput);
+  const bool readBack = plan.gpuWork && (check || options.onCharacterOutput);
   if (plan.gpuWork) {
     // The reference needs each character's normal map as the GPU had it before this frame.
     std::vector<std::vector<runtime::BlendedNormalMap>> prevMaps(batches.size());

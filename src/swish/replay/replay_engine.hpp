@@ -38,7 +38,6 @@ struct ReplayOptions {
   std::function<void(uint32_t sceneFrame, uint32_t character, const runtime::ReferenceFrameOutputs& batchOutputs,
                      uint32_t instance)>
       onCharacterOutput;
-  bool readBackEveryFrame = false;  // read outputs back on every frame, not only on checks
 };
 
 // Milliseconds; NaN where a stage did not run.
@@ -51,7 +50,7 @@ struct FrameTimes {
 
 struct CharacterCheck {
   uint32_t character = 0;
-  double maxPositionErrorMm = 0, rmsPositionErrorMm = 0;
+  double maxPositionErrorMm = 0;
   double maxNormalErrorDeg = 0, maxTangentErrorDeg = 0;
   int maxMapErrorSteps = 0;  // snorm16 steps
   bool ok = true;
