@@ -40,8 +40,6 @@ void main() {
     precise vec3 e2 = corner(tris, t, 2u) - p0;
     nsum = nsum + crossCpu(e1, e2);
   }
-  const float nl = normCpu(nsum);
-  precise vec3 nrm = nl > 0.0 ? nsum / nl : vec3(0, 0, 1);
 
   precise vec3 tsum = vec3(0.0), bsum = vec3(0.0);
   if (p.hasUvs != 0u) {
@@ -63,10 +61,9 @@ void main() {
       bsum = bsum + (e2 * d1.x - e1 * d2.x) / r;
     }
   }
-  precise vec3 tan = tsum - nrm * dotCpu(nrm, tsum);
-  const float tl = normCpu(tan);
-  tan = (tl > 1e-20 && isFinite(tl)) ? tan / tl : anyPerpendicular(nrm);
-  const float w = dotCpu(crossCpu(nrm, tan), bsum) < 0.0 ? -1.0 : 1.0;
+  vec3 nrm;
+  vec4 tangent;
+  finishVertexFrame(nsum, tsum, bsum, nrm, tangent);
 
   FloatsOut normalsOut = FloatsOut(p.normalsOut);
   FloatsOut tangentsOut = FloatsOut(p.tangentsOut);
@@ -74,8 +71,8 @@ void main() {
   normalsOut.v[3u * o] = nrm.x;
   normalsOut.v[3u * o + 1u] = nrm.y;
   normalsOut.v[3u * o + 2u] = nrm.z;
-  tangentsOut.v[4u * o] = tan.x;
-  tangentsOut.v[4u * o + 1u] = tan.y;
-  tangentsOut.v[4u * o + 2u] = tan.z;
-  tangentsOut.v[4u * o + 3u] = w;
+  tangentsOut.v[4u * o] = tangent.x;
+  tangentsOut.v[4u * o + 1u] = tangent.y;
+  tangentsOut.v[4u * o + 2u] = tangent.z;
+  tangentsOut.v[4u * o + 3u] = tangent.w;
 }
