@@ -1,45 +1,21 @@
 #pragma once
 // The preview renderer's Vulkan objects: buffers and images with their own memory, owned RAII-style.
 // The renderer is a host like any other, so it has its own small helpers rather than swish's private
-// gpu layer.
+// gpu layer (apart from the header-only handle owner below).
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
-#include <functional>
-#include <utility>
+
+#include "swish/gpu/vk_unique.hpp"
 
 namespace swish::render {
 
 class HostDevice;
 
-// Any handle with a destroy function; move-only.
+// Any handle with a destroy function; move-only. The gpu layer's header-only owner (it pulls in
+// nothing else of that layer).
 template <class H>
-class Owned {
- public:
-  Owned() = default;
-  Owned(H h, std::function<void(H)> destroy) : h_(h), destroy_(std::move(destroy)) {}
-  Owned(Owned&& o) noexcept : h_(std::exchange(o.h_, H{})), destroy_(std::move(o.destroy_)) {}
-  Owned& operator=(Owned&& o) noexcept {
-    if (this != &o) {
-      reset();
-      h_ = std::exchange(o.h_, H{});
-      destroy_ = std::move(o.destroy_);
-    }
-    return *this;
-  }
-  Owned(const Owned&) = delete;
-  Owned& operator=(const Owned&) = delete;
-  ~Owned() { reset(); }
-  void reset() {
-    if (h_ != H{} && destroy_) destroy_(h_);
-    h_ = H{};
-  }
-  H get() const { return h_; }
-
- private:
-  H h_{};
-  std::function<void(H)> destroy_;
-};
+using Owned = gpu::VkUnique<H>;
 
 // A buffer in host-visible, coherent memory, mapped for its lifetime (vertex data written each frame,
 // image readback). The preview moves little data; one allocation per buffer is plenty.
