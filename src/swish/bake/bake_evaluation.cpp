@@ -15,6 +15,11 @@
 
 namespace swish::bake {
 
+nlohmann::json toJson(const DistanceStats& s) { return {{"mean_mm", s.mean}, {"p95_mm", s.p95}, {"max_mm", s.max}}; }
+nlohmann::json toJson(const AngularErrorStats& s) {
+  return {{"mean_deg", s.meanDegrees}, {"p95_deg", s.p95Degrees}, {"max_deg", s.maxDegrees}};
+}
+
 DistanceStats distanceStats(std::vector<double> v) {
   DistanceStats s;
   if (v.empty()) return s;

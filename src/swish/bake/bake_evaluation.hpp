@@ -15,6 +15,8 @@
 //                temporal filter), and vqAdded = selection map uncompressed vs VQ-decoded.
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "swish/bake/dataset.hpp"
 #include "swish/bake/normal_map_metrics.hpp"
 #include "swish/bake/pca.hpp"
@@ -26,6 +28,10 @@ struct DistanceStats {
   double mean = 0.0, p95 = 0.0, max = 0.0;
 };
 DistanceStats distanceStats(std::vector<double> values);
+
+// The report's and the model metadata's form of the figures: {mean,p95,max}_mm and {mean,p95,max}_deg.
+nlohmann::json toJson(const DistanceStats& s);
+nlohmann::json toJson(const AngularErrorStats& s);
 
 struct PoseEvaluation {
   uint32_t poseId = 0;

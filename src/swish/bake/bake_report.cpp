@@ -13,10 +13,6 @@
 namespace swish::bake {
 
 namespace {
-nlohmann::json j(const AngularErrorStats& s) {
-  return {{"mean_deg", s.meanDegrees}, {"p95_deg", s.p95Degrees}, {"max_deg", s.maxDegrees}};
-}
-nlohmann::json j(const DistanceStats& s) { return {{"mean_mm", s.mean}, {"p95_mm", s.p95}, {"max_mm", s.max}}; }
 std::string f2(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.2f", v);
@@ -56,8 +52,8 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
     perK.push_back({{"k", k}, {"explained_variance", out.meshPca.explainedVariance[Eigen::Index(k)]}, {"rms_mm", rms[k]}});
   r["mesh_pca"] = {{"components", out.meshPca.components()}, {"method", out.meshPca.randomized ? "randomized" : "exact"},
                    {"per_k", perK}};
-  r["vertex_error_held_out"] = {{"total", j(ev.totalMm)}, {"pca_truncation", j(ev.truncationMm)},
-                                {"regression", j(ev.regressionMm)}};
+  r["vertex_error_held_out"] = {{"total", toJson(ev.totalMm)}, {"pca_truncation", toJson(ev.truncationMm)},
+                                {"regression", toJson(ev.regressionMm)}};
   r["mlp"] = {{"best_epoch", out.regressor.bestEpoch}, {"epochs_run", out.regressor.epochsRun},
               {"best_validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds},
               {"activation", activationName(out.regressor.activation)}};
@@ -65,10 +61,10 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
     r["normal_maps"] = {
         {"code_dims", out.normalPca.codeDims()},
         {"database_maps", out.model.normalMaps.mapCount()},
-        {"held_out", {{"database", j(ev.normalDatabase)}, {"selection", j(ev.normalSelection)},
-                      {"total_vq", j(ev.normalTotal)}, {"vq_added", j(ev.normalVqAdded)},
+        {"held_out", {{"database", toJson(ev.normalDatabase)}, {"selection", toJson(ev.normalSelection)},
+                      {"total_vq", toJson(ev.normalTotal)}, {"vq_added", toJson(ev.normalVqAdded)},
                       {"selection_agreement", ev.selectionAgreement}}},
-        {"compression", {{"vq_vs_uncompressed", j(out.vqVsUncompressed)}, {"bc5_vs_uncompressed", j(out.bc5VsUncompressed)},
+        {"compression", {{"vq_vs_uncompressed", toJson(out.vqVsUncompressed)}, {"bc5_vs_uncompressed", toJson(out.bc5VsUncompressed)},
                          {"vq_bytes", out.vq.totalBytes()}, {"vq_codebook_bytes", out.vq.codebookBytes},
                          {"vq_index_bytes", out.vq.indexBytes}, {"bc5_bytes", out.bc5Bytes},
                          {"uncompressed_float_bytes", out.uncompressedBytes}, {"codebook_entries", out.vq.codebookEntries},

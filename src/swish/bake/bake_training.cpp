@@ -36,11 +36,6 @@ nlohmann::json BakeTrainSettings::toJson() const {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-
-nlohmann::json statsJson(const AngularErrorStats& s) {
-  return {{"mean_deg", s.meanDegrees}, {"p95_deg", s.p95Degrees}, {"max_deg", s.maxDegrees}};
-}
-nlohmann::json statsJson(const DistanceStats& s) { return {{"mean_mm", s.mean}, {"p95_mm", s.p95}, {"max_mm", s.max}}; }
 }  // namespace
 
 BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress) {
@@ -173,20 +168,20 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   const auto& ev = out.evaluation;
   out.metadata["errors"] = {
       {"held_out_poses", ev.poses},
-      {"vertex_total", statsJson(ev.totalMm)},
-      {"vertex_pca_truncation", statsJson(ev.truncationMm)},
-      {"vertex_regression", statsJson(ev.regressionMm)},
+      {"vertex_total", toJson(ev.totalMm)},
+      {"vertex_pca_truncation", toJson(ev.truncationMm)},
+      {"vertex_regression", toJson(ev.regressionMm)},
       {"mesh_components", K},
       {"mesh_explained_variance", out.meshPca.explainedVariance[K]},
       {"mlp", {{"best_epoch", out.regressor.bestEpoch}, {"epochs", out.regressor.epochsRun},
                {"validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds}}}};
   if (maps) {
-    out.metadata["errors"]["normal_database"] = statsJson(ev.normalDatabase);
-    out.metadata["errors"]["normal_selection"] = statsJson(ev.normalSelection);
-    out.metadata["errors"]["normal_total"] = statsJson(ev.normalTotal);
-    out.metadata["errors"]["normal_vq_added"] = statsJson(ev.normalVqAdded);
-    out.metadata["errors"]["vq_vs_uncompressed"] = statsJson(out.vqVsUncompressed);
-    out.metadata["errors"]["bc5_vs_uncompressed"] = statsJson(out.bc5VsUncompressed);
+    out.metadata["errors"]["normal_database"] = toJson(ev.normalDatabase);
+    out.metadata["errors"]["normal_selection"] = toJson(ev.normalSelection);
+    out.metadata["errors"]["normal_total"] = toJson(ev.normalTotal);
+    out.metadata["errors"]["normal_vq_added"] = toJson(ev.normalVqAdded);
+    out.metadata["errors"]["vq_vs_uncompressed"] = toJson(out.vqVsUncompressed);
+    out.metadata["errors"]["bc5_vs_uncompressed"] = toJson(out.bc5VsUncompressed);
     out.metadata["memory"] = {{"vq_bytes", out.vq.totalBytes()}, {"bc5_bytes", out.bc5Bytes},
                               {"database_maps", db.mapCount()}, {"codebook_entries", db.codebookSize}};
   }
