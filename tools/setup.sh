@@ -12,7 +12,7 @@ PACKAGES=(
   libeigen3-dev                                    # linear algebra
   googletest libgtest-dev libbenchmark-dev         # tests, benchmarks
   libassimp-dev assimp-testmodels                  # FBX/glTF/BVH import; CMU mocap clips
-  libtinygltf-dev nlohmann-json3-dev libstb-dev    # glTF export, JSON, PNG
+  nlohmann-json3-dev libstb-dev                    # JSON (and the glTF export built on it), PNG
   libcli11-dev                                     # command line
   libsquish-dev                                    # BC5 baseline for the VQ normal maps
   libembree-dev libtbb-dev                         # ray casts for normal-map baking; parallel loops
