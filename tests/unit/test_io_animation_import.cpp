@@ -152,17 +152,18 @@ void checkCmuClipRetargetedOnto(const Character& c) {
   const io::SourceAnimation src = io::readBvh(kClip);
   const auto g = c.skeleton.globalTransforms(clip.frames[0]);
   const auto s = src.frameGlobals(0);
-  int checked = 0;
   for (const char* pair : {"LeftArm>LeftForeArm", "LeftForeArm>LeftHand", "RightArm>RightForeArm",
                            "LeftUpLeg>LeftLeg", "RightLeg>RightFoot", "Spine>Spine1", "Neck1>Head"}) {
     const std::string p(pair);
     const std::string a = p.substr(0, p.find('>')), b = p.substr(p.find('>') + 1);
+    for (const std::string& name : {a, b}) {
+      ASSERT_GE(c.skeleton.find(name), 0) << name << " missing from the character";
+      ASSERT_GE(src.find(name), 0) << name << " missing from the clip";
+    }
     const Vec3f dc = (g[size_t(c.skeleton.find(b))].translation - g[size_t(c.skeleton.find(a))].translation).normalized();
     const Vec3f ds = (s[size_t(src.find(b))].translation - s[size_t(src.find(a))].translation).normalized();
     EXPECT_GT(dc.dot(ds), 0.9999f) << a << " -> " << b;
-    ++checked;
   }
-  EXPECT_EQ(checked, 7);
   // Y stays up: the head is above the hips in the first frame.
   EXPECT_GT(g[size_t(c.skeleton.find("Head"))].translation.y(), g[0].translation.y() + 0.4f);
 }
