@@ -1,9 +1,9 @@
 #include "swish/gpu/frame_recorder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <unordered_map>
 
 #include "shaders/swish_layouts.h"
 #include "swish/gpu/context.hpp"
@@ -104,14 +104,14 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
   }
 
   if (maps) {
-    // Each selected map decoded once: slots in first-selection order.
-    std::unordered_map<uint32_t, uint32_t> slotOfMap;
+    // Each selected map decoded once: slots in first-selection order (a batch selects a few dozen
+    // maps at most, so a linear search beats hashing).
     std::vector<uint32_t> slotMaps;
     std::vector<layout::NormalMapBlendCharacter> chars(in.instanceCount);
     for (uint32_t i = 0; i < in.instanceCount; ++i) {
-      auto [it, inserted] = slotOfMap.try_emplace(in.selectedMaps[i], uint32_t(slotMaps.size()));
-      if (inserted) slotMaps.push_back(in.selectedMaps[i]);
-      chars[i] = {it->second, in.blendAlpha[i]};
+      const size_t slot = size_t(std::find(slotMaps.begin(), slotMaps.end(), in.selectedMaps[i]) - slotMaps.begin());
+      if (slot == slotMaps.size()) slotMaps.push_back(in.selectedMaps[i]);
+      chars[i] = {uint32_t(slot), in.blendAlpha[i]};
     }
     f.decodedSlotCount = uint32_t(slotMaps.size());
     f.decodeSlotMaps.upload(*ctx_, slotMaps.data(), slotMaps.size() * sizeof(uint32_t));
