@@ -46,7 +46,8 @@ int FrameRecord::maxMapErrorSteps() const {
 struct Batch {
   const runtime::PlannedBatch* planned = nullptr;
   const Model* model = nullptr;
-  Model gpuModelData;  // the model as uploaded: without its database when the plan leaves maps out
+  std::optional<Model> withoutMaps;  // a copy without the database, only when the plan leaves maps out
+  const Model& uploaded() const { return withoutMaps ? *withoutMaps : *model; }  // the model on the GPU
   std::optional<runtime::MlpEvaluator> mlp;
   std::optional<runtime::NearestCodeSearch> search;
   std::vector<runtime::TemporalFilter> filters;
@@ -111,11 +112,11 @@ void ReplayEngine::Impl::setUp() {
     ctx = &*ownContext;
   }
   for (Batch& B : batches) {
-    B.gpuModelData = *B.model;
-    if (!B.planned->normalMaps) {
-      B.gpuModelData.normalMaps = NormalMapDatabase{};  // not uploaded: the plan leaves normal maps out
+    if (!B.planned->normalMaps) {  // not uploaded: the plan leaves normal maps out
+      B.withoutMaps.emplace(*B.model);
+      B.withoutMaps->normalMaps = NormalMapDatabase{};
     }
-    B.gpuModel = std::make_unique<gpu::GpuModel>(*ctx, B.gpuModelData, B.planned->model);
+    B.gpuModel = std::make_unique<gpu::GpuModel>(*ctx, B.uploaded(), B.planned->model);
     gpu::FrameRecorderOptions ro;
     ro.framesInFlight = 1;
     ro.tangentFrames = B.planned->tangentFrames;
@@ -223,7 +224,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
         Batch& B = batches[b];
         const runtime::ReferenceFrameOutputs gpuOut = B.recorder->download(0);
         if (check) {
-          const runtime::ReferenceFrameOutputs cpuOut = runtime::referenceFrame(B.gpuModelData, B.inputs, prevMaps[b]);
+          const runtime::ReferenceFrameOutputs cpuOut = runtime::referenceFrame(B.uploaded(), B.inputs, prevMaps[b]);
           for (uint32_t i = 0; i < B.planned->characters.size(); ++i) {
             CharacterCheck c = compareInstance(gpuOut, cpuOut, i, B.planned->characters[i]);
             if (!c.ok)
