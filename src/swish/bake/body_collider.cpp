@@ -159,7 +159,7 @@ void BodyCollider::rebuild() {
   }
 }
 
-BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance) const {
+BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance, int onlyPart, int skipPart) const {
   Hit hit;
   if (!p.allFinite() || !(maxDistance > 0.f)) return hit;
   Eigen::Vector3i a, b;
@@ -190,6 +190,7 @@ BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance) const
           const float lower = (p - s.head<3>()).norm() - s[3];
           if (lower > maxDistance) continue;
           const uint32_t part = triangleComponent_[t];
+          if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
           size_t slot = 0;
           while (slot < partCount && parts[slot].part != part) ++slot;
           if (slot < partCount && lower > parts[slot].distance) continue;
@@ -236,6 +237,7 @@ BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance) const
     hit.signedDistance = sd;
     hit.point = pb.point.point;
     hit.triangle = pb.tri;
+    hit.part = int(pb.part);
     hit.normal = pb.distance > 1e-7f ? Vec3f(sign * diff / pb.distance) : pseudo;
     bestPart = pb.part;
   }

@@ -24,6 +24,7 @@ class BodyCollider {
     Vec3f point = Vec3f::Zero();   // closest point on the surface
     Vec3f normal = Vec3f::Zero();  // unit, pointing out of the body at `point`
     int triangle = -1;  // the body triangle `point` lies on
+    int part = -1;      // the connected part that triangle belongs to
   };
 
   // `body`: rest positions, triangles, skin weights (validated, naming `what`). `cellSize`: grid
@@ -33,8 +34,10 @@ class BodyCollider {
   // Poses the body by linear blend skinning and rebuilds normals and the grid.
   void pose(const std::vector<Mat4f>& skinMatrices);
 
-  // Closest surface point to p within maxDistance (metres). Thread-safe (const, no scratch state).
-  Hit closest(const Vec3f& p, float maxDistance) const;
+  // Closest surface point to p within maxDistance (metres), of the whole body or, when onlyPart >= 0,
+  // of that connected part alone, or, when skipPart >= 0, of the other parts. Thread-safe (const, no
+  // scratch state).
+  Hit closest(const Vec3f& p, float maxDistance, int onlyPart = -1, int skipPart = -1) const;
 
   const Points3f& positions() const { return positions_; }
   const Triangles& triangles() const { return triangles_; }
