@@ -161,7 +161,7 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
   p = "part1.simulation";
   c.onlyKeys(sim, p,
              {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
-              "iterations", "threads", "gravity"});
+              "iterations", "threads", "gravity", "limb_clearance"});
   ClothSimSettings& cs = s.simulation;
   if (sim.contains("preset")) {
     try {
@@ -180,6 +180,8 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
   s.threads = int(c.number(sim, p, "threads", 0, 1024, s.threads, true));
   // Gravity along -Y in m/s^2 (0 turns it off: see docs/baking.md for why a bake may need that).
   cs.gravity = Vec3f(0.f, -float(c.number(sim, p, "gravity", 0, 100, -cs.gravity.y())), 0.f);
+  // Metres kept between a limb and the trunk (limb_clearance.hpp); 0 leaves the poses as recorded.
+  s.limbClearance.clearance = float(c.number(sim, p, "limb_clearance", 0, 0.1, s.limbClearance.clearance));
   try {
     cs.validate();
   } catch (const Error& e) {

@@ -16,6 +16,7 @@
 #include "swish/bake/pose_thinning.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
+#include "swish/core/skinning.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/io/character_import.hpp"
 #include "swish/model/atomic_write.hpp"
@@ -133,7 +134,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
        {{"preset", m.material.name}, {"vertices", simulationVertices}, {"thickness", m.thickness},
         {"transition_seconds", m.transitionSeconds}, {"settle_seconds", m.settleSeconds},
         {"frame_rate", m.frameRate}, {"substeps", m.substeps}, {"iterations", m.iterations},
-        {"gravity", -m.gravity.y()}}},
+        {"gravity", -m.gravity.y()}, {"limb_clearance", limbClearance.clearance}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength}, {"smoothing_iterations", transfer.smoothing.iterations},
         {"smoothing_weights", transfer.smoothing.weights == LaplacianWeights::Cotangent ? "cotangent" : "uniform"}}},
@@ -150,6 +151,7 @@ nlohmann::json DatasetBuildResult::toJson() const {
   for (const DatasetBuildStep& s : steps) st.push_back({{"step", s.name}, {"seconds", s.seconds}});
   return {{"clip_frames", clipFrames},     {"samples", samples},
           {"kept_poses", keptPoses},       {"tolerance", tolerance},
+          {"poses_corrected", posesCorrected}, {"max_correction_degrees", maxCorrectionDegrees},
           {"simulation_vertices", simulationVertices},
           {"simulated", simulated},        {"simulations_reused", simulationsReused},
           {"transferred", transferred},    {"transfers_reused", transfersReused},
@@ -219,6 +221,32 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   }
   step("sampling + thinning", t);
 
+  // Limbs out of the trunk: the corrected poses are simulated; the dataset keeps the recorded poses,
+  // which are what the model sees at run time (see the transfer below).
+  const std::vector<Pose> recorded = poses;
+  if (s.limbClearance.clearance > 0.f) {
+    t = Clock::now();
+    const LimbClearance clearance(character, s.limbClearance);
+    std::vector<std::vector<LimbCorrection>> corrections(poses.size());
+    tbb::parallel_for(size_t(0), poses.size(), [&](size_t i) { corrections[i] = clearance.apply(poses[i]); });
+    size_t stillInside = 0;
+    for (const auto& c : corrections) {
+      if (!c.empty()) ++res.posesCorrected;
+      for (const LimbCorrection& x : c) {
+        res.maxCorrectionDegrees = std::max(res.maxCorrectionDegrees, x.degrees);
+        if (x.depthAfter > 0.f) ++stillInside;
+      }
+    }
+    char line[240];
+    std::snprintf(line, sizeof line,
+                  "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk (%zu limbs of the body "
+                  "checked); turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
+                  1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
+                  double(res.maxCorrectionDegrees), stillInside, since(t));
+    log(line);
+    step("limb clearance", t);
+  }
+
   // Dataset folder: reset when its poses were made with other settings or another pose list.
   nlohmann::json settingsJson = s.toJson();
   settingsJson["pose_list_digest"] = std::to_string(poseListDigest(poses));
@@ -278,7 +306,15 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         TransferredPose tp = transfer.transfer(poses[id], rec->result.positions);
         DatasetPose dp;
         dp.id = id;
-        dp.pose = poses[id];
+        // A pose whose limbs were turned out of the trunk: the shape before skinning comes from the
+        // corrected simulation; the pose and the world shape are the recorded ones, the world shape
+        // being that shape skinned as the run time will skin it. The model so learns its real
+        // inputs, and the sleeves of a hanging arm pass into the torso with the arm, as the body does.
+        dp.pose = recorded[id];
+        if (!std::equal(poses[id].local.begin(), poses[id].local.end(), recorded[id].local.begin(),
+                        [](const Quatf& a, const Quatf& b) { return a.coeffs() == b.coeffs(); }))
+          tp.gameMeshWorld = skinPositions(tp.gameMeshPreSkin, character.garment.skin,
+                                           character.skeleton.skinningMatrices(recorded[id]));
         dp.gameMeshWorld = std::move(tp.gameMeshWorld);
         dp.gameMeshPreSkin = std::move(tp.gameMeshPreSkin);
         dp.normalMap = std::move(tp.normalMap);

@@ -28,6 +28,7 @@
 #include "swish/bake/dataset_io.hpp"
 #include "swish/bake/pose_sampling.hpp"
 #include "swish/bake/pose_transfer.hpp"
+#include "swish/bake/limb_clearance.hpp"
 #include "swish/bake/simulation_mesh.hpp"
 #include "swish/io/joint_map.hpp"
 
@@ -57,6 +58,9 @@ struct DatasetBuildSettings {
 
   size_t simulationVertices = kDefaultSimulationVertices;  // 0: the welded game mesh, not subdivided
   ClothSimSettings simulation;
+  // Limbs that pass into the trunk are turned out of it before simulating (limb_clearance.hpp);
+  // clearance 0 turns this off.
+  LimbClearanceSettings limbClearance;
   int threads = 0;                 // 0: all cores (TBB's default)
 
   PoseTransferSettings transfer;
@@ -78,6 +82,8 @@ struct DatasetBuildResult {
   size_t clipFrames = 0;           // frames over all clips
   size_t samples = 0;              // Theta samples before thinning
   size_t keptPoses = 0;            // after thinning
+  size_t posesCorrected = 0;       // poses whose limbs were turned out of the trunk
+  float maxCorrectionDegrees = 0.f;
   float tolerance = 0.f;           // the thinning tolerance used
   size_t simulationVertices = 0;
   size_t simulated = 0, simulationsReused = 0;
