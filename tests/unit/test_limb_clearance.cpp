@@ -71,6 +71,7 @@ float armToTorso(const Character& c, const Pose& pose) {
 TEST(LimbClearance, RestPoseOfTheMannequinNeedsNoCorrection) {
   const LimbClearance lc(mannequin());
   EXPECT_EQ(lc.limbCount(), 7u);  // head, two arms, two legs, two feet
+  EXPECT_TRUE(lc.skipped().empty()) << lc.skipped();
   Pose p = mannequin().skeleton.restPose();
   EXPECT_TRUE(lc.apply(p).empty());
 }
@@ -118,6 +119,14 @@ TEST(LimbClearance, OnePartBodiesAndBadPosesAreLeftAlone) {
   const Character capsule = test::capsuleCharacter();
   const LimbClearance lc(capsule);
   EXPECT_EQ(lc.limbCount(), 0u);
+  EXPECT_NE(lc.skipped().find("one connected mesh"), std::string::npos) << lc.skipped();
+  // A trunk with a hole has no inside: nothing is checked.
+  Character open = mannequin();
+  open.body.triangles.conservativeResize(open.body.triangles.rows(), 3);
+  open.body.triangles.row(0) = open.body.triangles.row(1);  // one torso triangle doubled, one gone
+  const LimbClearance holed(open);
+  EXPECT_EQ(holed.limbCount(), 0u);
+  EXPECT_NE(holed.skipped().find("not a closed surface"), std::string::npos) << holed.skipped();
   Pose p = capsule.skeleton.restPose();
   p.local[2] = Quatf(Eigen::AngleAxisf(1.2f, Vec3f::UnitX()));
   EXPECT_TRUE(lc.apply(p).empty());

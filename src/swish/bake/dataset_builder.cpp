@@ -237,13 +237,14 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         if (x.depthAfter > 0.f) ++stillInside;
       }
     }
+    if (!clearance.skipped().empty()) log("part 1: limb clearance skipped: " + clearance.skipped());
     char line[240];
-    std::snprintf(line, sizeof line,
+    if (clearance.limbCount() > 0) std::snprintf(line, sizeof line,
                   "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk (%zu limbs of the body "
                   "checked); turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
                   1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
                   double(res.maxCorrectionDegrees), stillInside, since(t));
-    log(line);
+    if (clearance.limbCount() > 0) log(line);
     step("limb clearance", t);
   }
 

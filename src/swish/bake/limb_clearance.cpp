@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "swish/bake/body_collider.hpp"
 #include "swish/core/error.hpp"
@@ -68,7 +69,27 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
     if (part[body_.triangles(t, 0)] == trunk) keep.push_back(t);
   trunk_.triangles.resize(Eigen::Index(keep.size()), 3);
   for (size_t i = 0; i < keep.size(); ++i) trunk_.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
-  if (keep.size() == size_t(body_.triangles.rows())) return;  // one part: nothing to keep apart
+  if (keep.size() == size_t(body_.triangles.rows())) {
+    skipped_ = "the body is one connected mesh: no limbs to keep apart";
+    return;
+  }
+  // Inside and outside need a closed trunk: near the openings of an open one (a torso whose head and
+  // hands are separate meshes) the sign of the distance means nothing.
+  {
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (Eigen::Index t = 0; t < trunk_.triangles.rows(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t a = trunk_.triangles(t, k), b = trunk_.triangles(t, (k + 1) % 3);
+        ++uses[{std::min(a, b), std::max(a, b)}];
+      }
+    size_t open = 0;
+    for (const auto& [edge, count] : uses) open += count != 2;
+    if (open > 0) {
+      skipped_ = "the body's trunk is not a closed surface (" + std::to_string(open) +
+                 " edges not shared by two triangles): inside and outside are undefined";
+      return;
+    }
+  }
 
   BodyCollider trunkCollider(trunk_, kCell, what + " (trunk)");
   const Pose rest = skeleton_.restPose();

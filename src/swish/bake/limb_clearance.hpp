@@ -15,7 +15,8 @@
 // root joint is the shallowest joint weighting its vertices. Only limb vertices that lie outside the
 // trunk in the rest pose and farther than rootRadius from the root joint are checked: the root of a
 // tube starts inside the trunk by construction. A body that is one connected mesh has no parts to
-// separate, and its poses are left unchanged.
+// separate, and a trunk that is not a closed surface has no inside; the poses of either are left
+// unchanged (skipped() says why).
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ class LimbClearance {
   std::vector<LimbCorrection> apply(Pose& pose) const;
 
   size_t limbCount() const { return limbs_.size(); }
+  // Why no limb is checked (empty when some are).
+  const std::string& skipped() const { return skipped_; }
 
  private:
   struct Limb {
@@ -58,6 +61,7 @@ class LimbClearance {
   Mesh body_;
   LimbClearanceSettings settings_;
   std::vector<Limb> limbs_;
+  std::string skipped_;
 };
 
 }  // namespace swish::bake
