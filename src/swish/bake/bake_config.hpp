@@ -21,7 +21,8 @@
 //                    "speed_jitter", "seed"},
 //       "thinning": {"tolerance": 0.1} | {"target_poses": 200},
 //       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
-//                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y)},
+//                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
+//                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp)},
 //       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}
