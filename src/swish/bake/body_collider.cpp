@@ -54,30 +54,22 @@ BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& 
   if (!(cellSize > 0.f) || !std::isfinite(cellSize)) throw Error(what + ": collider cell size must be positive");
   // Edge numbering: shared sides get one index, so their pseudo-normal sums both faces.
   std::unordered_map<uint64_t, uint32_t> edgeIndex;
+  std::vector<uint32_t> edgeUses;
   triangleEdges_.resize(size_t(triangles_.rows()) * 3);
   for (Eigen::Index t = 0; t < triangles_.rows(); ++t)
     for (int k = 0; k < 3; ++k) {
       uint32_t a = triangles_(t, k), b = triangles_(t, (k + 1) % 3);
       if (a > b) std::swap(a, b);
       auto [it, inserted] = edgeIndex.try_emplace((uint64_t(a) << 32) | b, uint32_t(edgeTriangles_.size()));
-      if (inserted) edgeTriangles_.push_back({int32_t(t), -1});
+      if (inserted) edgeTriangles_.push_back({int32_t(t), -1}), edgeUses.push_back(0);
       else if (edgeTriangles_[it->second][1] < 0) edgeTriangles_[it->second][1] = int32_t(t);
+      ++edgeUses[it->second];
       triangleEdges_[size_t(t) * 3 + k] = it->second;
     }
-  // Connected parts, by union-find over the triangles' corners.
-  std::vector<uint32_t> parent(size_t(restPositions_.rows()));
-  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
-  auto find = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (Eigen::Index t = 0; t < triangles_.rows(); ++t)
-    for (int k = 1; k < 3; ++k) {
-      const uint32_t a = find(triangles_(t, 0)), b = find(triangles_(t, k));
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+  openEdges_ = size_t(std::count_if(edgeUses.begin(), edgeUses.end(), [](uint32_t u) { return u != 2; }));
+  const std::vector<uint32_t> part = connectedParts(triangles_, size_t(restPositions_.rows()));
   triangleComponent_.resize(size_t(triangles_.rows()));
-  for (Eigen::Index t = 0; t < triangles_.rows(); ++t) triangleComponent_[size_t(t)] = find(triangles_(t, 0));
+  for (Eigen::Index t = 0; t < triangles_.rows(); ++t) triangleComponent_[size_t(t)] = part[triangles_(t, 0)];
   positions_ = restPositions_;
   rebuild();
 }

@@ -39,6 +39,10 @@ class BodyCollider {
   // scratch state).
   Hit closest(const Vec3f& p, float maxDistance, int onlyPart = -1, int skipPart = -1) const;
 
+  // Edges not shared by exactly two triangles (by vertex index): 0 for a closed surface, the only
+  // kind whose inside the signed distance tells reliably.
+  size_t openEdges() const { return openEdges_; }
+
   const Points3f& positions() const { return positions_; }
   const Triangles& triangles() const { return triangles_; }
 
@@ -52,6 +56,7 @@ class BodyCollider {
   std::vector<std::array<int32_t, 2>> edgeTriangles_;  // up to two triangles per edge (-1: none)
   std::vector<uint32_t> triangleComponent_;  // connected part (by shared vertices) of each triangle
   float cellSize_;
+  size_t openEdges_ = 0;
 
   Points3f positions_;
   std::vector<Vec3f> faceNormals_, vertexNormals_, edgeNormals_;

@@ -84,6 +84,23 @@ std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, 
   return neighbours;
 }
 
+std::vector<uint32_t> connectedParts(const Triangles& tris, size_t n) {
+  // Union-find; a union hangs the larger root under the smaller, so every root is its part's minimum.
+  std::vector<uint32_t> parent(n);
+  for (uint32_t v = 0; v < n; ++v) parent[v] = v;
+  auto find = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (Eigen::Index t = 0; t < tris.rows(); ++t)
+    for (int k = 1; k < 3; ++k) {
+      const uint32_t a = find(tris(t, 0)), b = find(tris(t, k));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  for (uint32_t v = 0; v < n; ++v) parent[v] = find(v);
+  return parent;
+}
+
 VertexTriangleAdjacency buildVertexTriangleAdjacency(const Triangles& tris, size_t n,
                                                      const std::vector<uint32_t>* weld) {
   // Count per representative, then expand to every vertex of the group.

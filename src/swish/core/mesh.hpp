@@ -52,4 +52,8 @@ VertexTriangleAdjacency buildVertexTriangleAdjacency(const Triangles& tris, size
 std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, size_t vertexCount,
                                                          const std::vector<uint32_t>* weld = nullptr);
 
+// Connected parts by shared vertex indices: per vertex, the smallest vertex index of its part (a
+// vertex in no triangle is a part of its own).
+std::vector<uint32_t> connectedParts(const Triangles& tris, size_t vertexCount);
+
 }  // namespace swish
