@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 
 #include "swish/bake/body_collider.hpp"
 #include "swish/core/error.hpp"
@@ -18,22 +17,6 @@ constexpr float kSearch = 0.25f;
 constexpr float kCell = 0.05f;
 // A limb this little inside its clearance is left alone (m).
 constexpr float kTolerance = 0.001f;
-
-std::vector<uint32_t> connectedParts(const Mesh& m) {
-  std::vector<uint32_t> parent(m.vertexCount());
-  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
-  auto find = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (Eigen::Index t = 0; t < m.triangles.rows(); ++t)
-    for (int k = 1; k < 3; ++k) {
-      const uint32_t a = find(m.triangles(t, 0)), b = find(m.triangles(t, k));
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = find(v);
-  return parent;
-}
 
 int depthOf(const Skeleton& s, int j) {
   int d = 0;
@@ -59,40 +42,30 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   if (skeleton_.inverseBind.empty()) skeleton_.computeInverseBindFromRest();
 
   // Parts; the trunk is the one with the most triangles.
-  const std::vector<uint32_t> part = connectedParts(body_);
+  const std::vector<uint32_t> part = connectedParts(body_.triangles, body_.vertexCount());
   std::vector<size_t> triangleCount(body_.vertexCount(), 0);
   for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t) ++triangleCount[part[body_.triangles(t, 0)]];
   const uint32_t trunk = uint32_t(std::max_element(triangleCount.begin(), triangleCount.end()) - triangleCount.begin());
-  trunk_ = body_;
+  Mesh trunkMesh = body_;
   std::vector<Eigen::Index> keep;
   for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t)
     if (part[body_.triangles(t, 0)] == trunk) keep.push_back(t);
-  trunk_.triangles.resize(Eigen::Index(keep.size()), 3);
-  for (size_t i = 0; i < keep.size(); ++i) trunk_.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
+  trunkMesh.triangles.resize(Eigen::Index(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) trunkMesh.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
   if (keep.size() == size_t(body_.triangles.rows())) {
     skipped_ = "the body is one connected mesh: no limbs to keep apart";
     return;
   }
   // Inside and outside need a closed trunk: near the openings of an open one (a torso whose head and
   // hands are separate meshes) the sign of the distance means nothing.
-  {
-    std::map<std::pair<uint32_t, uint32_t>, int> uses;
-    for (Eigen::Index t = 0; t < trunk_.triangles.rows(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t a = trunk_.triangles(t, k), b = trunk_.triangles(t, (k + 1) % 3);
-        ++uses[{std::min(a, b), std::max(a, b)}];
-      }
-    size_t open = 0;
-    for (const auto& [edge, count] : uses) open += count != 2;
-    if (open > 0) {
-      skipped_ = "the body's trunk is not a closed surface (" + std::to_string(open) +
-                 " edges not shared by two triangles): inside and outside are undefined";
-      return;
-    }
+  trunk_.emplace(trunkMesh, kCell, what + " (trunk)");
+  if (trunk_->openEdges() > 0) {
+    skipped_ = "the body's trunk is not a closed surface (" + std::to_string(trunk_->openEdges()) +
+               " edges not shared by two triangles): inside and outside are undefined";
+    return;
   }
-
-  BodyCollider trunkCollider(trunk_, kCell, what + " (trunk)");
   const Pose rest = skeleton_.restPose();
+  BodyCollider trunkCollider = *trunk_;
   trunkCollider.pose(skeleton_.skinningMatrices(rest));
   const auto g = skeleton_.globalTransforms(rest);
   const int n = body_.skin.influences;
@@ -145,12 +118,13 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
 
   // The trunk is posed once: turning a limb moves only the few trunk vertices its blends reach, near
   // its root, where nothing is checked.
-  BodyCollider trunk(trunk_, kCell, "trunk");
+  BodyCollider trunk = *trunk_;
   trunk.pose(skeleton_.skinningMatrices(p));
   for (const Limb& limb : limbs_) {
     // How far the limb is inside its clearance, the trunk's outward direction there and the centre of
     // the offending vertices.
-    auto measure = [&](Vec3f& push, Vec3f& centre) {
+    Vec3f push = Vec3f::Zero(), centre = Vec3f::Zero();
+    auto measure = [&] {
       const std::vector<Mat4f> m = skeleton_.skinningMatrices(p);
       float worst = 0.f, total = 0.f;
       push.setZero();
@@ -172,8 +146,7 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
       if (total > 0.f) centre /= total;
       return worst;
     };
-    Vec3f push, centre;
-    const float before = measure(push, centre);
+    const float before = measure();
     if (before <= kTolerance) continue;
     const std::vector<RigidTransform> g = skeleton_.globalTransforms(p);
     const int j = limb.rootJoint, parent = skeleton_.joints[size_t(j)].parent;
@@ -187,11 +160,12 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
     axis.normalize();
     const Quatf global = g[size_t(j)].rotation, parentInv = g[size_t(parent)].rotation.conjugate();
     // The smallest whole number of degrees that clears the limb: 5-degree steps, then bisection.
+    int tried = 0;  // the turn p holds
     auto depthAt = [&](int degrees) {
+      tried = degrees;
       const Quatf turn(Eigen::AngleAxisf(float(degrees) * float(M_PI) / 180.f, axis));
       p.local[size_t(j)] = (parentInv * turn * global).normalized();
-      Vec3f unusedPush, unusedCentre;
-      return measure(unusedPush, unusedCentre);
+      return measure();
     };
     const int most = int(settings_.maxDegrees);
     int lo = 0, hi = 0;
@@ -208,7 +182,7 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
       else lo = mid;
     }
     const int degrees = hi;
-    after = depthAt(degrees);
+    if (tried != degrees) after = depthAt(degrees);
     pose.local[size_t(j)] = p.local[size_t(j)];
     c.degrees = float(degrees);
     c.depthAfter = after > kTolerance ? after : 0.f;

@@ -3,23 +3,24 @@
 //
 // A body made of separate closed parts (the embedded mannequin's torso, head, arm and leg tubes) and
 // driven by motion capture of a real person intersects itself: in the CMU clips the upper arms hang
-// straight down, and the mannequin's arm tubes then pass 4-5 cm into its torso. Cloth cannot be
+// straight down, and the mannequin's arm tubes then pass 4-7 cm into its torso. Cloth cannot be
 // outside both: a sleeve around an arm that is inside the torso is necessarily inside the body, and
 // the solver tears it trying. So before simulating, each limb that has moved into the trunk is
-// rotated about its root joint, away from the trunk, by the smallest angle that leaves a clearance
-// (a degree at a time), just as datasets of simulated clothing filter or correct self-intersecting
-// body poses. The corrected pose is the one simulated and stored, so inputs and shapes stay
-// consistent; the spine joints (the model's inputs by default) are never changed.
+// rotated about its root joint, away from the trunk, by the smallest whole number of degrees that
+// leaves a clearance, just as datasets of simulated clothing filter or correct self-intersecting
+// body poses. The bake simulates the corrected pose and stores the recorded one (dataset_builder.cpp).
 //
 // Parts are the body's connected components; the trunk is the one with the most triangles. A limb's
-// root joint is the shallowest joint weighting its vertices. Only limb vertices that lie outside the
-// trunk in the rest pose and farther than rootRadius from the root joint are checked: the root of a
-// tube starts inside the trunk by construction. A body that is one connected mesh has no parts to
-// separate, and a trunk that is not a closed surface has no inside; the poses of either are left
-// unchanged (skipped() says why).
+// root joint is the shallowest joint carrying a tenth of its skin weight. Only limb vertices that lie
+// outside the trunk in the rest pose and farther than rootRadius from the root joint are checked:
+// the root of a tube starts inside the trunk by construction. A body that is one connected mesh has
+// no parts to separate, and a trunk that is not a closed surface has no inside; the poses of either
+// are left unchanged (skipped() says why).
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "swish/bake/body_collider.hpp"
 #include "swish/core/character.hpp"
 
 namespace swish::bake {
@@ -57,8 +58,8 @@ class LimbClearance {
     std::vector<float> restDistance;  // their signed distance to the trunk at rest
   };
   Skeleton skeleton_;
-  Mesh trunk_;
   Mesh body_;
+  std::optional<BodyCollider> trunk_;  // the trunk alone, unposed: copied and posed per pose
   LimbClearanceSettings settings_;
   std::vector<Limb> limbs_;
   std::string skipped_;
