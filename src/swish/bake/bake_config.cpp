@@ -1,11 +1,11 @@
 #include "swish/bake/bake_config.hpp"
 
 #include <cctype>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "swish/core/error.hpp"
+#include "swish/runtime/json_file.hpp"
 
 namespace swish::bake {
 
@@ -280,15 +280,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
 }
 
 BakeConfig loadBakeConfig(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot open the bake config");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file.string() + ": not valid JSON: " + e.what());
-  }
-  return parseBakeConfig(j, file.string(), file.parent_path());
+  return parseBakeConfig(runtime::readJsonFile(file, "bake config"), file.string(), file.parent_path());
 }
 
 }  // namespace swish::bake

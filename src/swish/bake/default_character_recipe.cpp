@@ -2,11 +2,11 @@
 
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <set>
 
 #include "swish/core/error.hpp"
 #include "swish/core/skeleton.hpp"
+#include "swish/runtime/json_file.hpp"
 
 namespace swish::bake {
 namespace {
@@ -235,15 +235,7 @@ DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, cons
 }
 
 DefaultCharacterRecipe loadDefaultCharacterRecipe(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot open the recipe");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file.string() + ": not valid JSON (" + e.what() + ")");
-  }
-  return parseDefaultCharacterRecipe(j, file.string());
+  return parseDefaultCharacterRecipe(runtime::readJsonFile(file, "recipe"), file.string());
 }
 
 const char* embeddedDefaultRecipeJson() { return kEmbeddedRecipe; }

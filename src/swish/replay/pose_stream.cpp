@@ -1,13 +1,13 @@
 #include "swish/replay/pose_stream.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 
 #include <nlohmann/json.hpp>
 
 #include "swish/core/error.hpp"
 #include "swish/model/atomic_write.hpp"
+#include "swish/runtime/json_file.hpp"
 
 namespace swish::replay {
 
@@ -28,14 +28,7 @@ json number(float f) { return std::isfinite(f) ? json(f) : json(nullptr); }
 
 PoseStream readPoseStream(const std::filesystem::path& file) {
   const std::string src = file.string();
-  std::ifstream in(file);
-  if (!in) throw Error(src + ": cannot open the pose stream");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw Error(src + ": not valid JSON: " + e.what());
-  }
+  const json j = runtime::readJsonFile(file, "pose stream");
   if (!j.is_object() || j.value("format", "") != "swish-pose-stream")
     throw Error(src + ": format: must be \"swish-pose-stream\"");
   if (j.value("version", 0) != 1) throw Error(src + ": version: only version 1 is supported");

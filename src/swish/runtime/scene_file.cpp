@@ -1,12 +1,12 @@
 #include "swish/runtime/scene_file.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <initializer_list>
 #include <set>
 #include <sstream>
 
 #include "swish/core/error.hpp"
+#include "swish/runtime/json_file.hpp"
 
 namespace swish::runtime {
 
@@ -195,15 +195,7 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
 Scene loadScene(const std::filesystem::path& file, bool checkFiles) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw Error(file.string() + ": scene file does not exist");
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot open the scene file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw Error(file.string() + ": not valid JSON: " + e.what());
-  }
-  return parseScene(j, file, checkFiles);
+  return parseScene(readJsonFile(file, "scene file"), file, checkFiles);
 }
 
 json sceneToJson(const Scene& s) {
