@@ -5,12 +5,12 @@
 #include <string>
 
 #include "swish/bake/normal_map_pca.hpp"
+#include "swish/bake/vq_codebook.hpp"
 #include "swish/core/error.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/nearest_code.hpp"
 #include "swish/runtime/reference_pca.hpp"
 #include "swish/runtime/reference_skinning.hpp"
-#include "swish/runtime/reference_vq_decode.hpp"
 #include "swish/runtime/theta.hpp"
 
 namespace swish::bake {
@@ -33,14 +33,6 @@ DistanceStats distanceStats(std::vector<double> v) {
   return s;
 }
 
-namespace {
-NormalMapImage toImage(const runtime::DecodedNormalMap& d) {
-  NormalMapImage m{d.width, d.height, std::vector<float>(d.xy.size())};
-  for (size_t i = 0; i < d.xy.size(); ++i) m.xy[i] = runtime::snorm8ToFloat(d.xy[i]);
-  return m;
-}
-}  // namespace
-
 BakeEvaluation evaluateModel(const Model& model, const std::vector<const DatasetPose*>& heldOut,
                              const std::vector<const NormalMapImage*>& uncompressed, const PcaResult* normalPca) {
   BakeEvaluation ev;
@@ -57,7 +49,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
                   std::to_string(model.normalMaps.mapCount()) + " (and the normal-map PCA is required)");
     search = std::make_unique<runtime::NearestCodeSearch>(model.normalMaps.keys);
     for (uint32_t m = 0; m < model.normalMaps.mapCount(); ++m)
-      decoded.push_back(toImage(runtime::referenceVqDecode(model.normalMaps, m)));
+      decoded.push_back(decodeVqMap(model.normalMaps, m));
   }
   // The PCA basis as a PcaResult-like projector for the truncation error.
   const MatXf& basis = model.meshPca.basis;
