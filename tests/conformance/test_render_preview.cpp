@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "support/temp_dir.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/io/png.hpp"
 #include "swish/render/body_from_character.hpp"
@@ -150,12 +151,12 @@ TEST_F(PreviewRender, KnownFramesDrawTheJerseyOnTheMannequin) {
   // A contact sheet of the three frames: 3 thumbnails side by side, written atomically as PNG.
   const auto sheet = render::makeContactSheet(frames, {3, 80, 4});
   EXPECT_EQ(sheet.width, 3 * 80 + 4 * 4);
-  const auto path = std::filesystem::temp_directory_path() / "swish_test_contact_sheet.png";
+  const test::TempDir tmp("test_contact_sheet");
+  const auto path = tmp / "contact_sheet.png";
   render::writeContactSheet(frames, path, {3, 80, 4});
   const io::PngImage back = io::readPng(path);
   EXPECT_EQ(back.width, sheet.width);
   EXPECT_EQ(back.height, sheet.height);
-  std::filesystem::remove(path);
 }
 
 TEST_F(PreviewRender, JerseySilhouetteMatchesTheCpuReferenceProjection) {

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "support/random_model.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/bake_pipeline.hpp"
 #include "swish/bake/bake_report.hpp"
 #include "swish/bake/dataset_io.hpp"
@@ -93,8 +94,8 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   EXPECT_LE(out.evaluation.normalTotal.meanDegrees, out.evaluation.normalSelection.meanDegrees + 1.5);
   EXPECT_EQ(out.model.normalMaps.mapCount(), 24u);
 
-  const auto dir = std::filesystem::temp_directory_path() / ("swish_bake_part2_" + std::to_string(seed));
-  std::filesystem::remove_all(dir);
+  const test::TempDir tmp("bake_part2_" + std::to_string(seed));
+  const auto dir = tmp / "report";  // not there yet: writeBakeReport makes it
   const auto md = writeBakeReport(out, ds, dir);
   EXPECT_TRUE(std::filesystem::exists(md));
   EXPECT_TRUE(std::filesystem::exists(dir / "report.json"));
@@ -128,14 +129,13 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     err += (frame.positions[0].row(v) - p.gameMeshWorld.row(v)).norm();
   err = 1000.0 * err / double(frame.positions[0].rows());
   EXPECT_NEAR(err, out.evaluation.perPose[0].meanMm, 1e-3);  // same path, same answer
-  std::filesystem::remove_all(dir);
 }
 
 TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {
   const uint64_t seed = test::testSeed(502);
   const Dataset ds = syntheticDataset(seed, 60, 16);
-  const auto dir = std::filesystem::temp_directory_path() / ("swish_run_bake_" + std::to_string(seed));
-  std::filesystem::remove_all(dir);
+  const test::TempDir tmp("run_bake_" + std::to_string(seed));
+  const auto dir = tmp / "bake";  // not there yet: the DatasetWriter and runBake make what they need
   {
     DatasetWriter w(dir / "dataset", ds.character, ds.inputJoints, ds.settings, 16);
     for (const auto& p : ds.poses) w.writePose(p);
@@ -165,5 +165,4 @@ TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {
   // No dataset and no part 1 section: a clear error before any work.
   const BakeConfig none = parseBakeConfig({{"output", "o2"}}, "none.json", dir);
   EXPECT_THROW(runBake(none, o), Error);
-  std::filesystem::remove_all(dir);
 }

@@ -17,6 +17,7 @@
 
 #include "support/gpu_test.hpp"
 #include "support/paths.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/bake_pipeline.hpp"
 #include "swish/bake/dataset_io.hpp"
 #include "swish/core/error.hpp"
@@ -55,6 +56,7 @@ nlohmann::json smallConfig() {
 
 // One bake shared by the tests below (it is the expensive part).
 struct WholeBake {
+  test::TempDir tmp{"bake_whole"};  // removed when the process ends
   fs::path dir;
   BakeConfig config;
   BakeRunResult first;
@@ -64,8 +66,7 @@ struct WholeBake {
 WholeBake& sharedBake() {
   static std::unique_ptr<WholeBake> b = [] {
     auto w = std::make_unique<WholeBake>();
-    w->dir = fs::temp_directory_path() / ("swish_bake_whole_" + std::to_string(::getpid()));
-    fs::remove_all(w->dir);
+    w->dir = w->tmp / "bake";  // not there yet: runBake makes what it needs
     w->config = parseBakeConfig(smallConfig(), "whole.json", w->dir);
     BakeRunOptions o;
     o.log = [raw = w.get()](const std::string& l) { raw->lines.push_back(l); };
@@ -74,14 +75,6 @@ WholeBake& sharedBake() {
   }();
   return *b;
 }
-
-struct CleanUp : ::testing::Environment {
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(fs::temp_directory_path() / ("swish_bake_whole_" + std::to_string(::getpid())), ec);
-  }
-};
-const auto* const cleanUp = ::testing::AddGlobalTestEnvironment(new CleanUp);
 
 bool requireClip() { return fs::exists(kClip); }
 

@@ -4,15 +4,16 @@
 // out keeps the meshes unchanged, the planner's memory is the memory really allocated, and an error
 // leaves no partial outputs.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
@@ -33,9 +34,7 @@ class ReplayE2E : public test::GpuTest {
   void SetUp() override {
     test::GpuTest::SetUp();
     if (IsSkipped()) return;
-    dir_ = fs::temp_directory_path() / ("swish_replay_e2e_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = tmp_.emplace("replay_e2e").path();
     const uint64_t seed = test::testSeed(11);
     std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
     Rng rng(seed);
@@ -51,7 +50,7 @@ class ReplayE2E : public test::GpuTest {
     writeStream("walk.json", rng, 6, {});
   }
   void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
+    tmp_.reset();
     test::GpuTest::TearDown();
   }
 
@@ -89,6 +88,7 @@ class ReplayE2E : public test::GpuTest {
     return o;
   }
 
+  std::optional<test::TempDir> tmp_;  // made in SetUp, only when the test runs
   fs::path dir_;
   Model model_;
 };

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 
+#include "support/temp_dir.hpp"
 #include "swish/bake/pose_simulation.hpp"
 #include "swish/bake/simulated_pose_file.hpp"
 #include "swish/core/error.hpp"
@@ -16,15 +17,6 @@ using namespace swish::bake;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("swish_cloth_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
 
 ClothSimSettings fastSettings() {
   ClothSimSettings s;
@@ -56,8 +48,9 @@ TEST(ClothPoseDriver, ResumesWithoutLosingOrRedoingFinishedPoses) {
   std::vector<Pose> poses = somePoses(ch.skeleton, 6);
   poses[3].local[1] = Quatf(std::numeric_limits<float>::quiet_NaN(), 0, 0, 0);  // fails, and is reported
 
-  TempDir whole("whole"), resumed("resumed");
-  const PoseSimulationRun ref = simulatePoses(solver, poses, whole.path, {}, 2);
+  const test::TempDir tmp("cloth_resume");
+  const fs::path whole = tmp / "whole", resumed = tmp / "resumed";
+  const PoseSimulationRun ref = simulatePoses(solver, poses, whole, {}, 2);
   EXPECT_EQ(ref.simulated, 6u);
   EXPECT_EQ(ref.failed, 1u);
   ASSERT_EQ(ref.failures.size(), 1u);
@@ -67,7 +60,7 @@ TEST(ClothPoseDriver, ResumesWithoutLosingOrRedoingFinishedPoses) {
   // Interrupted after two poses (one thread, so exactly two are done), then run again.
   size_t calls = 0;
   const PoseSimulationRun first =
-      simulatePoses(solver, poses, resumed.path, [&](size_t done, size_t total, double left) {
+      simulatePoses(solver, poses, resumed, [&](size_t done, size_t total, double left) {
         ++calls;
         EXPECT_EQ(total, 6u);
         EXPECT_GE(left, 0.0);
@@ -76,24 +69,24 @@ TEST(ClothPoseDriver, ResumesWithoutLosingOrRedoingFinishedPoses) {
   EXPECT_TRUE(first.stopped);
   EXPECT_EQ(first.simulated, 2u);
   std::vector<fs::file_time_type> stamps;
-  for (uint32_t id : {0u, 1u}) stamps.push_back(fs::last_write_time(simulatedPosePath(resumed.path, id)));
-  const PoseSimulationRun second = simulatePoses(solver, poses, resumed.path, {}, 2);
+  for (uint32_t id : {0u, 1u}) stamps.push_back(fs::last_write_time(simulatedPosePath(resumed, id)));
+  const PoseSimulationRun second = simulatePoses(solver, poses, resumed, {}, 2);
   EXPECT_EQ(second.reused, 2u);
   EXPECT_EQ(second.simulated, 4u);
   EXPECT_FALSE(second.stopped);
   EXPECT_EQ(second.failures, ref.failures);
   for (uint32_t id : {0u, 1u})  // finished poses were not written again
-    EXPECT_EQ(fs::last_write_time(simulatedPosePath(resumed.path, id)), stamps[id]);
+    EXPECT_EQ(fs::last_write_time(simulatedPosePath(resumed, id)), stamps[id]);
   // Same results, bit for bit, as the uninterrupted run (which ran on two threads).
   for (uint32_t id = 0; id < 6; ++id) {
-    const SimulatedPoseRecord a = readSimulatedPose(simulatedPosePath(whole.path, id));
-    const SimulatedPoseRecord b = readSimulatedPose(simulatedPosePath(resumed.path, id));
+    const SimulatedPoseRecord a = readSimulatedPose(simulatedPosePath(whole, id));
+    const SimulatedPoseRecord b = readSimulatedPose(simulatedPosePath(resumed, id));
     EXPECT_EQ(a.result.ok, id != 3);
     EXPECT_EQ(a.result.ok, b.result.ok);
     EXPECT_TRUE(sameBits(a.result.positions, b.result.positions)) << "pose " << id;
   }
   // A third run has nothing left to do.
-  const PoseSimulationRun third = simulatePoses(solver, poses, resumed.path);
+  const PoseSimulationRun third = simulatePoses(solver, poses, resumed);
   EXPECT_EQ(third.simulated, 0u);
   EXPECT_EQ(third.reused, 6u);
 }
@@ -102,16 +95,17 @@ TEST(ClothPoseDriver, RedoesPosesWhoseSetupChangedOrWhoseFileIsDamaged) {
   const Character ch = test::capsuleCharacter();
   const ClothSolver solver(ch, buildSimulationMesh(ch, 0), fastSettings());
   const std::vector<Pose> poses = somePoses(ch.skeleton, 2);
-  TempDir dir("changed");
-  simulatePoses(solver, poses, dir.path);
+  const test::TempDir tmp("cloth_changed");
+  const fs::path dir = tmp / "changed";
+  simulatePoses(solver, poses, dir);
   // Damage pose 0's file: it must be detected and simulated again.
   {
-    std::fstream f(simulatedPosePath(dir.path, 0), std::ios::in | std::ios::out | std::ios::binary);
+    std::fstream f(simulatedPosePath(dir, 0), std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(60);
     f.put('\x7f');
   }
-  EXPECT_THROW(readSimulatedPose(simulatedPosePath(dir.path, 0)), Error);
-  const PoseSimulationRun again = simulatePoses(solver, poses, dir.path);
+  EXPECT_THROW(readSimulatedPose(simulatedPosePath(dir, 0)), Error);
+  const PoseSimulationRun again = simulatePoses(solver, poses, dir);
   EXPECT_EQ(again.simulated, 1u);
   EXPECT_EQ(again.reused, 1u);
   // Another material: nothing is reused.
@@ -119,7 +113,7 @@ TEST(ClothPoseDriver, RedoesPosesWhoseSetupChangedOrWhoseFileIsDamaged) {
   cotton.material = clothMaterialPreset("cotton");
   const ClothSolver other(ch, buildSimulationMesh(ch, 0), cotton);
   EXPECT_NE(other.fingerprint(), solver.fingerprint());
-  EXPECT_EQ(simulatePoses(other, poses, dir.path).simulated, 2u);
+  EXPECT_EQ(simulatePoses(other, poses, dir).simulated, 2u);
 }
 
 TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {
@@ -132,9 +126,9 @@ TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {
   rec.result.residuals.maxPenetration = 0.001f;
   rec.result.residuals.converged = true;
   rec.result.residuals.iterations = 360;
-  TempDir dir("file");
-  fs::create_directories(dir.path);
-  const fs::path file = simulatedPosePath(dir.path, 42);
+  const test::TempDir tmp("cloth_file");
+  const fs::path dir = tmp.path();
+  const fs::path file = simulatedPosePath(dir, 42);
   EXPECT_EQ(file.filename(), "pose_000042.clothsim");
   writeSimulatedPose(file, rec);
   const SimulatedPoseRecord back = readSimulatedPose(file);

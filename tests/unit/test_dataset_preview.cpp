@@ -3,8 +3,7 @@
 
 #include <filesystem>
 
-#include <unistd.h>
-
+#include "support/temp_dir.hpp"
 #include "swish/bake/dataset_preview.hpp"
 #include "swish/io/png.hpp"
 
@@ -54,8 +53,8 @@ TEST(DatasetPreview, WritesPicturesAndSummary) {
     p.residuals.converged = true;
     d.poses.push_back(p);
   }
-  const auto dir = std::filesystem::temp_directory_path() / ("swish_test_preview_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const test::TempDir tmp("test_preview");
+  const auto dir = tmp / "preview";  // not there yet: writeDatasetPreview makes it
   const auto files = writeDatasetPreview(d, dir, 2, 32);
   ASSERT_EQ(files.size(), 5u);  // 2 poses x 2 pictures + preview.json
   EXPECT_EQ(files[0].filename(), "pose_00002_front.png");
@@ -63,5 +62,4 @@ TEST(DatasetPreview, WritesPicturesAndSummary) {
   const io::PngImage im = io::readPng(files[0]);
   EXPECT_EQ(im.width, 32u);
   EXPECT_TRUE(std::filesystem::exists(dir / "preview.json"));
-  std::filesystem::remove_all(dir);
 }

@@ -1,7 +1,6 @@
 // The .swish model file and atomic writes: round trips, truncation, corruption, hostile counts,
 // version handling, and that a failed save never damages an existing file.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
@@ -11,6 +10,7 @@
 #include <vector>
 
 #include "support/random_model.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
 #include "swish/model/atomic_write.hpp"
 #include "swish/model/byte_writer.hpp"
@@ -21,32 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A fresh, empty folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("swish_test_model_file_" + std::to_string(::getpid()) + "_" + info->test_suite_name() + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  // Everything in the folder, to see that no temporary file was left behind.
-  std::vector<std::string> entries() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename().string());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
+// A fresh, empty folder per test (named after it), removed afterwards.
+using swish::test::TempDir;
 
 std::string readText(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

@@ -5,9 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>
-
 #include "support/random_model.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/io/png.hpp"
@@ -15,13 +14,6 @@
 using namespace swish;
 
 namespace {
-
-std::filesystem::path tempDir(const std::string& name) {
-  auto d = std::filesystem::temp_directory_path() / ("swish_test_png_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(d);
-  std::filesystem::create_directories(d);
-  return d;
-}
 
 io::PngImage randomImage(Rng& rng, uint32_t w, uint32_t h, uint32_t channels, uint32_t depth) {
   io::PngImage im;
@@ -40,7 +32,8 @@ io::PngImage randomImage(Rng& rng, uint32_t w, uint32_t h, uint32_t channels, ui
 
 TEST(Png, RoundTripsEveryChannelCountAtBothDepths) {
   Rng rng(test::testSeed(301));
-  const auto dir = tempDir("roundtrip");
+  const test::TempDir tmp("test_png_roundtrip");
+  const auto dir = tmp.path();
   for (uint32_t depth : {8u, 16u}) {
     for (uint32_t ch = 1; ch <= 4; ++ch) {
       const io::PngImage im = randomImage(rng, 37, 23, ch, depth);
@@ -56,7 +49,6 @@ TEST(Png, RoundTripsEveryChannelCountAtBothDepths) {
   }
   // No temporary files left behind by the atomic write.
   for (const auto& e : std::filesystem::directory_iterator(dir)) EXPECT_EQ(e.path().extension(), ".png");
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Png, NormalMapEncodingRoundTripsWithinQuantisation) {
@@ -90,7 +82,8 @@ TEST(Png, NormalMapEncodingRoundTripsWithinQuantisation) {
 }
 
 TEST(Png, ReadErrorsNameTheFile) {
-  const auto dir = tempDir("errors");
+  const test::TempDir tmp("test_png_errors");
+  const auto dir = tmp.path();
   const auto missing = dir / "missing.png";
   try {
     io::readPng(missing);
@@ -115,7 +108,6 @@ TEST(Png, ReadErrorsNameTheFile) {
       EXPECT_NE(std::string(e.what()).find(truncated.filename().string()), std::string::npos) << e.what();
     }
   }
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Png, RejectsInconsistentImages) {
