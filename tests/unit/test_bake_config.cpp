@@ -2,6 +2,7 @@
 // name the key; defaults fill what is absent; paths resolve against the config's folder.
 #include <gtest/gtest.h>
 
+#include "support/error_message.hpp"
 #include "swish/bake/bake_config.hpp"
 #include "swish/core/error.hpp"
 
@@ -10,12 +11,7 @@ using namespace swish::bake;
 
 namespace {
 std::string errorOf(const nlohmann::json& j) {
-  try {
-    parseBakeConfig(j, "recipe.json", "/base");
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return test::errorOf([&] { parseBakeConfig(j, "recipe.json", "/base"); });
 }
 }  // namespace
 

@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>
-
+#include "support/error_message.hpp"
 #include "support/random_model.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/dataset_io.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
@@ -16,12 +16,6 @@ using namespace swish::bake;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  auto d = fs::temp_directory_path() / ("swish_test_dataset_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  return d;
-}
 
 Character makeCharacter(Rng& rng) {
   test::RandomModelSpec spec;
@@ -50,13 +44,10 @@ DatasetPose makePose(Rng& rng, const Character& c, uint32_t id, uint32_t mapSize
   return p;
 }
 
-void expectErrorMentioning(const std::function<void()>& f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "expected an Error mentioning " << needle;
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+void expectErrorMentioning(const std::function<void()>& f, const std::string& needle,
+                           std::source_location where = std::source_location::current()) {
+  const std::string e = test::errorOf(f, where);
+  EXPECT_NE(e.find(needle), std::string::npos) << e;
 }
 
 }  // namespace
@@ -64,7 +55,8 @@ void expectErrorMentioning(const std::function<void()>& f, const std::string& ne
 TEST(DatasetIo, RoundTripsEverythingAndResumes) {
   Rng rng(test::testSeed(501));
   const Character c = makeCharacter(rng);
-  const fs::path dir = tempDir("roundtrip");
+  const test::TempDir tmp("test_dataset_roundtrip");
+  const fs::path dir = tmp / "dataset";
   std::vector<DatasetPose> poses;
   for (uint32_t id : {0u, 3u, 7u}) poses.push_back(makePose(rng, c, id));
   {
@@ -110,13 +102,13 @@ TEST(DatasetIo, RoundTripsEverythingAndResumes) {
   EXPECT_EQ(m.at("poses")[1].at("residuals").at("iterations").get<int>(), 103);
   EXPECT_EQ(m.at("failedPoses")[0].at("reason").get<std::string>(), "did not converge");
   EXPECT_EQ(m.at("normalMap").at("bitDepth").get<int>(), 16);
-  fs::remove_all(dir);
 }
 
 TEST(DatasetIo, CorruptOrMismatchedFilesGiveErrorsNamingTheFile) {
   Rng rng(test::testSeed(502));
   const Character c = makeCharacter(rng);
-  const fs::path dir = tempDir("corrupt");
+  const test::TempDir tmp("test_dataset_corrupt");
+  const fs::path dir = tmp / "dataset";
   DatasetWriter w(dir, c, {0}, nlohmann::json::object(), 8);
   w.writePose(makePose(rng, c, 1));
   w.writePose(makePose(rng, c, 2));
@@ -166,13 +158,13 @@ TEST(DatasetIo, CorruptOrMismatchedFilesGiveErrorsNamingTheFile) {
   // Reopening the folder for another character is refused.
   Rng other(test::testSeed(503));
   expectErrorMentioning([&] { DatasetWriter(dir, makeCharacter(other), {0}, {}); }, "character.bin");
-  fs::remove_all(dir);
 }
 
 TEST(DatasetIo, WriterRejectsPosesThatDoNotFitTheCharacter) {
   Rng rng(test::testSeed(504));
   const Character c = makeCharacter(rng);
-  const fs::path dir = tempDir("reject");
+  const test::TempDir tmp("test_dataset_reject");
+  const fs::path dir = tmp / "dataset";
   DatasetWriter w(dir, c, {0}, {});
   DatasetPose p = makePose(rng, c, 4);
   p.gameMeshWorld.conservativeResize(p.gameMeshWorld.rows() - 1, 3);
@@ -188,5 +180,4 @@ TEST(DatasetIo, WriterRejectsPosesThatDoNotFitTheCharacter) {
   EXPECT_THROW(w.writePose(p), Error);
   EXPECT_FALSE(w.hasPose(4));
   EXPECT_THROW(DatasetWriter(dir, c, {999}, {}), Error);
-  fs::remove_all(dir);
 }

@@ -11,7 +11,9 @@
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
 
+#include "support/error_message.hpp"
 #include "support/paths.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/default_character.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/animation_import.hpp"
@@ -33,14 +35,7 @@ std::string readText(const fs::path& p) {
   return s.str();
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::errorOf;
 
 const Character& sharedCharacter() {
   static const Character c = io::importCharacter(kCharacter);
@@ -187,10 +182,10 @@ TEST(IoAnimationImport, UnknownJointsAreAnError) {
     const size_t at = text.find(std::string("JOINT ") + name);
     text.replace(at + 6, std::strlen(name), std::string("Mystery") + name);
   }
-  const fs::path p = fs::temp_directory_path() / ("swish_test_unknown_" + std::to_string(::getpid()) + ".bvh");
+  const test::TempDir tmp("test_unknown");
+  const fs::path p = tmp / "clip.bvh";
   std::ofstream(p) << text;
   const std::string e = errorOf([&] { io::importAnimation(p, sharedCharacter().skeleton); });
-  fs::remove(p);
   EXPECT_NE(e.find(p.string()), std::string::npos) << e;
   EXPECT_NE(e.find("unknown joints"), std::string::npos) << e;
   EXPECT_NE(e.find("'LowerBack'"), std::string::npos) << e;
@@ -203,7 +198,8 @@ TEST(IoAnimationImport, GltfClipImportsLikeTheBvhItCameFrom) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(kClip.string(), 0);
   ASSERT_NE(scene, nullptr) << importer.GetErrorString();
-  const fs::path glb = fs::temp_directory_path() / ("swish_test_clip_" + std::to_string(::getpid()) + ".glb");
+  const test::TempDir tmp("test_clip");
+  const fs::path glb = tmp / "clip.glb";
   Assimp::Exporter exporter;
   ASSERT_EQ(exporter.Export(scene, "glb2", glb.string()), AI_SUCCESS) << exporter.GetErrorString();
   const Character c = bake::makeDefaultCharacter();
@@ -211,7 +207,6 @@ TEST(IoAnimationImport, GltfClipImportsLikeTheBvhItCameFrom) {
   io::AnimationImportOptions o;
   o.framesPerSecond = fromBvh.framesPerSecond;
   const AnimationClip fromGltf = io::importAnimation(glb, c.skeleton, o);
-  fs::remove(glb);
   ASSERT_GE(fromGltf.frames.size(), fromBvh.frames.size() - 1);
   float worst = 0;
   for (size_t f = 0; f < fromBvh.frames.size(); f += 97)

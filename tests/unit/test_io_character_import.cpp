@@ -11,7 +11,9 @@
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
 
+#include "support/error_message.hpp"
 #include "support/paths.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/default_character.hpp"
 #include "swish/io/gltf_export.hpp"
 #include "swish/core/error.hpp"
@@ -30,17 +32,10 @@ const fs::path kTestCharacter = test::sharedAsset("tshirt_lo.glb");
   GTEST_SKIP() << "the shared CC0 test character " << kTestCharacter                                 \
                << " is absent (../shared/assets beside the project); this test needs it"
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::errorOf;
 
-fs::path tempFile(const std::string& name, const std::string& bytes) {
-  fs::path p = fs::temp_directory_path() / ("swish_test_io_" + std::to_string(::getpid()) + "_" + name);
+// Writes `bytes` to `p` and returns `p`.
+fs::path writeFile(const fs::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary) << bytes;
   return p;
 }
@@ -119,24 +114,22 @@ TEST(IoCharacterImport, MissingAndCorruptFilesGiveErrorsNamingTheFile) {
   EXPECT_NE(e.find("/nonexistent/dir/char.glb"), std::string::npos) << e;
   EXPECT_NE(e.find("no such file"), std::string::npos) << e;
 
-  const fs::path junk = tempFile("junk.glb", std::string("glTF\x02\0\0\0garbage that is not a glb", 33));
+  const test::TempDir tmp("test_io");
+  const fs::path junk = writeFile(tmp / "junk.glb", std::string("glTF\x02\0\0\0garbage that is not a glb", 33));
   e = errorOf([&] { io::importCharacter(junk); });
   EXPECT_NE(e.find(junk.string()), std::string::npos) << e;
-  fs::remove(junk);
 
   if (fs::exists(kTestCharacter)) {  // a real file cut in half
     std::ifstream in(kTestCharacter, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), {});
-    const fs::path half = tempFile("half.glb", bytes.substr(0, bytes.size() / 2));
+    const fs::path half = writeFile(tmp / "half.glb", bytes.substr(0, bytes.size() / 2));
     e = errorOf([&] { io::importCharacter(half); });
     EXPECT_NE(e.find(half.string()), std::string::npos) << e;
-    fs::remove(half);
   }
   // A file with meshes but no skin.
-  const fs::path obj = tempFile("plain.obj", "o body\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const fs::path obj = writeFile(tmp / "plain.obj", "o body\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   e = errorOf([&] { io::importCharacter(obj); });
   EXPECT_NE(e.find("no skin"), std::string::npos) << e;
-  fs::remove(obj);
 }
 
 TEST(IoMeshTopology, ClosedOutwardMeshPasses) {
@@ -184,17 +177,16 @@ TEST(IoCharacterImport, FbxPathReadsWhatGltfHolds) {
   // default character's .glb, and check the FBX route (joined vertices, FBX node conventions) gives
   // the same character.
   const Character c = bake::makeDefaultCharacter();
-  const fs::path glb = tempFile("fbxsrc.glb", "");
+  const test::TempDir tmp("test_io");
+  const fs::path glb = writeFile(tmp / "fbxsrc.glb", "");
   io::writeCharacterGlb(glb, c);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(glb.string(), 0);
   ASSERT_NE(scene, nullptr) << importer.GetErrorString();
-  const fs::path fbx = fs::temp_directory_path() / ("swish_test_io_" + std::to_string(::getpid()) + "_char.fbx");
+  const fs::path fbx = tmp / "char.fbx";
   Assimp::Exporter exporter;
   ASSERT_EQ(exporter.Export(scene, "fbxa", fbx.string()), AI_SUCCESS) << exporter.GetErrorString();
   const Character back = io::importCharacter(fbx);
-  fs::remove(glb);
-  fs::remove(fbx);
   EXPECT_EQ(back.skeleton.size(), c.skeleton.size());
   ASSERT_EQ(back.body.vertexCount(), c.body.vertexCount());
   ASSERT_EQ(back.garment.vertexCount(), c.garment.vertexCount());

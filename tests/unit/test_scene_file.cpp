@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "support/error_message.hpp"
 #include "support/paths.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
 #include "swish/runtime/scene_file.hpp"
 
@@ -19,12 +21,9 @@ namespace fs = std::filesystem;
 class SceneFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("swish_scene_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
     std::ofstream(dir_ / "a.swish") << "not really a model, but it exists";
     std::ofstream(dir_ / "walk.bvh") << "HIERARCHY";
   }
-  void TearDown() override { fs::remove_all(dir_); }
   fs::path source() const { return dir_ / "scene.json"; }
 
   json valid() const {
@@ -38,16 +37,11 @@ class SceneFileTest : public ::testing::Test {
       ]})");
   }
   // The message of the Error parseScene throws for `j` (fails the test if it does not throw).
-  std::string errorOf(const json& j) const {
-    try {
-      parseScene(j, source());
-    } catch (const swish::Error& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no error for " << j.dump();
-    return {};
+  std::string errorOf(const json& j, std::source_location where = std::source_location::current()) const {
+    return swish::test::errorOf([&] { parseScene(j, source()); }, where);
   }
-  fs::path dir_;
+  const swish::test::TempDir tmp_{"scene_test"};
+  const fs::path dir_ = tmp_.path();
 };
 
 TEST_F(SceneFileTest, ValidSceneParsesWithDefaultsAndResolvedPaths) {

@@ -2,13 +2,14 @@
 // problems are Errors naming the file and JSON path, and CharacterMotion handles every kind of bad pose
 // as character_motion.hpp documents, reporting each with frame, character and joint.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 
+#include "support/error_message.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
 #include "swish/replay/character_motion.hpp"
 #include "swish/replay/pose_stream.hpp"
@@ -41,10 +42,6 @@ replay::PoseStreamFrame frame(std::vector<Quatf> r, Vec3f root = Vec3f(0, 1, 0))
   return f;
 }
 
-fs::path tempFile(const std::string& name) {
-  return fs::temp_directory_path() / ("swish_pose_stream_" + std::to_string(::getpid()) + "_" + name);
-}
-
 TEST(PoseStream, RoundTripsNaNAndMissingJoints) {
   replay::PoseStream s;
   s.framesPerSecond = 24;
@@ -52,10 +49,10 @@ TEST(PoseStream, RoundTripsNaNAndMissingJoints) {
   s.frames.push_back(frame({Quatf::Identity(), Quatf(kNaN, 0, 0, 1)}));
   s.frames.push_back(frame({Quatf::Identity(), Quatf::Identity()}, Vec3f(kNaN, 0, 0)));
   s.frames[1].present[0] = false;
-  const fs::path f = tempFile("rt.json");
+  const test::TempDir tmp("pose_stream");
+  const fs::path f = tmp / "rt.json";
   replay::writePoseStream(f, s);
   const replay::PoseStream r = replay::readPoseStream(f);
-  fs::remove(f);
   EXPECT_EQ(r.framesPerSecond, 24);
   ASSERT_EQ(r.frames.size(), 2u);
   EXPECT_TRUE(std::isnan(r.frames[0].rotations[1].w()));
@@ -66,15 +63,11 @@ TEST(PoseStream, RoundTripsNaNAndMissingJoints) {
 }
 
 TEST(PoseStream, StructuralErrorsNameFileAndPath) {
-  const fs::path f = tempFile("bad.json");
-  auto errorOf = [&](const std::string& text) {
+  const test::TempDir tmp("pose_stream");
+  const fs::path f = tmp / "bad.json";
+  auto errorOf = [&](const std::string& text, std::source_location where = std::source_location::current()) {
     std::ofstream(f) << text;
-    try {
-      replay::readPoseStream(f);
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return test::errorOf([&] { replay::readPoseStream(f); }, where);
   };
   EXPECT_NE(errorOf("{").find("not valid JSON"), std::string::npos);
   EXPECT_NE(errorOf(R"({"format": "x", "version": 1})").find("format"), std::string::npos);
@@ -84,7 +77,6 @@ TEST(PoseStream, StructuralErrorsNameFileAndPath) {
   EXPECT_NE(e.find(f.string()), std::string::npos) << e;
   EXPECT_NE(e.find("frames[1].rotations[0]: must be [x, y, z, w] or null"), std::string::npos) << e;
   EXPECT_NE(errorOf(head + R"([{"rotations": [[0, 0, 0, "w"]]}]})").find("must be a number or null"), std::string::npos);
-  fs::remove(f);
 }
 
 TEST(CharacterMotion, BadPosesAreReplacedAndReported) {

@@ -9,24 +9,15 @@
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>
-
+#include "support/error_message.hpp"
 #include "support/random_model.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/external_simulation.hpp"
 #include "swish/core/error.hpp"
 
 using namespace swish;
 using namespace swish::bake;
 namespace fs = std::filesystem;
-
-namespace {
-fs::path tempDir(const std::string& name) {
-  auto d = fs::temp_directory_path() / ("swish_test_external_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-}  // namespace
 
 TEST(ExternalSimulation, TransitionClipReimportsWithAssimpToTheSameRotations) {
   Rng rng(test::testSeed(701));
@@ -47,7 +38,8 @@ TEST(ExternalSimulation, TransitionClipReimportsWithAssimpToTheSameRotations) {
       EXPECT_GT(std::abs(frames[markers[i].targetFrame].local[j].dot(targets[i].local[j])), 1.f - 1e-6f);
     }
   }
-  const fs::path dir = tempDir("bvh");
+  const test::TempDir tmp("test_external_bvh");
+  const fs::path dir = tmp.path();
   const fs::path bvh = dir / "poses.bvh";
   writeTransitionBvh(bvh, sk, targets, s);
   ASSERT_TRUE(fs::exists(dir / "poses.bvh.markers.json"));
@@ -72,11 +64,11 @@ TEST(ExternalSimulation, TransitionClipReimportsWithAssimpToTheSameRotations) {
     }
   }
   EXPECT_EQ(checked, sk.size() * frames.size());
-  fs::remove_all(dir);
 }
 
 TEST(ExternalSimulation, ObjReaderMapsByVertexOrderAndRejectsBadFiles) {
-  const fs::path dir = tempDir("obj");
+  const test::TempDir tmp("test_external_obj");
+  const fs::path dir = tmp.path();
   const fs::path good = dir / "good.obj";
   std::ofstream(good) << "# a quad\nv 0 0 0\nv 1 0 0\r\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
                          "f 1/1/1 2/1/1 3/1/1 4/1/1\nf -4//1 -3//1 -2//1\n";
@@ -88,15 +80,12 @@ TEST(ExternalSimulation, ObjReaderMapsByVertexOrderAndRejectsBadFiles) {
   EXPECT_EQ(m.triangles.row(2), (Eigen::Matrix<uint32_t, 1, 3>() << 0, 1, 2).finished());
   EXPECT_EQ(importSimulatedPositions(good, 4), m.positions);
 
-  auto expectError = [&](const std::string& body, const std::string& needle) {
+  auto expectError = [&](const std::string& body, const std::string& needle,
+                         std::source_location where = std::source_location::current()) {
     const fs::path p = dir / "bad.obj";
     std::ofstream(p) << body;
-    try {
-      readObj(p);
-      ADD_FAILURE() << "expected an error for: " << body;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+    const std::string e = test::errorOf([&] { readObj(p); }, where);
+    EXPECT_NE(e.find(needle), std::string::npos) << e;
   };
   expectError("v 0 0\n", "bad.obj:1");
   expectError("v 0 0 0\nv 1 nan 0\n", "bad.obj:2");
@@ -113,5 +102,4 @@ TEST(ExternalSimulation, ObjReaderMapsByVertexOrderAndRejectsBadFiles) {
     EXPECT_NE(std::string(e.what()).find("good.obj"), std::string::npos);
   }
   EXPECT_THROW(readObj(dir / "missing.obj"), Error);
-  fs::remove_all(dir);
 }
