@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/paths.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/default_character.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/character_import.hpp"
@@ -20,10 +21,6 @@ using namespace swish;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempPath(const std::string& name) {
-  return fs::temp_directory_path() / ("swish_test_gltf_" + std::to_string(::getpid()) + "_" + name);
-}
 
 nlohmann::json glbJson(const std::vector<uint8_t>& glb) {
   uint32_t len = 0;
@@ -60,10 +57,10 @@ void expectSameMesh(const Mesh& a, const Mesh& b, const std::string& what) {
 
 TEST(IoGltfExport, DefaultCharacterRoundTripsThroughTheImporter) {
   const Character c = bake::makeDefaultCharacter();
-  const fs::path p = tempPath("default.glb");
+  const test::TempDir tmp("test_gltf");
+  const fs::path p = tmp / "default.glb";
   io::writeCharacterGlb(p, c);
   const Character back = io::importCharacter(p);
-  fs::remove(p);
   ASSERT_EQ(back.skeleton.size(), c.skeleton.size());
   for (size_t j = 0; j < c.skeleton.size(); ++j) {
     EXPECT_EQ(back.skeleton.joints[j].name, c.skeleton.joints[j].name);
@@ -78,10 +75,10 @@ TEST(IoGltfExport, SharedCharacterRoundTrips) {
   const fs::path shared = test::sharedAsset("tshirt_lo.glb");
   if (!fs::exists(shared)) GTEST_SKIP() << "the shared test character " << shared << " is absent";
   const Character c = io::importCharacter(shared);
-  const fs::path p = tempPath("shared.glb");
+  const test::TempDir tmp("test_gltf");
+  const fs::path p = tmp / "shared.glb";
   io::writeCharacterGlb(p, c);
   const Character back = io::importCharacter(p);
-  fs::remove(p);
   expectSameMesh(c.body, back.body, "body");
   expectSameMesh(c.garment, back.garment, "shirt");
 }
