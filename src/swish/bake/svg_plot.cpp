@@ -23,7 +23,8 @@ std::string xmlEscape(const std::string& s) {
 }
 
 namespace {
-const char* kPalette[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"};
+const char* const kPalette[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+constexpr size_t kPaletteSize = sizeof kPalette / sizeof kPalette[0];
 
 std::string fmt(double v) {
   char buf[32];
@@ -55,6 +56,7 @@ std::string SvgPlot::render() const {
     }
   if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
   if (x1 == x0) x0 -= 0.5, x1 += 0.5;
+  if (!logY && yFromZero && y0 > 0) y0 = 0;  // before widening a flat range, so that it still starts at 0
   if (y1 == y0) y0 -= 0.5, y1 += 0.5;
   if (!logY && y0 > 0 && y0 < 0.5 * y1) y0 = 0;  // anchor linear error plots at zero
   const double padY = (y1 - y0) * 0.05;
@@ -88,15 +90,44 @@ std::string SvgPlot::render() const {
     << xmlEscape(yLabel) << (logY ? " (log)" : "") << "</text>\n";
   for (size_t si = 0; si < series.size(); ++si) {
     const auto& s = series[si];
-    const std::string colour = s.colour.empty() ? kPalette[si % 6] : s.colour;
-    o << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.5\" points=\"";
+    const std::string colour = s.colour.empty() ? kPalette[si % kPaletteSize] : s.colour;
+    if (!s.markers) o << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.5\" points=\"";
     for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i]) || (logY && s.y[i] <= 0)) continue;
-      o << px(s.x[i]) << "," << py(s.y[i]) << " ";
+      if (s.markers)
+        o << "<circle cx=\"" << px(s.x[i]) << "\" cy=\"" << py(s.y[i]) << "\" r=\"3\" fill=\"" << colour
+          << "\" fill-opacity=\"0.7\"/>\n";
+      else
+        o << px(s.x[i]) << "," << py(s.y[i]) << " ";
     }
-    o << "\"/>\n<rect x=\"" << left + pw - 170 << "\" y=\"" << top + 10 + 18 * si << "\" width=\"12\" height=\"3\" fill=\""
+    if (!s.markers) o << "\"/>\n";
+    o << "<rect x=\"" << left + pw - 170 << "\" y=\"" << top + 10 + 18 * si << "\" width=\"12\" height=\"3\" fill=\""
       << colour << "\"/><text x=\"" << left + pw - 152 << "\" y=\"" << top + 15 + 18 * si << "\">" << xmlEscape(s.label)
       << "</text>\n";
+  }
+  o << "</svg>\n";
+  return o.str();
+}
+
+std::string SvgBarChart::render() const {
+  double top = 0;
+  for (double v : values)
+    if (std::isfinite(v)) top = std::max(top, v);
+  if (top <= 0) top = 1;
+  const double rowH = 22, rowsTop = 36, left = 200, right = 100;
+  const double height = rowsTop + rowH * double(labels.size()) + 30;
+  std::ostringstream o;
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  o << "<text x=\"" << width / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << xmlEscape(title) << "</text>\n";
+  for (size_t i = 0; i < labels.size(); ++i) {
+    const double y = rowsTop + rowH * double(i), v = i < values.size() && std::isfinite(values[i]) ? values[i] : 0.0;
+    const double w = v / top * (width - left - right);
+    o << "<text x=\"" << left - 6 << "\" y=\"" << y + 14 << "\" text-anchor=\"end\">" << xmlEscape(labels[i]) << "</text>\n"
+      << "<rect x=\"" << left << "\" y=\"" << y + 3 << "\" width=\"" << w << "\" height=\"" << rowH - 6 << "\" fill=\""
+      << kPalette[i % kPaletteSize] << "\"/>\n"
+      << "<text x=\"" << left + w + 4 << "\" y=\"" << y + 14 << "\">" << fmt(v) << (unit.empty() ? "" : " ")
+      << xmlEscape(unit) << "</text>\n";
   }
   o << "</svg>\n";
   return o.str();
