@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <utility>
+#include <vector>
 
+#include "swish/bake/svg_plot.hpp"
 #include "swish/model/atomic_write.hpp"
-#include "swish/replay/svg_plot.hpp"
 #include "swish/runtime/scene_file.hpp"
 
 namespace swish::replay {
@@ -198,8 +200,10 @@ std::string reportMarkdown(const json& j) {
 void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, const ModelLibrary& models, const ReplayResult& r) {
   const json j = reportJson(scene, models, r);
   std::filesystem::create_directories(dir / "plots");
-  PlotSeries cpu{"CPU total", {}, {}}, gpu{"GPU total", {}, {}}, wall{"submit to fence", {}, {}};
-  PlotSeries pos{"positions (mm)", {}, {}}, deg{"normals (deg)", {}, {}}, vsTime{"checked frames", {}, {}};
+  using bake::PlotSeries;
+  PlotSeries cpu{"CPU total", {}, {}, ""}, gpu{"GPU total", {}, {}, ""}, wall{"submit to fence", {}, {}, ""};
+  PlotSeries pos{"positions (mm)", {}, {}, ""}, deg{"normals (deg)", {}, {}, ""}, vsTime{"checked frames", {}, {}, ""};
+  vsTime.markers = true;
   for (const auto& f : r.frames) {
     const double x = f.frame;
     cpu.x.push_back(x), cpu.y.push_back(f.times.cpuTotal());
@@ -212,18 +216,26 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
       vsTime.y.push_back(f.maxPositionErrorMm());
     }
   }
-  writeTextFileAtomic(dir / "plots/time_per_frame.svg", svgLineChart({"Time per frame", "scene frame", "ms"}, {cpu, gpu, wall}));
+  auto plot = [](const char* title, const char* xLabel, const char* yLabel, std::vector<PlotSeries> series) {
+    bake::SvgPlot p;
+    p.title = title, p.xLabel = xLabel, p.yLabel = yLabel;
+    p.yFromZero = true;
+    p.width = 720, p.height = 360;
+    p.series = std::move(series);
+    return p.render();
+  };
+  writeTextFileAtomic(dir / "plots/time_per_frame.svg", plot("Time per frame", "scene frame", "ms", {cpu, gpu, wall}));
   writeTextFileAtomic(dir / "plots/error_per_frame.svg",
-                      svgLineChart({"GPU vs CPU reference, worst character", "scene frame", "error"}, {pos, deg}));
-  writeTextFileAtomic(dir / "plots/error_vs_time.svg",
-                      svgScatter({"Error against run time (checked frames)", "CPU + GPU ms per frame", "max position error (mm)"}, {vsTime}));
-  std::vector<std::string> labels;
-  std::vector<double> values;
+                      plot("GPU vs CPU reference, worst character", "scene frame", "error", {pos, deg}));
+  writeTextFileAtomic(dir / "plots/error_vs_time.svg", plot("Error against run time (checked frames)", "CPU + GPU ms per frame",
+                                                            "max position error (mm)", {vsTime}));
+  bake::SvgBarChart stages;
+  stages.title = "Median time per stage", stages.unit = "ms";
   for (const auto& st : stageColumns()) {
-    labels.push_back(st.label);
-    values.push_back(num(j["summary"]["medianMs"][st.key]));
+    stages.labels.push_back(st.label);
+    stages.values.push_back(num(j["summary"]["medianMs"][st.key]));
   }
-  writeTextFileAtomic(dir / "plots/time_per_stage.svg", svgBarChart({"Median time per stage", "ms", ""}, labels, values));
+  writeTextFileAtomic(dir / "plots/time_per_stage.svg", stages.render());
   writeTextFileAtomic(dir / "report.json", j.dump(2));
   writeTextFileAtomic(dir / "report.md", reportMarkdown(j));
 }
