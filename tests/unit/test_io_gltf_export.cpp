@@ -123,6 +123,44 @@ TEST(IoGltfExport, UnskinnedMeshesAndSeveralNodes) {
   EXPECT_FALSE(j.contains("skins"));
 }
 
+TEST(IoGltfExport, GltfTextHoldsTheGlbContentAndPreciseTranslations) {
+  const Character c = bake::makeDefaultCharacter();
+  io::GltfScene s;
+  s.generator = "test";
+  s.meshes.push_back({"a", &c.garment, false, std::nullopt, {Quatf(0.f, 0.f, 1.f, 0.f), Vec3f(2, 0, 0)}});
+  s.meshes.push_back({"b", &c.garment, false, std::nullopt, {}});
+  s.meshes.back().preciseTranslation = Eigen::Vector3d(1e4 + 1e-4, -3.25, 0.1);
+  const auto glb = io::encodeGlb(s);
+  const auto text = nlohmann::json::parse(io::encodeGltf(s));
+  // The JSON is the .glb's, the buffer moved into a base64 data URI.
+  nlohmann::json same = text;
+  const std::string uri = same["buffers"][0]["uri"].get<std::string>();
+  same["buffers"][0].erase("uri");
+  EXPECT_EQ(same, glbJson(glb));
+  const std::string prefix = "data:application/octet-stream;base64,";
+  ASSERT_EQ(uri.rfind(prefix, 0), 0u);
+  std::vector<uint8_t> bin;
+  uint32_t bits = 0;
+  int have = 0;
+  for (char ch : uri.substr(prefix.size())) {
+    if (ch == '=') break;
+    const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    bits = bits << 6 | uint32_t(alphabet.find(ch));
+    if ((have += 6) >= 8) bin.push_back(uint8_t(bits >> (have -= 8)));
+  }
+  uint32_t jsonLen = 0, binLen = 0;
+  std::memcpy(&jsonLen, glb.data() + 12, 4);
+  std::memcpy(&binLen, glb.data() + 20 + jsonLen, 4);
+  ASSERT_EQ(bin.size(), binLen);
+  EXPECT_EQ(std::memcmp(bin.data(), glb.data() + 28 + jsonLen, binLen), 0);
+  // Float transforms as before; the double translation kept exactly.
+  EXPECT_EQ(text["nodes"][0]["translation"][0], 2.0);
+  EXPECT_EQ(text["nodes"][0]["rotation"][1], 1.0);
+  EXPECT_EQ(text["nodes"][1]["translation"][0].get<double>(), 1e4 + 1e-4);
+  EXPECT_EQ(text["nodes"][1]["translation"][1].get<double>(), -3.25);
+  EXPECT_EQ(text["nodes"][1]["translation"][2].get<double>(), 0.1);
+}
+
 TEST(IoGltfExport, CommittedDefaultCharacterGlbIsCurrent) {
   const fs::path committed = test::sourceDir() / "assets/default/default_character.glb";
   ASSERT_TRUE(fs::exists(committed)) << committed;

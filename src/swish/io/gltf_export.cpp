@@ -13,7 +13,22 @@ namespace {
 constexpr int kFloat = 5126, kUnsignedShort = 5123, kUnsignedInt = 5125;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
-class GlbBuilder {
+std::string base64(const std::vector<uint8_t>& b) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string o;
+  o.reserve((b.size() + 2) / 3 * 4);
+  for (size_t i = 0; i < b.size(); i += 3) {
+    const uint32_t v = uint32_t(b[i]) << 16 | (i + 1 < b.size() ? uint32_t(b[i + 1]) << 8 : 0) | (i + 2 < b.size() ? b[i + 2] : 0);
+    o += t[v >> 18 & 63];
+    o += t[v >> 12 & 63];
+    o += i + 1 < b.size() ? t[v >> 6 & 63] : '=';
+    o += i + 2 < b.size() ? t[v & 63] : '=';
+  }
+  return o;
+}
+
+// The JSON and the binary buffer of a glTF asset, packed at the end as .glb or as .gltf text.
+class GltfBuilder {
  public:
   nlohmann::json json = nlohmann::json::object();
 
@@ -47,7 +62,15 @@ class GlbBuilder {
     return int(json["accessors"].size()) - 1;
   }
 
-  std::vector<uint8_t> finish() {
+  // .gltf: the buffer as a base64 data URI inside the JSON.
+  std::string finishGltf() {
+    while (bin_.size() % 4) bin_.push_back(0);
+    json["buffers"] = nlohmann::json::array(
+        {{{"byteLength", bin_.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin_)}}});
+    return json.dump();
+  }
+
+  std::vector<uint8_t> finishGlb() {
     while (bin_.size() % 4) bin_.push_back(0);
     json["buffers"] = nlohmann::json::array({{{"byteLength", bin_.size()}}});
     std::string text = json.dump();
@@ -77,10 +100,7 @@ class GlbBuilder {
 nlohmann::json quatJson(const Quatf& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 nlohmann::json vecJson(const Vec3f& v) { return {v.x(), v.y(), v.z()}; }
 
-}  // namespace
-
-std::vector<uint8_t> encodeGlb(const GltfScene& scene) {
-  GlbBuilder b;
+void buildScene(GltfBuilder& b, const GltfScene& scene) {
   b.json["asset"] = {{"version", "2.0"}, {"generator", scene.generator}};
   b.json["scene"] = 0;
   b.json["nodes"] = nlohmann::json::array();
@@ -173,14 +193,28 @@ std::vector<uint8_t> encodeGlb(const GltfScene& scene) {
     nlohmann::json node = {{"name", e.name}, {"mesh", b.json["meshes"].size() - 1}};
     if (skinned) node["skin"] = skin;
     else {
-      node["translation"] = vecJson(e.transform.translation);
+      const Eigen::Vector3d t = e.preciseTranslation.value_or(e.transform.translation.cast<double>());
+      node["translation"] = {t.x(), t.y(), t.z()};
       node["rotation"] = quatJson(e.transform.rotation);
     }
     b.json["nodes"].push_back(node);
     roots.push_back(b.json["nodes"].size() - 1);
   }
   b.json["scenes"] = nlohmann::json::array({{{"nodes", roots}}});
-  return b.finish();
+}
+
+}  // namespace
+
+std::vector<uint8_t> encodeGlb(const GltfScene& scene) {
+  GltfBuilder b;
+  buildScene(b, scene);
+  return b.finishGlb();
+}
+
+std::string encodeGltf(const GltfScene& scene) {
+  GltfBuilder b;
+  buildScene(b, scene);
+  return b.finishGltf();
 }
 
 void writeGlb(const std::filesystem::path& file, const GltfScene& scene) {

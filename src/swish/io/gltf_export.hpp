@@ -1,6 +1,7 @@
 #pragma once
-// glTF 2.0 binary (.glb) export of meshes, with optional skin and normal-map texture, for previews,
-// replays and the default character. Written atomically (swish::writeFileAtomic).
+// glTF 2.0 export of meshes, with optional skin and normal-map texture, for previews, replays and the
+// default character: binary (.glb), or JSON (.gltf) with the binary buffer embedded as a base64 data
+// URI (same content). .glb files are written atomically (swish::writeFileAtomic).
 //
 // Each mesh becomes one node with one primitive: POSITION, NORMAL, TANGENT and TEXCOORD_0 when the
 // Mesh has them, indices as uint32; a skinned mesh (with a skeleton in the scene) also gets
@@ -31,6 +32,9 @@ struct GltfMeshEntry {
   bool skinned = true;          // ignored when the scene has no skeleton
   std::optional<size_t> material;  // index into GltfScene::materials
   RigidTransform transform;     // node transform (unskinned meshes only; skinned ones follow the joints)
+  // When set, the node's translation in double precision instead of transform.translation (unskinned
+  // meshes only): a mesh kept local and placed 1e4 m away keeps its placement exact in the file.
+  std::optional<Eigen::Vector3d> preciseTranslation = std::nullopt;
 };
 
 struct GltfScene {
@@ -43,6 +47,9 @@ struct GltfScene {
 std::vector<uint8_t> encodeGlb(const GltfScene& scene);
 // Throws Error naming the path when it cannot be written (nothing half-written is left behind).
 void writeGlb(const std::filesystem::path& file, const GltfScene& scene);
+// The same scene as .gltf text: one JSON document, the buffer as a data:...;base64 URI (write it with
+// swish::writeTextFileAtomic).
+std::string encodeGltf(const GltfScene& scene);
 
 // A character as the importer expects it: meshes "body" and "shirt" (garment) and, when present,
 // "simulation", skinned to the skeleton; plain materials (the garment's with `garmentNormalMapPng`).
