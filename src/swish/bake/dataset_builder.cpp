@@ -16,7 +16,6 @@
 #include "swish/bake/pose_thinning.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
-#include "swish/core/skinning.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/io/character_import.hpp"
 #include "swish/model/atomic_write.hpp"
@@ -50,26 +49,6 @@ struct ProgressThrottle {
 };
 
 std::string namingName(io::JointNaming n) { return io::jointNamingName(n); }
-
-Character loadCharacter(const DatasetBuildSettings& s) {
-  if (!s.characterFile.empty()) {
-    io::CharacterImportOptions o;
-    if (!s.bodyMeshNames.empty()) o.bodyNames = s.bodyMeshNames;
-    if (!s.garmentMeshNames.empty()) o.garmentNames = s.garmentMeshNames;
-    if (!s.simulationMeshNames.empty()) o.simulationMeshNames = s.simulationMeshNames;
-    o.requiredJoints = s.inputJoints;
-    return io::importCharacter(s.characterFile, o);
-  }
-  if (!s.characterRecipe.empty()) return makeDefaultCharacter(loadDefaultCharacterRecipe(s.characterRecipe));
-  return makeDefaultCharacter();
-}
-
-// The pose as simulated and stored: root at its rest rotation and translation (see the header).
-Pose canonicalPose(const Skeleton& skeleton, Pose p) {
-  p.local[0] = skeleton.joints[0].rest.rotation;
-  p.rootTranslation = skeleton.joints[0].rest.translation;
-  return p;
-}
 
 // A digest of the thinned pose list: a different list means different pose ids.
 uint64_t poseListDigest(const std::vector<Pose>& poses) {
@@ -109,6 +88,28 @@ bool resetDatasetIfStale(const fs::path& dir, const nlohmann::json& settings,
 }
 
 }  // namespace
+
+Character loadDatasetCharacter(const DatasetBuildSettings& s) {
+  if (!s.characterFile.empty()) {
+    io::CharacterImportOptions o;
+    if (!s.bodyMeshNames.empty()) o.bodyNames = s.bodyMeshNames;
+    if (!s.garmentMeshNames.empty()) o.garmentNames = s.garmentMeshNames;
+    if (!s.simulationMeshNames.empty()) o.simulationMeshNames = s.simulationMeshNames;
+    o.requiredJoints = s.inputJoints;
+    return io::importCharacter(s.characterFile, o);
+  }
+  if (!s.characterRecipe.empty()) return makeDefaultCharacter(loadDefaultCharacterRecipe(s.characterRecipe));
+  return makeDefaultCharacter();
+}
+
+PoseShapeSettings DatasetBuildSettings::poseShape() const {
+  PoseShapeSettings p;
+  p.simulationVertices = simulationVertices;
+  p.simulation = simulation;
+  p.limbClearance = limbClearance;
+  p.transfer = transfer;
+  return p;
+}
 
 nlohmann::json DatasetBuildSettings::toJson() const {
   nlohmann::json clipList = nlohmann::json::array();
@@ -173,7 +174,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
 
   // Character and clips.
   auto t = Clock::now();
-  const Character character = loadCharacter(s);
+  const Character character = loadDatasetCharacter(s);
   std::vector<uint32_t> inputJoints;
   for (const std::string& name : s.inputJoints) {
     const int j = character.skeleton.find(name);
@@ -221,14 +222,21 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   }
   step("sampling + thinning", t);
 
+  // Clearance, simulation and transfer of one pose are PoseShapeSimulator's steps (pose_shape.hpp),
+  // shared with `swish replay --truth-every`; here each step runs over all poses in turn.
+  t = Clock::now();
+  const PoseShapeSimulator shapes(character, s.poseShape());
+  step("simulation setup", t);
+
   // Limbs out of the trunk: the corrected poses are simulated; the dataset keeps the recorded poses,
   // which are what the model sees at run time (see the transfer below).
   const std::vector<Pose> recorded = poses;
-  if (s.limbClearance.clearance > 0.f) {
+  if (shapes.clearance()) {
     t = Clock::now();
-    const LimbClearance clearance(character, s.limbClearance);
+    const LimbClearance& clearance = *shapes.clearance();
     std::vector<std::vector<LimbCorrection>> corrections(poses.size());
-    tbb::parallel_for(size_t(0), poses.size(), [&](size_t i) { corrections[i] = clearance.apply(poses[i]); });
+    tbb::parallel_for(size_t(0), poses.size(),
+                      [&](size_t i) { poses[i] = shapes.poseToSimulate(recorded[i], &corrections[i]); });
     size_t stillInside = 0;
     for (const auto& c : corrections) {
       if (!c.empty()) ++res.posesCorrected;
@@ -258,7 +266,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
 
   // Simulation (resumable per pose; failures are recorded in their files and left out).
   t = Clock::now();
-  const ClothSolver solver(character, buildSimulationMesh(character, s.simulationVertices), s.simulation);
+  const ClothSolver& solver = shapes.solver();
   res.simulationVertices = solver.mesh().vertexCount();
   log("part 1: simulation mesh " + std::to_string(res.simulationVertices) + " vertices, " +
       std::to_string(solver.mesh().triangles.rows()) + " triangles, preset '" + s.simulation.material.name + "'");
@@ -281,7 +289,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
 
   // Transfer + smoothing + normal map per pose, in parallel, each pose written when done.
   t = Clock::now();
-  const PoseTransfer transfer(character, solver.mesh().restPositions, solver.mesh().triangles, s.transfer);
   std::vector<uint32_t> todo;
   for (uint32_t id = 0; id < poses.size(); ++id) {
     const bool failed = std::any_of(sim.failures.begin(), sim.failures.end(), [&](const auto& f) { return f.first == id; });
@@ -304,18 +311,12 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
       if (!rec || !rec->result.ok) {
         failure = "simulation result missing or not usable";
       } else {
-        TransferredPose tp = transfer.transfer(poses[id], rec->result.positions);
+        // The pre-skin shape from the corrected simulation, the world shape skinned with the
+        // recorded pose (pose_shape.hpp); the dataset keeps the recorded pose.
+        TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], rec->result.positions);
         DatasetPose dp;
         dp.id = id;
-        // A pose whose limbs were turned out of the trunk: the shape before skinning comes from the
-        // corrected simulation; the pose and the world shape are the recorded ones, the world shape
-        // being that shape skinned as the run time will skin it. The model so learns its real
-        // inputs, and the sleeves of a hanging arm pass into the torso with the arm, as the body does.
         dp.pose = recorded[id];
-        if (!std::equal(poses[id].local.begin(), poses[id].local.end(), recorded[id].local.begin(),
-                        [](const Quatf& a, const Quatf& b) { return a.coeffs() == b.coeffs(); }))
-          tp.gameMeshWorld = skinPositions(tp.gameMeshPreSkin, character.garment.skin,
-                                           character.skeleton.skinningMatrices(recorded[id]));
         dp.gameMeshWorld = std::move(tp.gameMeshWorld);
         dp.gameMeshPreSkin = std::move(tp.gameMeshPreSkin);
         dp.normalMap = std::move(tp.normalMap);

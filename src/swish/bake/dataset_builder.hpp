@@ -27,6 +27,7 @@
 #include "swish/bake/cloth_solver.hpp"
 #include "swish/bake/dataset_io.hpp"
 #include "swish/bake/pose_sampling.hpp"
+#include "swish/bake/pose_shape.hpp"
 #include "swish/bake/pose_transfer.hpp"
 #include "swish/bake/limb_clearance.hpp"
 #include "swish/bake/simulation_mesh.hpp"
@@ -71,7 +72,14 @@ struct DatasetBuildSettings {
 
   // Every setting as JSON (for the dataset manifest and the rebuild check above).
   nlohmann::json toJson() const;
+  // The settings of the one-pose simulation (pose_shape.hpp); poseShapeSettingsFromJson(toJson())
+  // gives them back.
+  PoseShapeSettings poseShape() const;
 };
+
+// The character the settings name: the embedded default, the default from a recipe file, or an
+// imported glTF/FBX file. Throws Error naming the file on failure.
+Character loadDatasetCharacter(const DatasetBuildSettings& settings);
 
 struct DatasetBuildStep {
   std::string name;
