@@ -14,6 +14,7 @@
 // The bake keeps steps 1-3 apart (clearance over all poses first, then resumable per-pose simulation
 // files), so each step is its own call; simulate() runs them all for one pose. Everything is const and
 // deterministic: poses may be simulated on several threads at once with bitwise the same results.
+#include <optional>
 #include <string>
 #include <vector>
 

@@ -1,9 +1,16 @@
 #include "swish/replay/replay_engine.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include "swish/core/error.hpp"
 #include "swish/gpu/frame_recorder.hpp"
@@ -55,9 +62,22 @@ struct Batch {
   std::vector<CharacterMotion> motions;
   std::unique_ptr<gpu::GpuModel> gpuModel;
   std::unique_ptr<gpu::FrameRecorder> recorder;
+  std::unique_ptr<ModelTruth> truth;  // when ground truth was asked for
   // Per frame scratch.
+  std::vector<Pose> poses;
   std::vector<float> theta, meshWeights, codes;
   runtime::FrameKernelInputs inputs;
+};
+
+// One character's truth simulation, waiting for a batch of them to run in parallel.
+struct TruthJob {
+  size_t frame = 0;  // index into ReplayResult::frames
+  size_t slot = 0;   // index into that frame's truth
+  uint32_t character = 0;
+  const ModelTruth* truth = nullptr;
+  Pose pose;
+  Points3f positions;
+  std::optional<runtime::BlendedNormalMap> normalMap;
 };
 
 struct ReplayEngine::Impl {
@@ -68,10 +88,17 @@ struct ReplayEngine::Impl {
   std::optional<gpu::Context> ownContext;
   gpu::Context* ctx = nullptr;
   std::vector<Batch> batches;
+  // Ground truth.
+  std::vector<TruthJob> truthJobs;
+  std::vector<TruthPool> truthPools;  // per scene character
+  TruthPool truthOverall;
+  uint32_t truthDone = 0, truthTotal = 0;
 
   Impl(const runtime::Scene& s, ModelLibrary& m, const ReplayOptions& o) : scene(s), models(m), options(o) {}
   void setUp();
+  bool truthFrame(uint32_t index) const;
   FrameRecord runFrame(uint32_t index, ReplayResult& result);
+  void runTruth(ReplayResult& result);
 };
 
 void ReplayEngine::Impl::setUp() {
@@ -122,7 +149,16 @@ void ReplayEngine::Impl::setUp() {
     ro.tangentFrames = B.planned->tangentFrames;
     ro.normalMaps = B.planned->normalMaps;
     B.recorder = std::make_unique<gpu::FrameRecorder>(*ctx, *B.gpuModel, uint32_t(B.planned->characters.size()), ro);
+    // Ground truth needs the run time's outputs, hence GPU work.
+    if (options.truth.every > 0) B.truth = std::make_unique<ModelTruth>(models.at(B.planned->model), options.truth);
   }
+}
+
+bool ReplayEngine::Impl::truthFrame(uint32_t index) const {
+  if (options.truth.every == 0 || index % options.truth.every != 0) return false;
+  for (const Batch& B : batches)
+    if (B.truth && B.truth->available()) return true;
+  return false;
 }
 
 FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
@@ -139,7 +175,8 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
     const uint32_t n = uint32_t(B.planned->characters.size());
     const size_t jc = m.skeleton.size(), ts = size_t(m.thetaSize()), k = size_t(m.meshComponents());
     auto t0 = Clock::now();
-    std::vector<Pose> poses;
+    std::vector<Pose>& poses = B.poses;
+    poses.clear();
     poses.reserve(n);
     B.inputs.instanceCount = n;
     B.inputs.skinMatrices.resize(n * jc);
@@ -184,7 +221,8 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
   }
 
   const bool check = plan.gpuWork && index % scene.outputs.gpuCheckEvery == 0;
-  const bool readBack = plan.gpuWork && (check || options.onCharacterOutput);
+  rec.truthFrame = truthFrame(index);
+  const bool readBack = plan.gpuWork && (check || rec.truthFrame || options.onCharacterOutput);
   if (plan.gpuWork) {
     // The reference needs each character's normal map as the GPU had it before this frame.
     std::vector<std::vector<runtime::BlendedNormalMap>> prevMaps(batches.size());
@@ -235,6 +273,21 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
             rec.checks.push_back(c);
           }
         }
+        if (rec.truthFrame && B.truth && B.truth->available())
+          for (uint32_t i = 0; i < B.planned->characters.size(); ++i) {
+            TruthJob job;
+            job.frame = result.frames.size();  // the index this record gets
+            job.slot = rec.truth.size();
+            job.character = B.planned->characters[i];
+            job.truth = B.truth.get();
+            job.pose = B.poses[i];
+            job.positions = gpuOut.positions[i];
+            if (B.truth->normalMaps() && i < gpuOut.normalMaps.size()) job.normalMap = gpuOut.normalMaps[i];
+            rec.truth.push_back({});
+            rec.truth.back().character = job.character;
+            rec.truth.back().failure = "not simulated yet";
+            truthJobs.push_back(std::move(job));
+          }
         if (options.onCharacterOutput)
           for (uint32_t i = 0; i < B.planned->characters.size(); ++i)
             options.onCharacterOutput(rec.frame, B.planned->characters[i], gpuOut, i);
@@ -246,6 +299,39 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
   for (auto& i : issues)
     if (result.issues.size() < kMaxIssues) result.issues.push_back(std::move(i));
   return rec;
+}
+
+// Runs the gathered truth simulations in parallel, one task each (a pose takes about a second, so
+// nothing is gained by grouping them), then stores and pools the results in job order.
+void ReplayEngine::Impl::runTruth(ReplayResult& result) {
+  if (truthJobs.empty()) return;
+  const auto t0 = Clock::now();
+  std::vector<TruthMeasurement> out(truthJobs.size());
+  std::mutex mutex;
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, truthJobs.size(), 1),
+      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t k = range.begin(); k != range.end(); ++k) {
+          const TruthJob& j = truthJobs[k];
+          // Isolated: while the transfer's inner parallel loops wait, this thread must not pick up
+          // another pose, whose second of simulation would then count in this pose's time.
+          tbb::this_task_arena::isolate(
+              [&] { out[k] = j.truth->measure(j.pose, j.positions, j.normalMap ? &*j.normalMap : nullptr); });
+          std::lock_guard<std::mutex> lock(mutex);
+          ++truthDone;
+          if (options.truthProgress) options.truthProgress(truthDone, truthTotal);
+        }
+      },
+      tbb::simple_partitioner());
+  result.truthWallSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  for (size_t k = 0; k < truthJobs.size(); ++k) {
+    const TruthJob& j = truthJobs[k];
+    out[k].summary.character = j.character;
+    result.frames[j.frame].truth[j.slot] = out[k].summary;
+    truthPools[j.character].add(out[k]);
+    truthOverall.add(out[k]);
+  }
+  truthJobs.clear();
 }
 
 ReplayEngine::ReplayEngine(const runtime::Scene& scene, ModelLibrary& models, const ReplayOptions& options)
@@ -262,20 +348,45 @@ ReplayResult ReplayEngine::run() {
   ReplayResult r;
   r.plan = I.plan;
   r.device = I.ctx ? I.ctx->deviceName() : std::string("(no GPU work planned)");
-  if (I.options.truthEvery > 0)
-    r.truthNote = "--truth-every " + std::to_string(I.options.truthEvery) +
-                  ": no ground truth: the source simulation needs the model's bake character (body mesh, simulation mesh, "
-                  "cloth settings), which a .swish file does not carry, and the bake has no API yet from a model back to its "
-                  "recipe";
-  else
+  const uint32_t every = I.options.truth.every;
+  r.truthEvery = every;
+  if (every == 0) {
     r.truthNote = "no per-frame ground truth requested (--truth-every N); a baked model's held-out-pose errors (its "
                   "metadata) are quoted under Models";
+  } else if (!I.plan.gpuWork || I.batches.empty()) {
+    r.truthNote = "--truth-every " + std::to_string(every) + ": no ground truth: no GPU work is planned (no character on "
+                  "screen, or outputs that need no meshes), so there is no run-time output to measure";
+  } else {
+    // Per model: what its truth simulates, or why it has none.
+    uint32_t characters = 0;
+    for (const Batch& B : I.batches) {
+      if (!r.truthNote.empty()) r.truthNote += "; ";
+      const bool ok = B.truth && B.truth->available();
+      r.truthNote += "model '" + B.planned->model + "': " + (ok ? "ground truth every " + std::to_string(every) +
+                                                                       " frames from " : "no ground truth: ") +
+                     (B.truth ? B.truth->note() : std::string("not prepared"));
+      if (ok) characters += uint32_t(B.planned->characters.size());
+    }
+    I.truthTotal = characters * ((I.scene.frameCount + every - 1) / every);
+    I.truthPools = std::vector<TruthPool>(I.scene.characters.size());
+  }
   // Per-model ground truth: the bake's error on held-out poses, when the model's metadata has it.
   for (const auto& e : I.models.entries())
     if (e->model.metadata.find("\"held_out_poses\"") != std::string::npos) r.truthAvailable = true;
+  // Truth simulations wait until a few frames' worth can run in parallel (bounded memory: a job holds
+  // one character's output and normal map).
+  const size_t truthBatch = size_t(std::max(16, 4 * tbb::this_task_arena::max_concurrency()));
   for (uint32_t f = 0; f < I.scene.frameCount; ++f) {
     r.frames.push_back(I.runFrame(f, r));
+    if (r.frames.back().truthFrame) ++r.truthFrames;
     if (I.options.progress) I.options.progress(f + 1, I.scene.frameCount);
+    if (I.truthJobs.size() >= truthBatch) I.runTruth(r);
+  }
+  I.runTruth(r);
+  if (!I.truthPools.empty()) {
+    for (const TruthPool& p : I.truthPools) r.truthPerCharacter.push_back(p.summary());
+    r.truthOverall = I.truthOverall.summary();
+    if (r.truthOverall.samples > 0) r.truthAvailable = true;
   }
   // With validation on, a validation message is a failure of the run like a wrong output.
   if (I.ctx && I.ctx->validationEnabled())

@@ -12,8 +12,13 @@
 // Errors measured: on every outputs.gpuCheckEvery-th frame, the GPU outputs of that frame against the
 // CPU reference (runtime::referenceFrame) fed the same inputs and the GPU's previous normal maps:
 // positions (mm), normals and tangents (degrees), normal maps (snorm16 steps), per character.
-// Ground truth (per-vertex error against the source simulation) needs a model whose bake character is
-// at hand; ReplayResult::truthNote says why it is not available.
+// Ground truth (ReplayOptions::truth, `--truth-every N`; truth_simulation.hpp): on every Nth frame each
+// on-screen character's pose is simulated by the bake's source simulation and the frame's GPU output
+// is measured against it: per-vertex error (mm) and normal-map angular error (degrees), per character
+// and overall. The simulations of a frame run after it, outside the timed stages, in parallel (TBB;
+// several truth frames are gathered before they run), and each result lands in its own slot, so the
+// figures do not depend on the schedule. A model whose bake character cannot be rebuilt gets no
+// truth; ReplayResult::truthNote says why.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -22,6 +27,7 @@
 #include "swish/gpu/context.hpp"
 #include "swish/replay/character_motion.hpp"
 #include "swish/replay/model_library.hpp"
+#include "swish/replay/truth_simulation.hpp"
 #include "swish/runtime/planner.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/scene.hpp"
@@ -31,8 +37,10 @@ namespace swish::replay {
 struct ReplayOptions {
   gpu::ContextOptions device;
   gpu::Context* context = nullptr;  // use this device instead of creating one (tests, hosts)
-  uint32_t truthEvery = 0;          // 0: none; N: ask for ground truth on every Nth frame
+  TruthOptions truth;               // truth.every 0: none; N: ground truth on every Nth frame
   std::function<void(uint32_t framesDone, uint32_t framesTotal)> progress;
+  // Truth simulations done of those planned (called from worker threads, one call at a time).
+  std::function<void(uint32_t posesDone, uint32_t posesTotal)> truthProgress;
   // Called after each frame with its GPU outputs read back (local, character space), per on-screen
   // character in plan order; only on frames where outputs are read back (checks, meshes, normalMaps).
   std::function<void(uint32_t sceneFrame, uint32_t character, const runtime::ReferenceFrameOutputs& batchOutputs,
@@ -62,6 +70,8 @@ struct FrameRecord {
   bool checked = false;
   std::vector<CharacterCheck> checks;  // when checked
   uint32_t poseIssues = 0;
+  bool truthFrame = false;             // on the --truth-every grid, with a model that has truth
+  std::vector<CharacterTruth> truth;   // when truthFrame: per on-screen character with truth, plan order
   double maxPositionErrorMm() const;
   double maxNormalErrorDeg() const;
   int maxMapErrorSteps() const;
@@ -81,8 +91,14 @@ struct ReplayResult {
   std::vector<PoseIssue> issues;  // the first kMaxIssues
   size_t issueCount = 0;
   std::vector<std::string> failures;  // checks beyond tolerance, in words
-  bool truthAvailable = false;
+  bool truthAvailable = false;  // some ground truth is in the result: per-frame truth or a model's held-out figures
   std::string truthNote;
+  // Per-frame ground truth (ReplayOptions::truth).
+  uint32_t truthEvery = 0;
+  uint32_t truthFrames = 0;                     // frames with truth simulations
+  double truthWallSeconds = 0;                  // wall time of the truth simulations (all threads together)
+  std::vector<TruthSummary> truthPerCharacter;  // per scene character (empty when no truth ran)
+  TruthSummary truthOverall;
   bool failed() const { return !failures.empty() || issueCount > 0; }
 };
 

@@ -91,6 +91,10 @@ ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions
     bar.update(d, t);
     if (user) user(d, t);
   };
+  eo.truthProgress = [&, user = options.engine.truthProgress](uint32_t d, uint32_t t) {
+    bar.truth(d, t);
+    if (user) user(d, t);
+  };
   ReplayEngine engine(scene, models, eo);
   ReplayJobResult r;
   r.result = engine.run();

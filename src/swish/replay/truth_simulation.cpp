@@ -1,0 +1,263 @@
+#include "swish/replay/truth_simulation.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "swish/bake/bake_evaluation.hpp"
+#include "swish/bake/dataset_builder.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/skinning.hpp"
+
+namespace swish::replay {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Rest data written by code and read back from a float32 file: equal, but allow float noise.
+constexpr float kSameTolerance = 1e-5f;
+
+std::string str(const json& j, const char* key) {
+  return j.is_object() && j.contains(key) && j.at(key).is_string() ? j.at(key).get<std::string>() : std::string();
+}
+std::vector<std::string> strings(const json& j, const char* key) {
+  std::vector<std::string> out;
+  if (j.is_object() && j.contains(key) && j.at(key).is_array())
+    for (const auto& e : j.at(key))
+      if (e.is_string()) out.push_back(e.get<std::string>());
+  return out;
+}
+
+// A file the bake named: as written, else beside the model file.
+fs::path findBakeFile(const std::string& name, const ModelEntry& entry) {
+  std::error_code ec;
+  if (fs::is_regular_file(name, ec)) return name;
+  if (!entry.file.empty() && fs::path(name).is_relative() && fs::is_regular_file(entry.file.parent_path() / name, ec))
+    return entry.file.parent_path() / name;
+  return {};
+}
+
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+std::string fmtNum(const char* f, double v) {
+  char s[64];
+  std::snprintf(s, sizeof s, f, v);
+  return s;
+}
+
+template <class A, class B>
+bool near(const A& a, const B& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && (a.size() == 0 || (a - b).cwiseAbs().maxCoeff() <= kSameTolerance);
+}
+
+}  // namespace
+
+std::string characterDifference(const Model& model, const Character& ch) {
+  const Skeleton& a = model.skeleton;
+  const Skeleton& b = ch.skeleton;
+  if (a.size() != b.size())
+    return "the skeleton has " + std::to_string(b.size()) + " joints, the model's " + std::to_string(a.size());
+  for (size_t j = 0; j < a.size(); ++j) {
+    const Joint& x = a.joints[j];
+    const Joint& y = b.joints[j];
+    if (x.name != y.name || x.parent != y.parent) return "joint " + std::to_string(j) + " is '" + y.name + "', the model's '" + x.name + "'";
+    const bool sameRotation = (x.rest.rotation.coeffs() - y.rest.rotation.coeffs()).cwiseAbs().maxCoeff() <= kSameTolerance ||
+                              (x.rest.rotation.coeffs() + y.rest.rotation.coeffs()).cwiseAbs().maxCoeff() <= kSameTolerance;
+    if (!near(x.rest.translation, y.rest.translation) || !sameRotation)
+      return "joint '" + x.name + "' has another rest transform";
+  }
+  const Mesh& m = model.gameMesh;
+  const Mesh& g = ch.garment;
+  if (m.vertexCount() != g.vertexCount() || m.triangleCount() != g.triangleCount())
+    return "the game mesh has " + std::to_string(g.vertexCount()) + " vertices and " + std::to_string(g.triangleCount()) +
+           " triangles, the model's " + std::to_string(m.vertexCount()) + " and " + std::to_string(m.triangleCount());
+  if (m.triangles != g.triangles) return "the game mesh's triangles differ";
+  if (!near(m.positions, g.positions)) return "the game mesh's rest positions differ";
+  if (!near(m.uvs, g.uvs)) return "the game mesh's UVs differ";
+  if (m.skin.influences != g.skin.influences || m.skin.joints != g.skin.joints ||
+      m.skin.weights.size() != g.skin.weights.size())
+    return "the game mesh's skin weights differ";
+  for (size_t i = 0; i < m.skin.weights.size(); ++i)
+    if (std::abs(m.skin.weights[i] - g.skin.weights[i]) > kSameTolerance) return "the game mesh's skin weights differ";
+  return {};
+}
+
+ModelTruth::ModelTruth(const ModelEntry& entry, const TruthOptions& options) : model_(&entry.model) {
+  try {
+    prepare(entry, options);
+  } catch (const std::exception& e) {  // a metadata shape nobody foresaw: still no truth rather than no replay
+    note_ = std::string("the bake's source simulation cannot be rebuilt: ") + e.what();
+    simulator_.reset();
+    character_.reset();
+  }
+}
+
+void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
+  if (entry.procedural) {
+    note_ = "the procedural stand-in model was not baked from a simulation: no source simulation to run";
+    return;
+  }
+  const json meta = json::parse(entry.model.metadata, nullptr, false);
+  if (meta.is_discarded() || !meta.is_object() || !meta.contains("dataset_settings") || !meta["dataset_settings"].is_object()) {
+    note_ = "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character and "
+            "cloth settings of its source simulation are unknown";
+    return;
+  }
+  const json& ds = meta["dataset_settings"];
+  const json chj = ds.value("character", json::object());
+  bake::DatasetBuildSettings s;
+  std::string how = "the embedded default character, rebuilt by code";
+  if (const std::string file = str(chj, "file"); !file.empty()) {
+    s.characterFile = findBakeFile(file, entry);
+    if (s.characterFile.empty()) {
+      note_ = "the bake's character file " + file + " is not at hand (looked as written and beside the model)";
+      return;
+    }
+    s.bodyMeshNames = strings(chj, "body_mesh");
+    s.garmentMeshNames = strings(chj, "garment_mesh");
+    s.simulationMeshNames = strings(chj, "simulation_mesh");
+    how = "imported from " + s.characterFile.string();
+  } else if (const std::string recipe = str(chj, "recipe"); !recipe.empty()) {
+    s.characterRecipe = findBakeFile(recipe, entry);
+    if (s.characterRecipe.empty()) {
+      note_ = "the bake's character recipe " + recipe + " is not at hand (looked as written and beside the model)";
+      return;
+    }
+    how = "the default character from recipe " + s.characterRecipe.string();
+  }
+  s.inputJoints = strings(ds, "input_joints");
+  if (s.inputJoints.empty())
+    for (uint32_t j : entry.model.inputJoints) s.inputJoints.push_back(entry.model.skeleton.joints[j].name);
+  try {
+    character_ = std::make_unique<Character>(bake::loadDatasetCharacter(s));
+  } catch (const Error& e) {
+    note_ = std::string("the bake's character cannot be rebuilt: ") + e.what();
+    return;
+  }
+  if (const std::string diff = characterDifference(entry.model, *character_); !diff.empty()) {
+    note_ = "the rebuilt character '" + character_->name + "' (" + how + ") is not the model's: " + diff;
+    character_.reset();
+    return;
+  }
+  bake::PoseShapeSettings ps;
+  try {
+    ps = bake::poseShapeSettingsFromJson(ds, "model metadata dataset_settings");
+  } catch (const Error& e) {
+    note_ = e.what();
+    return;
+  }
+  std::string overridden;
+  if (options.simulationVertices) {
+    ps.simulationVertices = *options.simulationVertices;
+    overridden += " simulation vertices";
+  }
+  if (options.substeps) {
+    ps.simulation.substeps = *options.substeps;
+    overridden += " substeps";
+  }
+  try {
+    simulator_ = std::make_unique<bake::PoseShapeSimulator>(*character_, ps);
+  } catch (const Error& e) {
+    note_ = std::string("the source simulation cannot be set up: ") + e.what();
+    return;
+  }
+  std::string mapNote;
+  normalMaps_ = options.normalMaps && !entry.model.normalMaps.empty();
+  if (normalMaps_ && (ps.transfer.normalMap.width != entry.model.normalMaps.width ||
+                      ps.transfer.normalMap.height != entry.model.normalMaps.height)) {
+    normalMaps_ = false;
+    mapNote = "; normal maps not measured: the bake's are " + std::to_string(ps.transfer.normalMap.width) + " px, the model's " +
+              std::to_string(entry.model.normalMaps.width);
+  }
+  const bake::ClothSimSettings& cs = ps.simulation;
+  note_ = "the bake's source simulation of character '" + character_->name + "' (" + how + "): " +
+          std::to_string(simulator_->solver().mesh().vertexCount()) + " simulation vertices, preset '" + cs.material.name +
+          "', " + std::to_string(cs.substeps) + " substeps x " + std::to_string(cs.iterations) + " iterations at " +
+          fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) + " s transition + " +
+          fmtNum("%g", cs.settleSeconds) + " s settle, limb clearance " + fmtNum("%g", 1000.0 * ps.limbClearance.clearance) +
+          " mm, smoothing " + std::to_string(ps.transfer.smoothing.iterations) + " x " +
+          fmtNum("%g", ps.transfer.smoothing.strength) +
+          (overridden.empty() ? std::string() : "; overridden for this run (not the bake's):" + overridden) + mapNote;
+}
+
+ModelTruth::~ModelTruth() = default;
+
+TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions,
+                                     const runtime::BlendedNormalMap* normalMap) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = threadCpuSeconds();
+  TruthMeasurement m;
+  const bake::PoseShape shape = simulator_->simulate(bake::canonicalPose(character_->skeleton, pose));
+  m.summary.limbCorrections = uint32_t(shape.corrections.size());
+  if (!shape.ok) {
+    m.summary.failure = shape.failure;
+  } else if (positions.rows() != shape.gameMeshPreSkin.rows()) {
+    m.summary.failure = "the run time output has " + std::to_string(positions.rows()) + " vertices, the truth " +
+                        std::to_string(shape.gameMeshPreSkin.rows());
+  } else {
+    // Skinned as the run time skins the prediction: the model's skeleton and weights, the whole pose.
+    const Points3f truth = skinPositions(shape.gameMeshPreSkin, model_->gameMesh.skin, model_->skeleton.skinningMatrices(pose));
+    m.vertexMm.resize(size_t(truth.rows()));
+    for (Eigen::Index v = 0; v < truth.rows(); ++v) {
+      const double d = (positions.row(v).cast<double>() - truth.row(v).cast<double>()).norm() * 1000.0;
+      m.vertexMm[size_t(v)] = std::isfinite(d) ? d : 1e30;  // a non-finite output must not hide
+    }
+    const bake::DistanceStats st = bake::distanceStats(m.vertexMm);
+    m.summary.ok = true;
+    m.summary.meanMm = st.mean, m.summary.p95Mm = st.p95, m.summary.maxMm = st.max;
+    if (normalMaps_ && normalMap && normalMap->width == shape.normalMap.width && normalMap->height == shape.normalMap.height) {
+      bake::NormalMapImage shown{normalMap->width, normalMap->height, std::vector<float>(normalMap->xy.size())};
+      for (size_t i = 0; i < shown.xy.size(); ++i) shown.xy[i] = runtime::snorm16ToFloat(normalMap->xy[i]);
+      m.angles = std::make_unique<bake::AngularErrorAccumulator>();
+      m.angles->addMaps(shape.normalMap, shown);
+      const bake::AngularErrorStats a = m.angles->stats();
+      m.summary.normalMap = true;
+      m.summary.meanDeg = a.meanDegrees, m.summary.p95Deg = a.p95Degrees, m.summary.maxDeg = a.maxDegrees;
+    }
+  }
+  m.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  m.summary.cpuSeconds = threadCpuSeconds() - cpu0;
+  return m;
+}
+
+void TruthPool::add(const TruthMeasurement& m) {
+  seconds_ += m.summary.seconds;
+  cpuSeconds_ += m.summary.cpuSeconds;
+  if (!m.summary.ok) {
+    ++failed_;
+    return;
+  }
+  ++samples_;
+  vertexMm_.insert(vertexMm_.end(), m.vertexMm.begin(), m.vertexMm.end());
+  if (m.angles) {
+    if (!angles_) angles_ = std::make_unique<bake::AngularErrorAccumulator>();
+    angles_->merge(*m.angles);
+  }
+}
+
+TruthSummary TruthPool::summary() const {
+  TruthSummary s;
+  s.samples = samples_, s.failed = failed_, s.seconds = seconds_, s.cpuSeconds = cpuSeconds_;
+  if (!vertexMm_.empty()) {
+    const bake::DistanceStats d = bake::distanceStats(vertexMm_);
+    s.meanMm = d.mean, s.p95Mm = d.p95, s.maxMm = d.max;
+  }
+  if (angles_) {
+    const bake::AngularErrorStats a = angles_->stats();
+    s.normalMaps = true;
+    s.meanDeg = a.meanDegrees, s.p95Deg = a.p95Degrees, s.maxDeg = a.maxDegrees;
+  }
+  return s;
+}
+
+}  // namespace swish::replay
