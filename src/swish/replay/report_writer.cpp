@@ -54,6 +54,25 @@ std::string fmt(double v, const char* f = "%.4g") {
 }
 double num(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
 
+// Pooled ground truth; figures only where something was measured (null would read as zero error).
+json truthJson(const TruthSummary& t) {
+  json j{{"samples", t.samples}, {"failed", t.failed}, {"seconds", t.seconds}, {"cpuSeconds", t.cpuSeconds}};
+  if (t.samples > 0) {
+    j["meanMm"] = t.meanMm, j["p95Mm"] = t.p95Mm, j["maxMm"] = t.maxMm;
+    if (t.normalMaps) j["normalMeanDeg"] = t.meanDeg, j["normalP95Deg"] = t.p95Deg, j["normalMaxDeg"] = t.maxDeg;
+  }
+  return j;
+}
+
+// Mean over a frame's measured characters of their mean vertex error, and the worst max; NaN if none.
+std::pair<double, double> frameTruthMm(const FrameRecord& f) {
+  double sum = 0, worst = 0;
+  int n = 0;
+  for (const auto& c : f.truth)
+    if (c.ok) sum += c.meanMm, worst = std::max(worst, c.maxMm), ++n;
+  return n ? std::make_pair(sum / n, worst) : std::make_pair(double(NAN), double(NAN));
+}
+
 }  // namespace
 
 json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const ReplayResult& r) {
@@ -76,7 +95,12 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
       j["models"].back()["heldOutErrors"] = meta["errors"];
   }
   j["plan"] = r.plan.toJson();
-  j["truth"] = {{"available", r.truthAvailable}, {"note", r.truthNote}};
+  j["truth"] = {{"available", r.truthAvailable}, {"note", r.truthNote}, {"every", r.truthEvery}};
+  if (r.truthEvery > 0) {
+    j["truth"]["frames"] = r.truthFrames;
+    j["truth"]["wallSeconds"] = r.truthWallSeconds;
+    j["truth"]["overall"] = truthJson(r.truthOverall);
+  }
   j["frames"] = json::array();
   std::vector<json> perChar(scene.characters.size());
   for (size_t c = 0; c < scene.characters.size(); ++c)
@@ -87,6 +111,20 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
     for (const auto& s : stageColumns()) t[s.key] = f.times.*s.field;
     t["cpuTotal"] = f.times.cpuTotal();
     json fj{{"frame", f.frame}, {"times", t}, {"checked", f.checked}, {"poseIssues", f.poseIssues}};
+    if (f.truthFrame) {
+      fj["truth"] = json::array();
+      for (const auto& c : f.truth) {
+        json t{{"character", scene.characters[c.character].name}, {"ok", c.ok}, {"seconds", c.seconds},
+               {"cpuSeconds", c.cpuSeconds}, {"limbCorrections", c.limbCorrections}};
+        if (c.ok) {
+          t["meanMm"] = c.meanMm, t["p95Mm"] = c.p95Mm, t["maxMm"] = c.maxMm;
+          if (c.normalMap) t["normalMeanDeg"] = c.meanDeg, t["normalP95Deg"] = c.p95Deg, t["normalMaxDeg"] = c.maxDeg;
+        } else {
+          t["failure"] = c.failure;
+        }
+        fj["truth"].push_back(t);
+      }
+    }
     if (f.checked)
       fj["gpuVsCpu"] = {{"maxPositionErrorMm", f.maxPositionErrorMm()}, {"maxNormalErrorDeg", f.maxNormalErrorDeg()},
                         {"maxMapErrorSteps", f.maxMapErrorSteps()}};
@@ -102,6 +140,8 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
   for (const auto& i : r.issues)
     for (size_t c = 0; c < scene.characters.size(); ++c)
       if (scene.characters[c].name == i.character) perChar[c]["poseIssues"] = perChar[c]["poseIssues"].get<int>() + 1;
+  for (size_t c = 0; c < r.truthPerCharacter.size() && c < perChar.size(); ++c)
+    perChar[c]["truth"] = truthJson(r.truthPerCharacter[c]);
   j["characters"] = perChar;
   json summary;
   for (const auto& s : stageColumns()) {
@@ -167,6 +207,26 @@ std::string reportMarkdown(const json& j) {
   s << "\n## Error against run time\n\n";
   s << "Ground truth: " << (j["truth"]["available"].get<bool>() ? "available" : "not available") << " -- "
     << j["truth"]["note"].get<std::string>() << ".\n\n";
+  if (j["truth"].contains("overall")) {
+    const json& t = j["truth"]["overall"];
+    const double poses = num(t["samples"]) + num(t["failed"]);
+    const double frames = num(j["truth"]["frames"]);
+    s << "Ground truth every " << j["truth"]["every"] << " frames: " << t["samples"] << " character poses simulated and measured on "
+      << j["truth"]["frames"] << " frames, " << t["failed"] << " more whose simulation failed (the bake leaves such poses out too); "
+      << fmt(poses > 0 ? num(t["cpuSeconds"]) / poses : NAN, "%.2f") << " s CPU per pose ("
+      << fmt(poses > 0 ? num(t["seconds"]) / poses : NAN, "%.2f") << " s wall on its thread), "
+      << fmt(num(j["truth"]["wallSeconds"]), "%.1f") << " s wall in all ("
+      << fmt(frames > 0 ? num(j["truth"]["wallSeconds"]) / frames : NAN, "%.1f")
+      << " s per truth frame), outside the timed stages below.\n\n";
+    if (t.contains("meanMm")) {
+      s << "Run time against ground truth, character space (placement excluded): vertex error mean " << fmt(num(t["meanMm"]))
+        << " mm, p95 " << fmt(num(t["p95Mm"])) << " mm, max " << fmt(num(t["maxMm"])) << " mm";
+      if (t.contains("normalMeanDeg"))
+        s << "; normal-map angular error mean " << fmt(num(t["normalMeanDeg"])) << " deg, p95 " << fmt(num(t["normalP95Deg"]))
+          << " deg, max " << fmt(num(t["normalMaxDeg"])) << " deg";
+      s << ".\n\n![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
+    }
+  }
   s << "Numerical error of the GPU outputs against the CPU reference (" << sum["checkedFrames"] << " checked frames): "
     << "positions max " << fmt(num(sum["gpuVsCpu"]["maxPositionErrorMm"])) << " mm, normals/tangents max "
     << fmt(num(sum["gpuVsCpu"]["maxNormalErrorDeg"])) << " deg, normal maps max " << sum["gpuVsCpu"]["maxMapErrorSteps"]
@@ -183,6 +243,25 @@ std::string reportMarkdown(const json& j) {
     s << "| " << c["name"].get<std::string>() << " | " << c["model"].get<std::string>() << " | " << (c["onScreen"].get<bool>() ? "yes" : "no")
       << " | " << c["checks"] << " | " << fmt(num(c["maxPositionErrorMm"])) << " | " << fmt(num(c["maxNormalErrorDeg"])) << " | "
       << c["maxMapErrorSteps"] << " | " << c["poseIssues"] << " |\n";
+  if (j["truth"].contains("overall")) {
+    s << "\n### Ground truth per character\n\n| character | measured | failed | mean mm | p95 mm | max mm | map mean deg | map p95 deg |\n"
+      << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const auto& c : j["characters"]) {
+      if (!c.contains("truth")) continue;
+      const json& t = c["truth"];
+      if (num(t["samples"]) + num(t["failed"]) == 0) continue;
+      auto cell = [&](const char* k) { return t.contains(k) ? fmt(num(t[k])) : std::string("-"); };
+      s << "| " << c["name"].get<std::string>() << " | " << t["samples"] << " | " << t["failed"] << " | " << cell("meanMm") << " | "
+        << cell("p95Mm") << " | " << cell("maxMm") << " | " << cell("normalMeanDeg") << " | " << cell("normalP95Deg") << " |\n";
+    }
+    size_t failures = 0;
+    for (const auto& f : j["frames"])
+      for (const auto& t : f.value("truth", json::array()))
+        if (!t["ok"].get<bool>() && ++failures <= 50)
+          s << (failures == 1 ? "\nTruth simulations that failed (no truth for that frame and character):\n\n" : "") << "- frame "
+            << f["frame"] << ", " << t["character"].get<std::string>() << ": " << t.value("failure", std::string()) << "\n";
+    if (failures > 50) s << "- ... (" << failures << " in all; every one in report.json)\n";
+  }
   s << "\n## Bad poses and failures\n\n" << sum["poseIssues"] << " pose issues, " << sum["failures"] << " check failures.\n\n";
   size_t shown = 0;
   for (const auto& i : j["issues"]) {
@@ -204,6 +283,23 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
   PlotSeries cpu{"CPU total", {}, {}, ""}, gpu{"GPU total", {}, {}, ""}, wall{"submit to fence", {}, {}, ""};
   PlotSeries pos{"positions (mm)", {}, {}, ""}, deg{"normals (deg)", {}, {}, ""}, vsTime{"checked frames", {}, {}, ""};
   vsTime.markers = true;
+  PlotSeries truthMean{"mean over characters", {}, {}, ""}, truthMax{"worst character's max", {}, {}, ""};
+  PlotSeries truthVsTime{"truth frames: mean vertex error against ground truth (mm)", {}, {}, ""};
+  PlotSeries truthDeg{"normal-map mean angular error, mean over characters (deg)", {}, {}, ""};
+  truthMean.markers = truthMax.markers = truthVsTime.markers = truthDeg.markers = true;
+  for (const auto& f : r.frames) {
+    const auto [mean, worst] = frameTruthMm(f);
+    if (!std::isfinite(mean)) continue;
+    truthMean.x.push_back(f.frame), truthMean.y.push_back(mean);
+    truthMax.x.push_back(f.frame), truthMax.y.push_back(worst);
+    truthVsTime.x.push_back(f.times.cpuTotal() + (std::isfinite(f.times.gpuTotal) ? f.times.gpuTotal : 0.0));
+    truthVsTime.y.push_back(mean);
+    double deg = 0;
+    int n = 0;
+    for (const auto& c : f.truth)
+      if (c.ok && c.normalMap) deg += c.meanDeg, ++n;
+    if (n) truthDeg.x.push_back(f.frame), truthDeg.y.push_back(deg / n);
+  }
   for (const auto& f : r.frames) {
     const double x = f.frame;
     cpu.x.push_back(x), cpu.y.push_back(f.times.cpuTotal());
@@ -227,8 +323,19 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
   writeTextFileAtomic(dir / "plots/time_per_frame.svg", plot("Time per frame", "scene frame", "ms", {cpu, gpu, wall}));
   writeTextFileAtomic(dir / "plots/error_per_frame.svg",
                       plot("GPU vs CPU reference, worst character", "scene frame", "error", {pos, deg}));
-  writeTextFileAtomic(dir / "plots/error_vs_time.svg", plot("Error against run time (checked frames)", "CPU + GPU ms per frame",
-                                                            "max position error (mm)", {vsTime}));
+  std::vector<PlotSeries> vsTimeSeries{vsTime};
+  if (!truthVsTime.x.empty()) vsTimeSeries.push_back(truthVsTime);
+  writeTextFileAtomic(dir / "plots/error_vs_time.svg",
+                      plot(truthVsTime.x.empty() ? "Error against run time (checked frames)"
+                                                 : "Error against run time (checked frames: GPU vs CPU; truth frames: vs ground truth)",
+                           "CPU + GPU ms per frame", "position error (mm)", vsTimeSeries));
+  if (!truthMean.x.empty()) {
+    std::vector<PlotSeries> ts{truthMean, truthMax};
+    if (!truthDeg.x.empty()) ts.push_back(truthDeg);
+    writeTextFileAtomic(dir / "plots/truth_error_per_frame.svg",
+                        plot("Run time against ground truth (source simulation), per truth frame", "scene frame",
+                             "vertex error (mm); normal maps (deg)", ts));
+  }
   bake::SvgBarChart stages;
   stages.title = "Median time per stage", stages.unit = "ms";
   for (const auto& st : stageColumns()) {

@@ -1,8 +1,14 @@
 #pragma once
 // The replay report: report.json (every figure, machine-readable), report.md (for a person: the plan,
-// time per stage, GPU-vs-CPU error, per character, bad poses) and plots/*.svg (time per frame, error
-// per frame, time per stage, error against time). Written into `directory` (which the caller stages
-// and renames, so nothing partial is left on an error); each file atomically.
+// time per stage, GPU-vs-CPU error, ground truth when it ran, per character, bad poses) and
+// plots/*.svg (time per frame, error per frame, time per stage, error against time, and with ground
+// truth its error per truth frame). Written into `directory` (which the caller stages and renames, so
+// nothing partial is left on an error); each file atomically.
+//
+// Ground truth (--truth-every N) in report.json: "truth" {every, frames, wallSeconds, overall}, per
+// character "truth" and per truth frame "truth" [per character]; figures are meanMm/p95Mm/maxMm (per
+// vertex, character space) and normalMeanDeg/normalP95Deg/normalMaxDeg (per texel), present only
+// where something was measured.
 //
 // Deterministic apart from times: the same scene and models give the same errors, selections and plan.
 #include <filesystem>
