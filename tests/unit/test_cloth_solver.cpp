@@ -1,7 +1,9 @@
 // The source cloth simulation: simulation mesh, body collider, XPBD constraints, the per-pose solve.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <span>
 #include <cstring>
 #include <limits>
 #include <thread>
@@ -117,12 +119,12 @@ TEST(ClothBodyCollider, SignedDistanceMatchesTheAnalyticCapsule) {
   EXPECT_FALSE(collider.closest(Vec3f(1.f, 0.3f, 0.f), 0.1f).found);  // nothing within reach
 }
 
-TEST(ClothBodyCollider, OverlappingPartsAnswerAsTheirUnion) {
-  // Two capsules (separate closed parts of one body mesh, as a mannequin's arm tube pushed into its
-  // torso) crossing each other: the second one is the first moved by 0.15 m along x, so each has a
-  // wall buried inside the other. The union's signed distance is the smaller of the two exact ones;
-  // the closest triangle of the soup alone would answer with a buried wall and the wrong sign.
-  const test::CapsuleSpec spec;
+namespace {
+
+// Two capsules (separate closed parts of one body mesh, as a mannequin's arm tube pushed into its
+// torso) crossing each other: the second one is the first moved by 0.15 m along x, so each has a
+// wall buried inside the other.
+Mesh twoCrossedCapsules(const test::CapsuleSpec& spec) {
   Mesh a = test::capsuleBody(spec), b = a;
   b.positions.col(0).array() += 0.15f;
   Mesh body = a;
@@ -135,6 +137,16 @@ TEST(ClothBodyCollider, OverlappingPartsAnswerAsTheirUnion) {
   body.skin.joints.insert(body.skin.joints.end(), b.skin.joints.begin(), b.skin.joints.end());
   body.skin.weights = a.skin.weights;
   body.skin.weights.insert(body.skin.weights.end(), b.skin.weights.begin(), b.skin.weights.end());
+  return body;
+}
+
+}  // namespace
+
+TEST(ClothBodyCollider, OverlappingPartsAnswerAsTheirUnion) {
+  // The union's signed distance is the smaller of the two exact ones; the closest triangle of the
+  // soup alone would answer with a buried wall and the wrong sign.
+  const test::CapsuleSpec spec;
+  const Mesh body = twoCrossedCapsules(spec);
   BodyCollider collider(body, 0.03f);
   Rng rng(test::testSeed(37));
   int buriedWallsNear = 0;
@@ -154,6 +166,44 @@ TEST(ClothBodyCollider, OverlappingPartsAnswerAsTheirUnion) {
     EXPECT_NEAR((hit.point + hit.normal * hit.signedDistance - p).norm(), 0.f, 1e-4f);
   }
   EXPECT_GT(buriedWallsNear, 10) << "the sample must include points nearer a buried wall than the union's surface";
+}
+
+TEST(ClothBodyCollider, ClosestPartsGivesEachPartDeepestFirst) {
+  // The cloth solver keeps a contact plane for each of the two deepest parts (a vertex in the crease
+  // between an arm and the torso must stay out of both). Each answer is that part's own exact signed
+  // distance, the deepest comes first and is what closest() answers.
+  const test::CapsuleSpec spec;
+  const Mesh body = twoCrossedCapsules(spec);
+  BodyCollider collider(body, 0.03f);
+  Rng rng(test::testSeed(41));
+  int both = 0;
+  for (int tested = 0; tested < 300; ++tested) {
+    const Vec3f p(rng.uniformf(-0.16f, 0.31f), rng.uniformf(0.1f, 0.6f), rng.uniformf(-0.16f, 0.16f));
+    const float da = test::capsuleSignedDistance(spec, p);
+    const float db = test::capsuleSignedDistance(spec, p - Vec3f(0.15f, 0.f, 0.f));
+    const float reach = 0.06f;
+    std::array<BodyCollider::Hit, 3> hits;
+    const size_t n = collider.closestParts(p, reach, std::span(hits));
+    const size_t expected = size_t(std::abs(da) < reach - 3e-3f) + size_t(std::abs(db) < reach - 3e-3f);
+    if (std::abs(std::abs(da) - reach) > 3e-3f && std::abs(std::abs(db) - reach) > 3e-3f)
+      ASSERT_EQ(n, expected) << "point " << p.transpose();  // away from the edge of the search ball
+    if (n == 0) continue;
+    const BodyCollider::Hit single = collider.closest(p, reach);
+    EXPECT_EQ(hits[0].part, single.part);
+    EXPECT_EQ(hits[0].signedDistance, single.signedDistance);
+    if (n < 2) continue;
+    ++both;
+    EXPECT_NE(hits[0].part, hits[1].part);
+    EXPECT_LE(hits[0].signedDistance, hits[1].signedDistance);
+    EXPECT_NEAR(hits[0].signedDistance, std::min(da, db), 2.5e-3f) << "point " << p.transpose();
+    EXPECT_NEAR(hits[1].signedDistance, std::max(da, db), 2.5e-3f) << "point " << p.transpose();
+    for (size_t k = 0; k < 2; ++k)
+      EXPECT_NEAR((hits[k].point + hits[k].normal * hits[k].signedDistance - p).norm(), 0.f, 1e-4f);
+  }
+  EXPECT_GT(both, 50) << "the sample must include points near both parts";
+  // Asking for one answer gives the deepest part only.
+  BodyCollider::Hit one;
+  EXPECT_EQ(collider.closestParts(Vec3f(0.075f, 0.3f, 0.f), 0.2f, std::span(&one, 1)), 1u);
 }
 
 TEST(ClothConstraints, ProjectionReducesViolation) {

@@ -151,14 +151,14 @@ void BodyCollider::rebuild() {
   }
 }
 
-BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance, int onlyPart, int skipPart) const {
-  Hit hit;
-  if (!p.allFinite() || !(maxDistance > 0.f)) return hit;
+size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart,
+                                  int skipPart) const {
+  if (out.empty() || !p.allFinite() || !(maxDistance > 0.f)) return 0;
   Eigen::Vector3i a, b;
   for (int k = 0; k < 3; ++k) {
     const float lo = (p[k] - maxDistance - gridOrigin_[k]) / cellSize_;
     const float hi = (p[k] + maxDistance - gridOrigin_[k]) / cellSize_;
-    if (hi < 0.f || lo >= float(gridDims_[k])) return hit;  // the search ball misses the grid
+    if (hi < 0.f || lo >= float(gridDims_[k])) return 0;  // the search ball misses the grid
     a[k] = std::clamp(int(std::floor(lo)), 0, gridDims_[k] - 1);
     b[k] = std::clamp(int(std::floor(hi)), 0, gridDims_[k] - 1);
   }
@@ -210,9 +210,8 @@ BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance, int o
           if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {part, d, int(t), q};
         }
       }
-  if (partCount == 0) return hit;
-  uint32_t bestPart = 0;
-  // Union of the parts: the smallest signed distance wins (ties: the lower part id, deterministic).
+  // Each part's signed distance from its own closest feature's pseudo-normal.
+  std::array<Hit, kMaxParts> hits;
   for (size_t k = 0; k < partCount; ++k) {
     const PartBest& pb = parts[k];
     Vec3f pseudo;
@@ -223,16 +222,29 @@ BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance, int o
     }
     const Vec3f diff = p - pb.point.point;
     const float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
-    const float sd = sign * pb.distance;
-    if (hit.found && (sd > hit.signedDistance || (sd == hit.signedDistance && pb.part > bestPart))) continue;
-    hit.found = true;
-    hit.signedDistance = sd;
-    hit.point = pb.point.point;
-    hit.triangle = pb.tri;
-    hit.part = int(pb.part);
-    hit.normal = pb.distance > 1e-7f ? Vec3f(sign * diff / pb.distance) : pseudo;
-    bestPart = pb.part;
+    Hit& h = hits[k];
+    h.found = true;
+    h.signedDistance = sign * pb.distance;
+    h.point = pb.point.point;
+    h.triangle = pb.tri;
+    h.part = int(pb.part);
+    h.normal = pb.distance > 1e-7f ? Vec3f(sign * diff / pb.distance) : pseudo;
   }
+  // Smallest signed distance first (ties: the lower part id, deterministic).
+  const size_t n = std::min(partCount, out.size());
+  std::partial_sort(hits.begin(), hits.begin() + std::ptrdiff_t(n), hits.begin() + std::ptrdiff_t(partCount),
+                    [](const Hit& x, const Hit& y) {
+                      return x.signedDistance < y.signedDistance ||
+                             (x.signedDistance == y.signedDistance && x.part < y.part);
+                    });
+  std::copy_n(hits.begin(), n, out.begin());
+  return n;
+}
+
+BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance, int onlyPart, int skipPart) const {
+  // Union of the parts: the smallest signed distance wins.
+  Hit hit;
+  closestParts(p, maxDistance, std::span<Hit>(&hit, 1), onlyPart, skipPart);
   return hit;
 }
 

@@ -9,6 +9,7 @@
 // part answered by its own closest triangle. Taking the single closest triangle of the whole soup
 // instead would answer, in an armpit, with the arm tube's buried wall inside the torso, whose normal
 // points the wrong way, and push the cloth into the body.
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,13 @@ class BodyCollider {
   // of that connected part alone, or, when skipPart >= 0, of the other parts. Thread-safe (const, no
   // scratch state).
   Hit closest(const Vec3f& p, float maxDistance, int onlyPart = -1, int skipPart = -1) const;
+
+  // The closest surface point of each part within maxDistance, smallest signed distance first, at
+  // most out.size() of them; returns how many were written. Where two parts meet in a crease (an arm
+  // tube rising through the shoulder it is buried in) a point can be pushed out of one part into the
+  // other: the cloth solver keeps a contact plane for each of the two deepest.
+  size_t closestParts(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart = -1,
+                      int skipPart = -1) const;
 
   // Edges not shared by exactly two triangles (by vertex index): 0 for a closed surface, the only
   // kind whose inside the signed distance tells reliably.
