@@ -2,10 +2,16 @@
 // PCA reconstruction (pre-skinning space) + linear blend skinning for ALL instances of one model in one
 // dispatch. One thread per vertex: it loads its 3K basis values and its skin influences ONCE into
 // registers, then loops over the instances. The basis, the largest input (3N x K floats), is
-// therefore read once per frame, not once per instance. The instances' weights are read at addresses
-// uniform across the workgroup (broadcast loads, served by the scalar/constant path of GPUs and by
-// lavapipe's uniform-load path); staging them in shared memory measured 2x slower on lavapipe, whose
-// shared-memory loads and barriers are costly.
+// therefore read once per frame, not once per instance.
+//
+// The per-instance inputs, read N times per instance, come through texel buffers (set 0), a whole vec4
+// per fetch: the mesh weights as vec4[instance][K4 / 4] (K4 = K rounded up to 4, zero padded; every
+// thread fetches the same texels) and the skin matrices as vec4[instance][joint][3], the top three
+// rows of each affine matrix (the bottom row is 0 0 0 1). On lavapipe a vec4 texel fetch costs about
+// what ONE scalar load through a buffer address costs (descriptor_binding.hpp): per instance this pass
+// went from 32 + 48 scalar address loads per vertex to 8 + 12 texel fetches, about 3.5x less time per
+// instance in bench_replay's deform stage. Shared-memory staging of the weights measured 2x slower on
+// lavapipe, whose shared-memory loads and barriers are costly.
 //
 // Conforms to runtime/reference_pca.cpp (x = mean + sum_k basis_k * w_k, k ascending, starting at the
 // mean) and runtime/reference_skinning.cpp (core/skinning.cpp: B = sum over influences with w != 0 of
@@ -26,6 +32,9 @@ layout(constant_id = 2) const uint INFLUENCES = 4;      // skin influences per v
 layout(constant_id = 3) const bool APPLY_SKINNING = true;  // false: write the pre-skinning shape
 
 layout(push_constant) uniform Push { DeformParams p; };
+layout(set = 0, binding = 0) uniform samplerBuffer weightTexels;  // vec4[instance][K4 / 4]
+layout(set = 0, binding = 1) uniform samplerBuffer matrixRows;  // vec4[instance][joint][3] (rows 0..2)
+const uint K4 = (K + 3u) / 4u;
 
 void main() {
   const uint v = gl_GlobalInvocationID.x;
@@ -47,29 +56,28 @@ void main() {
     skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
   }
 
-  FloatsIn weightBuf = FloatsIn(p.weights);
-  FloatsIn matrices = FloatsIn(p.skinMatrices);
   FloatsOut outBuf = FloatsOut(p.positionsOut);
   for (uint instance = 0u; instance < p.instanceCount; ++instance) {
     precise vec3 x = mean;
-    [[unroll]] for (uint k = 0u; k < K; ++k) {
-      const float w = weightBuf.v[instance * K + k];  // the same address in every thread: a broadcast load
-      x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w;
+    [[unroll]] for (uint q = 0u; q < K4; ++q) {
+      const vec4 w4 = texelFetch(weightTexels, int(instance * K4 + q));  // the same texel in every thread
+      [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+        const uint k = 4u * q + j;
+        if (k < K) x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w4[j];
+      }
     }
     precise vec3 y = x;
     if (APPLY_SKINNING) {
-      // Only the top three rows of each (affine, column-major) matrix are read: 12 loads, not 16.
-      // The zero-weight skip is a select, not a branch: every lane runs the same loads (lavapipe
-      // gathers per lane, masked branches do not save that), and a skipped matrix still cannot
-      // bring its NaN/Inf in.
+      // Each matrix comes as its top three rows (3 fetches); the columns summed below are their
+      // components. The zero-weight skip is a select, not a branch: every lane runs the same fetches
+      // (lavapipe gathers per lane, masked branches do not save that), and a skipped matrix still
+      // cannot bring its NaN/Inf in.
       precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
       [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
-        const uint m = (instance * p.jointCount + joints[i]) * 16u;
+        const int m = int((instance * p.jointCount + joints[i]) * 3u);
         const float w = skinW[i];
-        const vec3 c0 = vec3(matrices.v[m], matrices.v[m + 1u], matrices.v[m + 2u]);
-        const vec3 c1 = vec3(matrices.v[m + 4u], matrices.v[m + 5u], matrices.v[m + 6u]);
-        const vec3 c2 = vec3(matrices.v[m + 8u], matrices.v[m + 9u], matrices.v[m + 10u]);
-        const vec3 c3 = vec3(matrices.v[m + 12u], matrices.v[m + 13u], matrices.v[m + 14u]);
+        const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2);
+        const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w);
         const bool use = w != 0.0;
         b0 = use ? b0 + w * c0 : b0;
         b1 = use ? b1 + w * c1 : b1;

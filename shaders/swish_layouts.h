@@ -7,8 +7,8 @@
 //   positions/normals : float[instance][vertex][3]   (same as swish::Points3f rows, one block per instance)
 //   tangents          : float[instance][vertex][4]   (xyz tangent, w = bitangent sign)
 //   PCA mean          : float[3N];  PCA basis: float[k][3N] (column-major 3N x K, as Eigen stores MeshPca::basis)
-//   mesh weights      : float[instance][K]
-//   skin matrices     : mat4[instance][joint], column-major (as Eigen stores Mat4f)
+//   mesh weights      : float[instance][K4], K4 = K rounded up to 4, zero padded (read as vec4 texels)
+//   skin matrix rows  : vec4[instance][joint][3], rows 0..2 of each affine skinning matrix (texels)
 //   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
 //   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
 //   VQ codebook       : int8[entry][16 texels][2] read as uint words (2 texels per word)
@@ -35,12 +35,12 @@ struct alignas(8) Address {
 // hundred they would spill).
 #define SWISH_MAX_MESH_COMPONENTS 256
 
-// deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances.
+// deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances. The mesh
+// weights (float[instanceCount][K4]) and skin matrix rows (vec4[instanceCount][jointCount][3]) are
+// texel buffers of its descriptor set.
 struct DeformParams {
   SWISH_ADDRESS mean;           // float[3N]
   SWISH_ADDRESS basis;          // float[K][3N]
-  SWISH_ADDRESS weights;        // float[instanceCount][K]
-  SWISH_ADDRESS skinMatrices;   // mat4[instanceCount][jointCount]
   SWISH_ADDRESS skinJoints;     // uint[N][influences]
   SWISH_ADDRESS skinWeights;    // float[N][influences]
   SWISH_ADDRESS positionsOut;   // float[instanceCount][N][3]
@@ -67,15 +67,17 @@ struct TangentFramesParams {
   uint pad0;
 };
 
-// vq_decode.comp: decodes database maps into decoded slots, one thread per texel pair.
+// vq_decode.comp: decodes database maps into decoded slots, one thread per texel pair; job j decodes
+// map jobMaps[j] into slot jobSlots[j] (slot j when jobSlots is 0).
 struct VqDecodeParams {
   SWISH_ADDRESS codebook;     // uint words of int8[entry][16][2]
   SWISH_ADDRESS indices;      // uint words of uint16[map][block]
-  SWISH_ADDRESS slotMaps;     // uint[slotCount]: database map decoded into each slot
+  SWISH_ADDRESS jobMaps;      // uint[jobCount]: database map decoded by each job
+  SWISH_ADDRESS jobSlots;     // uint[jobCount]: slot written by each job (0: job j writes slot j)
   SWISH_ADDRESS decodedOut;   // uint words of uint16[slot][height][width]
   uint width;
   uint height;
-  uint slotCount;
+  uint jobCount;
   uint codebookSize;          // entries; larger indices decode to 0 (the CPU reference does the same)
 };
 
@@ -86,8 +88,9 @@ struct NormalMapBlendCharacter {
 };
 
 // normal_map_blend.comp: temporal blend into the per-character layers of an RG16_SNORM 2D array image.
+// The decoded slots are a texel buffer (R32G32_UINT: 4 texels of a block row per texel) of its
+// descriptor set, beside the previous and current images.
 struct NormalMapBlendParams {
-  SWISH_ADDRESS decoded;      // as VqDecodeParams::decodedOut
   SWISH_ADDRESS characters;   // NormalMapBlendCharacter[characterCount]
   uint width;
   uint height;
@@ -105,11 +108,11 @@ struct CopyVec4Params {
 
 #ifdef __cplusplus
 static_assert(sizeof(Address) == 8);
-static_assert(sizeof(DeformParams) == 7 * 8 + 16);
+static_assert(sizeof(DeformParams) == 5 * 8 + 16);
 static_assert(sizeof(TangentFramesParams) == 9 * 8 + 16);
-static_assert(sizeof(VqDecodeParams) == 4 * 8 + 16);
+static_assert(sizeof(VqDecodeParams) == 5 * 8 + 16);
 static_assert(sizeof(NormalMapBlendCharacter) == 8);
-static_assert(sizeof(NormalMapBlendParams) == 2 * 8 + 16);
+static_assert(sizeof(NormalMapBlendParams) == 8 + 16);
 static_assert(sizeof(CopyVec4Params) == 2 * 8 + 8);
 static_assert(sizeof(TangentFramesParams) <= 128, "push constants: 128 bytes are all Vulkan guarantees");
 }  // namespace swish::gpu::layout

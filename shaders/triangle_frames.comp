@@ -7,7 +7,10 @@
 // in its operation order, `precise` (no FMA), so the stored terms equal what the CPU adds bit for bit.
 //
 // One thread per triangle, looping over the instances: the triangle's corner indices and UV terms
-// (instance-independent) are loaded and computed once for all instances.
+// (instance-independent) are loaded and computed once for all instances. The per-instance streams go
+// through the pass's descriptor set (binding numbers in swish_triangle_frames_layout.h): positions are
+// fetched as texels and the terms stored as whole vec4s of a storage buffer, the cheap ways on
+// lavapipe (descriptor_binding.hpp).
 #extension GL_GOOGLE_include_directive : require
 #include "swish_buffers.glsl"
 #include "swish_frame_math.glsl"
@@ -15,7 +18,13 @@
 
 layout(local_size_x_id = 0) in;
 layout(push_constant) uniform Push { TriangleFramesParams p; };
-layout(buffer_reference, std430, buffer_reference_align = 16) writeonly buffer Vec4sOut { vec4 v[]; };
+layout(set = 0, binding = SWISH_TF_BINDING_POSITIONS) uniform samplerBuffer positionTexels;  // float[instance][N][3]
+layout(set = 0, binding = SWISH_TF_BINDING_TERMS_OUT, std430) writeonly buffer TermsOut { vec4 termsOut[]; };
+
+vec3 position(uint base, uint corner) {
+  const int i = int(base + 3u * corner);
+  return vec3(texelFetch(positionTexels, i).x, texelFetch(positionTexels, i + 1).x, texelFetch(positionTexels, i + 2).x);
+}
 
 void main() {
   const uint t = gl_GlobalInvocationID.x;
@@ -36,23 +45,21 @@ void main() {
   // core/mesh_frames.cpp skips a triangle whose UV determinant is 0 or not finite.
   const bool usable = hasUvs && r != 0.0 && isFinite(r);
 
-  FloatsIn pos = FloatsIn(p.positions);
-  Vec4sOut terms = Vec4sOut(p.termsOut);
   for (uint instance = 0u; instance < p.instanceCount; ++instance) {
     const uint base = instance * p.vertexCount * 3u;
-    const vec3 p0 = vec3(pos.v[base + 3u * c0], pos.v[base + 3u * c0 + 1u], pos.v[base + 3u * c0 + 2u]);
-    precise vec3 e1 = vec3(pos.v[base + 3u * c1], pos.v[base + 3u * c1 + 1u], pos.v[base + 3u * c1 + 2u]) - p0;
-    precise vec3 e2 = vec3(pos.v[base + 3u * c2], pos.v[base + 3u * c2 + 1u], pos.v[base + 3u * c2 + 2u]) - p0;
+    const vec3 p0 = position(base, c0);
+    precise vec3 e1 = position(base, c1) - p0;
+    precise vec3 e2 = position(base, c2) - p0;
     const uint o = (instance * p.triangleCount + t) * SWISH_TRIANGLE_TERM_VEC4S;
-    terms.v[o] = vec4(crossCpu(e1, e2), 0.0);
+    termsOut[o] = vec4(crossCpu(e1, e2), 0.0);
     if (hasUvs) {
       precise vec3 tangentTerm = vec3(0.0), bitangentTerm = vec3(0.0);
       if (usable) {
         tangentTerm = (e1 * d2.y - e2 * d1.y) / r;
         bitangentTerm = (e2 * d1.x - e1 * d2.x) / r;
       }
-      terms.v[o + 1u] = vec4(tangentTerm, usable ? 1.0 : 0.0);
-      terms.v[o + 2u] = vec4(bitangentTerm, 0.0);
+      termsOut[o + 1u] = vec4(tangentTerm, usable ? 1.0 : 0.0);
+      termsOut[o + 2u] = vec4(bitangentTerm, 0.0);
     }
   }
 }

@@ -54,6 +54,7 @@ struct DeformSetup {
   std::unique_ptr<gpu::GpuModel> gpuModel;
   gpu::Buffer weights, matrices, positions, copySrc, copyDst;
   std::unique_ptr<gpu::DeformPass> pass;
+  gpu::DescriptorBinding instanceInputs;
   std::unique_ptr<gpu::CopyVec4Pass> copy;
   double bytesMoved = 0;
   uint32_t copyVec4s = 0;
@@ -78,14 +79,19 @@ DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning) {
     const auto mats = s.model.skeleton.skinningMatrices(test::makeRandomPose(rng, s.model.skeleton));
     m.insert(m.end(), mats.begin(), mats.end());
   }
-  s.weights = gpu::Buffer(ctx, w.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
-  s.weights.upload(ctx, w.data(), w.size() * 4);
-  s.matrices = gpu::Buffer(ctx, m.size() * 64, gpu::MemoryKind::DeviceLocal, "matrices");
-  s.matrices.upload(ctx, m.data(), m.size() * 64);
+  std::vector<float> rows(gpu::DeformPass::weightsBytes(instances, uint32_t(k)) / 4);
+  gpu::DeformPass::packWeights(w.data(), instances, uint32_t(k), rows.data());
+  s.weights = gpu::Buffer(ctx, rows.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
+  s.weights.upload(ctx, rows.data(), rows.size() * 4);
+  std::vector<float> matrixRows(m.size() * 12);
+  gpu::DeformPass::packSkinMatrices(m.data(), m.size(), matrixRows.data());
+  s.matrices = gpu::Buffer(ctx, matrixRows.size() * 4, gpu::MemoryKind::DeviceLocal, "matrices");
+  s.matrices.upload(ctx, matrixRows.data(), matrixRows.size() * 4);
   s.positions = gpu::Buffer(ctx, instances * n * 12, gpu::MemoryKind::DeviceLocal, "positions");
   s.pass = std::make_unique<gpu::DeformPass>(ctx, uint32_t(k), 4, skinning);
+  s.instanceInputs = s.pass->bindInstanceInputs(ctx, s.weights, s.matrices);
   // Bytes the kernel must move at least once: basis, mean, skin influences, weights, matrices, output.
-  s.bytesMoved = double(n * k * 3 * 4 + n * 3 * 4 + n * 4 * 8 + w.size() * 4 + m.size() * 64 + instances * n * 12);
+  s.bytesMoved = double(n * k * 3 * 4 + n * 3 * 4 + n * 4 * 8 + w.size() * 4 + m.size() * 48 + instances * n * 12);
   // The copy moves the same bytes: reads half, writes half.
   s.copyVec4s = uint32_t(s.bytesMoved / 32);
   s.copySrc = gpu::Buffer(ctx, size_t(s.copyVec4s) * 16, gpu::MemoryKind::DeviceLocal, "copy src");
@@ -104,8 +110,7 @@ void BM_Deform(benchmark::State& state) {
   gpu::DeformPass::Args a;
   a.mean = s.gpuModel->mean.address();
   a.basis = s.gpuModel->basis.address();
-  a.weights = s.weights.address();
-  a.skinMatrices = s.matrices.address();
+  a.instanceInputs = s.instanceInputs.get();
   a.skinJoints = s.gpuModel->skinJoints.address();
   a.skinWeights = s.gpuModel->skinWeights.address();
   a.positionsOut = s.positions.address();
@@ -150,8 +155,7 @@ void BM_TangentFrames(benchmark::State& state) {
   gpu::DeformPass::Args d;
   d.mean = g.mean.address();
   d.basis = g.basis.address();
-  d.weights = s.weights.address();
-  d.skinMatrices = s.matrices.address();
+  d.instanceInputs = s.instanceInputs.get();
   d.skinJoints = g.skinJoints.address();
   d.skinWeights = g.skinWeights.address();
   d.positionsOut = s.positions.address();
@@ -165,6 +169,19 @@ void BM_TangentFrames(benchmark::State& state) {
   gpu::Buffer terms(*ctx, gpu::TangentFramesPass::triangleTermsBytes(g.triangleCount(), instances), gpu::MemoryKind::DeviceLocal,
                     "triangle terms");
   const gpu::TangentFramesPass pass(*ctx);
+  gpu::DescriptorBinding binding;
+  if (twoPass) {
+    gpu::TangentFramesPass::TwoPassBuffers b;
+    b.positions = &s.positions;
+    b.triangleTerms = &terms;
+    b.normalOffsets = &g.normalOffsets;
+    b.normalTriangles = &g.normalTriangles;
+    b.tangentOffsets = &g.tangentOffsets;
+    b.tangentTriangles = &g.tangentTriangles;
+    b.normalsOut = &normals;
+    b.tangentsOut = &tangents;
+    binding = pass.bindTwoPass(*ctx, b);
+  }
   gpu::TangentFramesPass::Args a;
   a.positions = s.positions.address();
   a.uvs = g.uvs.address();
@@ -179,7 +196,7 @@ void BM_TangentFrames(benchmark::State& state) {
   a.instanceCount = instances;
   a.hasUvs = g.hasUvs();
   if (twoPass) {
-    a.triangleTerms = terms.address();
+    a.twoPass = binding.get();
     a.triangleCount = g.triangleCount();
   }
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { pass.record(cmd, a); });  // warm-up (first-use compile)

@@ -69,8 +69,12 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   const std::vector<uint32_t> joints(m.gameMesh.skin.joints.begin(), m.gameMesh.skin.joints.end());
   CheckedInput mean(ctx, std::span<const float>(m.meshPca.mean.data(), 3 * n), "mean");
   CheckedInput basis(ctx, std::span<const float>(m.meshPca.basis.data(), size_t(m.meshPca.basis.size())), "basis");
-  CheckedInput weights(ctx, std::span<const float>(in.weights), "weights");
-  CheckedInput matrices(ctx, std::span<const float>(in.matrices.front().data(), in.matrices.size() * 16), "skin matrices");
+  std::vector<float> weightRows(gpu::DeformPass::weightsBytes(in.instances, k) / sizeof(float));
+  gpu::DeformPass::packWeights(in.weights.data(), in.instances, k, weightRows.data());  // the kernel's padded rows
+  CheckedInput weights(ctx, std::span<const float>(weightRows), "weights");
+  std::vector<float> matrixRows(in.matrices.size() * 12);
+  gpu::DeformPass::packSkinMatrices(in.matrices.data(), in.matrices.size(), matrixRows.data());  // the kernel's layout
+  CheckedInput matrices(ctx, std::span<const float>(matrixRows), "skin matrices");
   CheckedInput skinJoints(ctx, std::span<const uint32_t>(joints), "skin joints");
   CheckedInput skinWeights(ctx, std::span<const float>(m.gameMesh.skin.weights), "skin weights");
   GuardedOutput out(ctx, size_t(in.instances) * n * 3 * sizeof(float), "deformed positions");
@@ -79,8 +83,8 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
-  a.weights = weights.address();
-  a.skinMatrices = matrices.address();
+  const gpu::DescriptorBinding instanceInputs = pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer());
+  a.instanceInputs = instanceInputs.get();
   a.skinJoints = skinJoints.address();
   a.skinWeights = skinWeights.address();
   a.positionsOut = out.address();

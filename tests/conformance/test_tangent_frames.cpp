@@ -1,5 +1,7 @@
-// Conformance of the tangent-frames kernel (shaders/tangent_frames.comp via gpu::TangentFramesPass)
-// to runtime::referenceTangentFrames (core/mesh_frames.cpp, THE definition of normals and tangents):
+// Conformance of the tangent-frames kernels (gpu::TangentFramesPass: the single-pass
+// shaders/tangent_frames.comp, and the two-pass triangle_frames.comp + vertex_frames_gather.comp that
+// the frame recorder uses) to runtime::referenceTangentFrames (core/mesh_frames.cpp, THE definition
+// of normals and tangents):
 // seeded random deformed meshes of odd sizes, several instances per dispatch, NaN placement,
 // an exactly representable flat mesh, guard words and unchanged inputs.
 #include <cmath>
@@ -39,7 +41,8 @@ struct Frames {
   std::vector<std::string> problems;
 };
 
-Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& positions, uint32_t instances, bool hasUvs = true) {
+Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& positions, uint32_t instances, bool hasUvs,
+              bool twoPass) {
   const Mesh& g = m.gameMesh;
   const uint32_t n = uint32_t(g.vertexCount());
   const MeshFrameTopology topo = buildFrameTopology(g.triangles, g.positions);
@@ -52,7 +55,22 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
   CheckedInput tTri(ctx, std::span<const uint32_t>(topo.tangentAdjacency.triangles), "tangent triangles");
   GuardedOutput normals(ctx, size_t(instances) * n * 3 * 4, "normals");
   GuardedOutput tangents(ctx, size_t(instances) * n * 4 * 4, "tangents");
+  const uint32_t triangles = uint32_t(g.triangles.rows());
+  GuardedOutput terms(ctx, std::max<size_t>(16, gpu::TangentFramesPass::triangleTermsBytes(triangles, instances)), "triangle terms");
   const gpu::TangentFramesPass pass(ctx);
+  gpu::DescriptorBinding twoPassBinding;
+  if (twoPass) {
+    gpu::TangentFramesPass::TwoPassBuffers b;
+    b.positions = &pos.buffer();
+    b.triangleTerms = &terms.buffer();
+    b.normalOffsets = &nOff.buffer();
+    b.normalTriangles = &nTri.buffer();
+    b.tangentOffsets = &tOff.buffer();
+    b.tangentTriangles = &tTri.buffer();
+    b.normalsOut = &normals.buffer();
+    b.tangentsOut = &tangents.buffer();
+    twoPassBinding = pass.bindTwoPass(ctx, b);
+  }
   gpu::TangentFramesPass::Args a;
   a.positions = pos.address();
   a.uvs = uvs.address();
@@ -66,13 +84,15 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
   a.vertexCount = n;
   a.instanceCount = instances;
   a.hasUvs = hasUvs;
+  a.twoPass = twoPassBinding.get();
+  a.triangleCount = triangles;
   ctx.submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, a); });
   Frames f;
   f.normals = normals.read<float>(ctx);
   f.tangents = tangents.read<float>(ctx);
   for (const CheckedInput* c : {&pos, &uvs, &tris, &nOff, &nTri, &tOff, &tTri})
     if (auto s = c->unchanged(ctx); !s.empty()) f.problems.push_back(s);
-  for (const GuardedOutput* o : {&normals, &tangents})
+  for (const GuardedOutput* o : {&normals, &tangents, &terms})
     if (auto s = o->guardsIntact(ctx); !s.empty()) f.problems.push_back(s);
   return f;
 }
@@ -128,9 +148,19 @@ TEST_P(TangentFramesConformance, MatchReference) {
   spec.normalMaps = 0;
   const Model m = test::makeRandomModel(rng, spec);
   const auto pos = deformedPositions(rng, m, GetParam().instances);
-  test::CompareReport rep;
-  expectMatch(runGpu(ctx(), m, pos, GetParam().instances), runReference(m, pos, GetParam().instances), &rep);
-  std::printf("max |gpu - reference|: normals %.3g over %zu values\n", rep.maxAbsError, rep.compared);
+  const Frames ref = runReference(m, pos, GetParam().instances);
+  const Frames one = runGpu(ctx(), m, pos, GetParam().instances, true, false);
+  const Frames two = runGpu(ctx(), m, pos, GetParam().instances, true, true);
+  for (const Frames* gpu : {&one, &two}) {
+    SCOPED_TRACE(gpu == &two ? "two passes" : "one pass");
+    test::CompareReport rep;
+    expectMatch(*gpu, ref, &rep);
+    std::printf("%s: max |gpu - reference|: normals %.3g over %zu values\n", gpu == &two ? "two passes" : "one pass",
+                rep.maxAbsError, rep.compared);
+  }
+  // Same per-triangle values, same sums in the same order: the two paths agree bit for bit.
+  EXPECT_TRUE(test::matchesReference("two-pass normals", two.normals, one.normals, [](size_t) { return 0.0; }));
+  EXPECT_TRUE(test::matchesReference("two-pass tangents", two.tangents, one.tangents, [](size_t) { return 0.0; }));
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, TangentFramesConformance,
@@ -149,7 +179,7 @@ TEST_F(TangentFramesSpecialCases, MeshWithoutUvsUsesTheFallbackTangentLikeTheRef
   spec.normalMaps = 0;
   const Model m = test::makeRandomModel(rng, spec);
   const auto pos = deformedPositions(rng, m, 2);
-  expectMatch(runGpu(ctx(), m, pos, 2, false), runReference(m, pos, 2, false));
+  for (bool twoPass : {false, true}) expectMatch(runGpu(ctx(), m, pos, 2, false, twoPass), runReference(m, pos, 2, false));
 }
 
 // A NaN position poisons the frames of the vertices around it exactly as in the reference (whose
@@ -165,8 +195,9 @@ TEST_F(TangentFramesSpecialCases, NanPositionAffectsExactlyTheReferenceVertices)
   auto pos = deformedPositions(rng, m, 2);
   pos[(64 + 27) * 3 + 1] = std::numeric_limits<float>::quiet_NaN();  // instance 1, vertex 27, y
   pos[(0 + 5) * 3 + 0] = std::numeric_limits<float>::infinity();     // instance 0, vertex 5, x
-  const Frames gpu = runGpu(ctx(), m, pos, 2), ref = runReference(m, pos, 2);
+  const Frames gpu = runGpu(ctx(), m, pos, 2, true, false), ref = runReference(m, pos, 2);
   expectMatch(gpu, ref);
+  expectMatch(runGpu(ctx(), m, pos, 2, true, true), ref);
   // The reference's fallbacks must actually have fired near the poisoned vertices: the frames there
   // differ from the frames of the same mesh without poison.
   size_t changed = 0;
@@ -193,10 +224,13 @@ TEST_F(TangentFramesSpecialCases, FlatIntegerGridIsExact) {
     m.gameMesh.uvs.row(v) << float(v % 6) * 0.125f, float(v / 6) * 0.125f;
     pos.insert(pos.end(), {float(v % 6) * 2.f, float(v / 6) * 2.f, 0.f});
   }
-  const Frames gpu = runGpu(ctx(), m, pos, 1), ref = runReference(m, pos, 1);
-  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-  EXPECT_TRUE(test::matchesReference("normals", gpu.normals, ref.normals, [](size_t) { return 0.0; }));
-  EXPECT_TRUE(test::matchesReference("tangents", gpu.tangents, ref.tangents, [](size_t) { return 0.0; }));
+  const Frames ref = runReference(m, pos, 1);
+  for (bool twoPass : {false, true}) {
+    const Frames gpu = runGpu(ctx(), m, pos, 1, true, twoPass);
+    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+    EXPECT_TRUE(test::matchesReference("normals", gpu.normals, ref.normals, [](size_t) { return 0.0; }));
+    EXPECT_TRUE(test::matchesReference("tangents", gpu.tangents, ref.tangents, [](size_t) { return 0.0; }));
+  }
   EXPECT_EQ(std::abs(ref.normals[2]), 1.f);  // the case really is the flat one
 }
 

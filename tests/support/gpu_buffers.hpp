@@ -23,6 +23,7 @@ class CheckedInput {
     buffer_.upload(ctx, bytes_.data(), bytes_.size());
   }
   VkDeviceAddress address() const { return buffer_.address(); }
+  const gpu::Buffer& buffer() const { return buffer_; }  // for descriptor bindings (texel buffers)
   // "" when unchanged, else a description of the first changed byte.
   std::string unchanged(gpu::Context& ctx) const;
 
@@ -40,6 +41,7 @@ class GuardedOutput {
 
   GuardedOutput(gpu::Context& ctx, size_t bytes, const std::string& name);
   VkDeviceAddress address() const { return buffer_.address(); }
+  const gpu::Buffer& buffer() const { return buffer_; }  // for descriptor bindings (storage buffers)
   // The output region's contents (waits on a host barrier first).
   template <class T>
   std::vector<T> read(gpu::Context& ctx) const {

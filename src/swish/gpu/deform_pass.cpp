@@ -1,10 +1,26 @@
 #include "swish/gpu/deform_pass.hpp"
 
+#include <algorithm>
+
 #include "shaders/swish_layouts.h"
 #include "swish/core/error.hpp"
 #include "swish/core/mesh.hpp"
 
 namespace swish::gpu {
+
+void DeformPass::packWeights(const float* w, uint32_t instances, uint32_t k, float* out) {
+  const uint32_t k4 = paddedComponents(k);
+  for (uint32_t i = 0; i < instances; ++i) {
+    std::copy(w + size_t(i) * k, w + size_t(i + 1) * k, out + size_t(i) * k4);
+    std::fill(out + size_t(i) * k4 + k, out + size_t(i + 1) * k4, 0.f);
+  }
+}
+
+void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
+  for (size_t i = 0; i < count; ++i)
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) out[12 * i + 4 * r + c] = m[i](r, c);
+}
 
 DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
@@ -12,17 +28,24 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
   if (influences < 1 || influences > uint32_t(kMaxInfluences))
     throw Error("deform pass: " + std::to_string(influences) + " skin influences; supported: 1..8");
+  inputsLayout_ = DescriptorLayout(ctx, {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER});
   pipeline_ = ComputePipeline(ctx, "deform.comp", {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u},
-                              sizeof(layout::DeformParams));
+                              sizeof(layout::DeformParams), inputsLayout_.get());
+}
+
+DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
+                                                 VkDeviceSize weightsOffset, VkDeviceSize matricesOffset) const {
+  return DescriptorBinding(ctx, inputsLayout_,
+                           {BoundResource::texels(weights, VK_FORMAT_R32G32B32A32_SFLOAT, weightsOffset),
+                            BoundResource::texels(skinMatrices, VK_FORMAT_R32G32B32A32_SFLOAT, matricesOffset)});
 }
 
 void DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   if (a.vertexCount == 0 || a.instanceCount == 0) return;
+  if (!a.instanceInputs) throw Error("deform pass: no instance inputs bound (bindInstanceInputs)");
   layout::DeformParams p;
   p.mean = layout::Address::of(a.mean);
   p.basis = layout::Address::of(a.basis);
-  p.weights = layout::Address::of(a.weights);
-  p.skinMatrices = layout::Address::of(a.skinMatrices);
   p.skinJoints = layout::Address::of(a.skinJoints);
   p.skinWeights = layout::Address::of(a.skinWeights);
   p.positionsOut = layout::Address::of(a.positionsOut);
@@ -31,6 +54,7 @@ void DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.jointCount = a.jointCount;
   p.pad0 = 0;
   pipeline_.bind(cmd, &p, sizeof(p));
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.layout(), 0, 1, &a.instanceInputs, 0, nullptr);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
 }
 

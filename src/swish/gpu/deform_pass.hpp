@@ -1,6 +1,8 @@
 #pragma once
 // The deform pass (shaders/deform.comp): PCA reconstruction + linear blend skinning of every instance
 // of one model in ONE dispatch; each vertex's basis values are read once per frame for all instances.
+// The per-instance inputs (mesh weights, skin matrix rows) are bound as texel buffers through a
+// descriptor set made once per pair of buffers by bindInstanceInputs (descriptor_binding.hpp says why).
 //
 // Records one dispatch into the caller's command buffer (never submits). Synchronisation the caller
 // provides: inputs written by the host before the submission (mapped memory; the submission makes them
@@ -11,7 +13,9 @@
 
 #include <cstdint>
 
+#include "swish/core/types.hpp"
 #include "swish/gpu/compute_pipeline.hpp"
+#include "swish/gpu/descriptor_binding.hpp"
 
 namespace swish::gpu {
 
@@ -22,24 +26,38 @@ class DeformPass {
   struct Args {
     VkDeviceAddress mean = 0;          // float[3N]
     VkDeviceAddress basis = 0;         // float[K][3N]
-    VkDeviceAddress weights = 0;       // float[instances][K]
-    VkDeviceAddress skinMatrices = 0;  // mat4[instances][jointCount], column-major
     VkDeviceAddress skinJoints = 0;    // uint[N][influences]
     VkDeviceAddress skinWeights = 0;   // float[N][influences]
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
+    VkDescriptorSet instanceInputs = VK_NULL_HANDLE;  // from bindInstanceInputs
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;
     uint32_t jointCount = 0;
   };
+
+  // Layout of the mesh-weights buffer: float[instances][paddedComponents(K)], each row zero padded.
+  static uint32_t paddedComponents(uint32_t k) { return (k + 3) / 4 * 4; }
+  static VkDeviceSize weightsBytes(uint32_t instances, uint32_t k) { return VkDeviceSize(instances) * paddedComponents(k) * 4; }
+  // Writes `instances` rows of K weights (row-major, as FrameKernelInputs holds them) in that layout.
+  static void packWeights(const float* weights, uint32_t instances, uint32_t k, float* out);
+  // Layout of the skin-matrices buffer: vec4[instances][jointCount][3], the top three rows of each
+  // affine skinning matrix (3 texel fetches per influence instead of 4 columns).
+  static VkDeviceSize skinMatricesBytes(uint32_t instances, uint32_t joints) { return VkDeviceSize(instances) * joints * 48; }
+  // Writes `count` matrices (instance-major, as FrameKernelInputs holds them) in that layout.
+  static void packSkinMatrices(const Mat4f* matrices, size_t count, float* out);
 
   DeformPass() = default;
   // meshComponents (K) in 1..SWISH_MAX_MESH_COMPONENTS; influences in 1..8. applySkinning = false writes
   // the pre-skinning shape (used to check the PCA reconstruction on its own).
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true);
 
+  // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance).
+  DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
+                                       VkDeviceSize weightsOffset = 0, VkDeviceSize matricesOffset = 0) const;
   void record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
+  DescriptorLayout inputsLayout_;
   ComputePipeline pipeline_;
 };
 

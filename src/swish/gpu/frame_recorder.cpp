@@ -26,14 +26,33 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
   if (tangentFrames_) tangentFramesPass_ = TangentFramesPass(ctx);
   if (normalMaps_) {
     decode_ = VqDecodePass(ctx);
-    blend_ = NormalMapBlendPass(ctx, o.framesInFlight);
+    blend_ = NormalMapBlendPass(ctx);
   }
   for (uint32_t s = 0; s < o.framesInFlight; ++s) frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s);
-  if (normalMaps_)
-    for (uint32_t s = 0; s < o.framesInFlight; ++s) {
-      const uint32_t prev = (s + o.framesInFlight - 1) % o.framesInFlight;
-      frames_[s].blendBinding = blend_.makeBinding(frames_[prev].normalMaps, frames_[s].normalMaps);
+  for (uint32_t s = 0; s < o.framesInFlight; ++s) {
+    FrameResources& f = frames_[s];
+    f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices);
+    if (tangentFrames_) {
+      TangentFramesPass::TwoPassBuffers b;
+      b.positions = &f.positions;
+      b.triangleTerms = &f.triangleTerms;
+      b.normalOffsets = &model.normalOffsets;
+      b.normalTriangles = &model.normalTriangles;
+      b.tangentOffsets = &model.tangentOffsets;
+      b.tangentTriangles = &model.tangentTriangles;
+      b.normalsOut = &f.normals;
+      b.tangentsOut = &f.tangents;
+      f.tangentFrames = tangentFramesPass_.bindTwoPass(ctx, b);
     }
+    if (normalMaps_) {
+      const uint32_t prev = (s + o.framesInFlight - 1) % o.framesInFlight;
+      f.blendBinding = blend_.makeBinding(ctx, frames_[prev].normalMaps, f.normalMaps, f.decodedMaps);
+    }
+  }
+}
+
+void FrameRecorder::forgetDecodedMaps() {
+  for (FrameResources& f : frames_) std::fill(f.slotMap.begin(), f.slotMap.end(), FrameResources::kNoMap);
 }
 
 void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& in) {
@@ -55,12 +74,19 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
   f.recordedTangentFrames = tangentFrames_;
   f.recordedNormalMaps = maps;
   f.decodedSlotCount = 0;
+  f.decodeJobCount = 0;
+  // The deform kernel's layouts: zero-padded weight rows, the top three rows of each skin matrix.
+  const uint32_t kk = m.kernelMeshComponents();
+  weightRows_.resize(size_t(in.instanceCount) * DeformPass::paddedComponents(kk));
   if (k == 0) {
-    std::memset(f.meshWeights.data(), 0, size_t(in.instanceCount) * sizeof(float));  // the kernel's padded K = 1
+    std::fill(weightRows_.begin(), weightRows_.end(), 0.f);  // the kernel's padded K = 1
   } else {
-    f.meshWeights.upload(*ctx_, in.meshWeights.data(), in.meshWeights.size() * sizeof(float));
+    DeformPass::packWeights(in.meshWeights.data(), in.instanceCount, uint32_t(k), weightRows_.data());
   }
-  f.skinMatrices.upload(*ctx_, in.skinMatrices.data(), in.skinMatrices.size() * sizeof(Mat4f));
+  f.meshWeights.upload(*ctx_, weightRows_.data(), weightRows_.size() * sizeof(float));
+  matrixRows_.resize(in.skinMatrices.size() * 12);
+  DeformPass::packSkinMatrices(in.skinMatrices.data(), in.skinMatrices.size(), matrixRows_.data());
+  f.skinMatrices.upload(*ctx_, matrixRows_.data(), matrixRows_.size() * sizeof(float));
 
   // Orders this frame after earlier frames' GPU work on the queue: their writes of the normal maps this
   // frame blends from, and their reads of buffers this frame overwrites.
@@ -71,8 +97,7 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
   DeformPass::Args d;
   d.mean = m.mean.address();
   d.basis = m.basis.address();
-  d.weights = f.meshWeights.address();
-  d.skinMatrices = f.skinMatrices.address();
+  d.instanceInputs = f.deformInputs.get();
   d.skinJoints = m.skinJoints.address();
   d.skinWeights = m.skinWeights.address();
   d.positionsOut = f.positions.address();
@@ -84,52 +109,60 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
 
   if (tangentFrames_) {
     computeToComputeBarrier(cmd);  // positions written -> read
-    TangentFramesPass::Args t;
-    t.positions = f.positions.address();
+    TangentFramesPass::Args t;  // two-pass: each triangle's terms computed once (the rest is in the set)
     t.uvs = m.uvs.address();
     t.triangles = m.triangles.address();
-    t.normalOffsets = m.normalOffsets.address();
-    t.normalTriangles = m.normalTriangles.address();
-    t.tangentOffsets = m.tangentOffsets.address();
-    t.tangentTriangles = m.tangentTriangles.address();
-    t.normalsOut = f.normals.address();
-    t.tangentsOut = f.tangents.address();
     t.vertexCount = m.vertexCount();
     t.instanceCount = in.instanceCount;
     t.hasUvs = m.hasUvs();
-    t.triangleTerms = f.triangleTerms.address();  // two-pass: each triangle's terms computed once
+    t.twoPass = f.tangentFrames.get();
     t.triangleCount = m.triangleCount();
     tangentFramesPass_.record(cmd, t);
     f.timestamps.mark(cmd, kAfterTangentFrames);
   }
 
   if (maps) {
-    // Each selected map decoded once: slots in first-selection order (a batch selects a few dozen
-    // maps at most, so a linear search beats hashing).
-    std::vector<uint32_t> slotMaps;
+    // Each selected map is decoded once into a slot of decodedMaps, and stays there for later frames
+    // (database maps are constant): only maps in no slot yet are decoded, into the slots least recently
+    // selected (never one this frame reads). A batch selects a few dozen maps at most, so linear
+    // searches beat hashing. The distinct maps of a frame never outnumber the slots (one per instance).
+    const uint64_t now = ++records_;  // 0 in slotLastUsed: never selected
+    auto slotOfMap = [&](uint32_t map) { return size_t(std::find(f.slotMap.begin(), f.slotMap.end(), map) - f.slotMap.begin()); };
+    for (uint32_t map : in.selectedMaps)  // first the slots this frame reads, so that none is given away
+      if (const size_t slot = slotOfMap(map); slot < f.slotMap.size()) f.slotLastUsed[slot] = now;
+    std::vector<uint32_t> jobMaps, jobSlots;
     std::vector<layout::NormalMapBlendCharacter> chars(in.instanceCount);
     for (uint32_t i = 0; i < in.instanceCount; ++i) {
-      const size_t slot = size_t(std::find(slotMaps.begin(), slotMaps.end(), in.selectedMaps[i]) - slotMaps.begin());
-      if (slot == slotMaps.size()) slotMaps.push_back(in.selectedMaps[i]);
+      const uint32_t map = in.selectedMaps[i];
+      size_t slot = slotOfMap(map);
+      if (slot == f.slotMap.size()) {
+        slot = size_t(std::min_element(f.slotLastUsed.begin(), f.slotLastUsed.end()) - f.slotLastUsed.begin());
+        f.slotMap[slot] = map;
+        f.slotLastUsed[slot] = now;
+        jobMaps.push_back(map);
+        jobSlots.push_back(uint32_t(slot));
+      }
       chars[i] = {uint32_t(slot), in.blendAlpha[i]};
     }
-    f.decodedSlotCount = uint32_t(slotMaps.size());
-    f.decodeSlotMaps.upload(*ctx_, slotMaps.data(), slotMaps.size() * sizeof(uint32_t));
+    f.decodedSlotCount = uint32_t(std::count(f.slotLastUsed.begin(), f.slotLastUsed.end(), now));
+    f.decodeJobCount = uint32_t(jobMaps.size());
+    jobMaps.insert(jobMaps.end(), jobSlots.begin(), jobSlots.end());
+    f.decodeSlotMaps.upload(*ctx_, jobMaps.data(), jobMaps.size() * sizeof(uint32_t));
     f.blendCharacters.upload(*ctx_, chars.data(), chars.size() * sizeof(chars[0]));
     VqDecodePass::Args v;
     v.codebook = m.codebook.address();
     v.indices = m.indices.address();
-    v.slotMaps = f.decodeSlotMaps.address();
+    v.jobMaps = f.decodeSlotMaps.address();
+    v.jobSlots = f.decodeSlotMaps.address() + f.decodeJobCount * sizeof(uint32_t);
     v.decodedOut = f.decodedMaps.address();
     v.width = m.mapWidth();
     v.height = m.mapHeight();
-    v.slotCount = f.decodedSlotCount;
+    v.jobCount = f.decodeJobCount;
     v.codebookSize = m.codebookSize();
     decode_.record(cmd, v);
     f.timestamps.mark(cmd, kAfterDecode);
     computeToComputeBarrier(cmd);  // decoded slots written -> read
     NormalMapBlendPass::Args b;
-    b.decoded = f.decodedMaps.address();
     b.characters = f.blendCharacters.address();
     b.width = m.mapWidth();
     b.height = m.mapHeight();

@@ -1,8 +1,8 @@
 #pragma once
 // Records one frame of swish's GPU work for a batch of instances of one model into a command buffer
 // the caller owns (the caller submits; nothing here submits frame work):
-//   deform (all instances, one dispatch) -> barrier -> tangent frames (one dispatch)
-//   VQ decode (each selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch)
+//   deform (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
+//   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch)
 // with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
 // uses slot f % framesInFlight and its blend reads the previous slot's normal maps.
 //
@@ -51,7 +51,11 @@ class FrameRecorder {
   const FrameResources& frame(uint32_t slot) const { return frames_.at(slot); }
 
   // Writes `inputs` into frame frameIndex's slot and records its passes into `cmd` (begun by the caller).
+  // The slot's decoded maps are kept for later frames: a caller that throws a recorded command buffer
+  // away instead of submitting it calls forgetDecodedMaps() before the next record().
   void record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& inputs);
+  // Every slot's decoded maps are decoded again when next selected.
+  void forgetDecodedMaps();
 
   // After the fence of that frame's submission.
   StageTimes stageTimes(uint32_t slot) const;
@@ -68,8 +72,10 @@ class FrameRecorder {
   DeformPass deform_;
   TangentFramesPass tangentFramesPass_;
   VqDecodePass decode_;
-  NormalMapBlendPass blend_;  // declared before frames_: their descriptor sets come from its pool
+  NormalMapBlendPass blend_;
   std::vector<FrameResources> frames_;
+  std::vector<float> weightRows_, matrixRows_;  // inputs in DeformPass's layouts
+  uint64_t records_ = 0;  // record() calls with normal maps: the clock of FrameResources::slotLastUsed
 };
 
 }  // namespace swish::gpu

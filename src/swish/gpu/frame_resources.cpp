@@ -1,8 +1,11 @@
 #include "swish/gpu/frame_resources.hpp"
 
+#include <algorithm>
+
 #include "shaders/swish_layouts.h"
 #include "swish/core/types.hpp"
 #include "swish/gpu/context.hpp"
+#include "swish/gpu/deform_pass.hpp"
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 
@@ -11,8 +14,10 @@ namespace swish::gpu {
 FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bool withFrames, bool withMaps, uint32_t slot) {
   const std::string tag = m.name() + " frame " + std::to_string(slot) + ": ";
   const VkDeviceSize n = m.vertexCount(), c = std::max(1u, cap);
-  meshWeights = Buffer(ctx, c * m.kernelMeshComponents() * sizeof(float), MemoryKind::HostVisible, tag + "mesh weights");
-  skinMatrices = Buffer(ctx, c * m.jointCount() * sizeof(Mat4f), MemoryKind::HostVisible, tag + "skin matrices");
+  meshWeights = Buffer(ctx, DeformPass::weightsBytes(uint32_t(c), m.kernelMeshComponents()), MemoryKind::HostVisible,
+                       tag + "mesh weights");
+  skinMatrices = Buffer(ctx, std::max<VkDeviceSize>(16, DeformPass::skinMatricesBytes(uint32_t(c), m.jointCount())),
+                        MemoryKind::HostVisible, tag + "skin matrices");
   positions = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "positions");
   if (withFrames) {
     normals = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "normals");
@@ -21,10 +26,12 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
                            MemoryKind::DeviceLocal, tag + "triangle terms");
   }
   if (withMaps) {
-    decodeSlotMaps = Buffer(ctx, c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode slot maps");
+    decodeSlotMaps = Buffer(ctx, 2 * c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode jobs");
     blendCharacters = Buffer(ctx, c * sizeof(layout::NormalMapBlendCharacter), MemoryKind::HostVisible, tag + "blend characters");
     decodedMaps = Buffer(ctx, c * m.mapWidth() * m.mapHeight() * 2, MemoryKind::DeviceLocal, tag + "decoded maps");
     normalMaps = NormalMapImages(ctx, m.mapWidth(), m.mapHeight(), uint32_t(c));
+    slotMap.assign(c, kNoMap);
+    slotLastUsed.assign(c, 0);
   }
   timestamps = TimestampQueries(ctx, 5);
 }

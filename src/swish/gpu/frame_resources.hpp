@@ -1,17 +1,21 @@
 #pragma once
 // The GPU resources of ONE frame in flight of a FrameRecorder: the per-frame inputs (host-visible,
 // written by the CPU each frame), the outputs (device-local: deformed positions, normals, tangents,
-// the decoded-map slots and the per-character normal maps) and the frame's timestamp queries.
+// the decoded-map slots and the per-character normal maps), the descriptor sets that bind them to the
+// passes (made once) and the frame's timestamp queries.
 // A frame in flight owns its outputs: while the host renderer still reads frame f's outputs, frame
 // f + 1 writes another FrameResources.
 //
 // Output layouts for a renderer (one vertex stream per attribute, instance i at byte offset
 // i * vertexCount * stride): positions and normals R32G32B32_SFLOAT (stride 12), tangents
 // R32G32B32A32_SFLOAT (stride 16, w = bitangent sign); UVs are the model's (GpuModel::uvs).
-// Every buffer has STORAGE | VERTEX | TRANSFER usage; normal maps are described in normal_map_images.hpp.
+// Every buffer has STORAGE | VERTEX | TRANSFER | texel-buffer usage; normal maps are described in
+// normal_map_images.hpp.
 #include <cstdint>
+#include <vector>
 
 #include "swish/gpu/buffer.hpp"
+#include "swish/gpu/descriptor_binding.hpp"
 #include "swish/gpu/normal_map_images.hpp"
 #include "swish/gpu/timestamp_queries.hpp"
 #include "swish/gpu/vk_unique.hpp"
@@ -28,23 +32,33 @@ struct FrameResources {
                  uint32_t slot);
 
   // Inputs, written by FrameRecorder::record.
-  Buffer meshWeights;      // float[instances][K]
-  Buffer skinMatrices;     // mat4[instances][joints]
-  Buffer decodeSlotMaps;   // uint[slots]
+  Buffer meshWeights;      // float[instances][K4] (DeformPass::packWeights)
+  Buffer skinMatrices;     // vec4[instances][joints][3] (DeformPass::packSkinMatrices)
+  Buffer decodeSlotMaps;   // the VQ decode jobs: uint[2][instances], maps then the slots they go to
   Buffer blendCharacters;  // layout::NormalMapBlendCharacter[instances]
   // Outputs.
   Buffer positions;        // float[instances][N][3]
   Buffer normals;          // float[instances][N][3]
   Buffer tangents;         // float[instances][N][4]
-  Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8), scratch of the normal-map passes
+  Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8): decoded database maps, one slot per instance
   Buffer triangleTerms;    // vec4[instances][T][3], scratch of the two-pass tangent frames
   NormalMapImages normalMaps;  // one layer per instance
-  VkUnique<VkDescriptorSet> blendBinding;  // prev frame's normalMaps -> this frame's normalMaps
+  DescriptorBinding deformInputs;   // meshWeights, skinMatrices
+  DescriptorBinding tangentFrames;  // positions, triangleTerms, the model's adjacency, normals, tangents
+  DescriptorBinding blendBinding;   // prev frame's normalMaps -> this frame's normalMaps, decodedMaps
+
+  // Which database map each slot of decodedMaps holds (kNoMap: none yet) and the last frame that
+  // selected it. Database maps never change, so a decoded slot stays valid until it is given to another
+  // map: a frame decodes only the maps not already in a slot (FrameRecorder::record).
+  static constexpr uint32_t kNoMap = 0xFFFFFFFFu;
+  std::vector<uint32_t> slotMap;
+  std::vector<uint64_t> slotLastUsed;
   TimestampQueries timestamps;
 
   // What the last record() into this frame did (for readback and timings).
   uint32_t instanceCount = 0;
-  uint32_t decodedSlotCount = 0;
+  uint32_t decodedSlotCount = 0;  // distinct maps the frame selected (slots it read)
+  uint32_t decodeJobCount = 0;    // of those, maps it decoded (not already in a slot)
   bool recordedTangentFrames = false;
   bool recordedNormalMaps = false;
 };

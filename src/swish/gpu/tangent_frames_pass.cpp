@@ -12,40 +12,62 @@ VkDeviceSize TangentFramesPass::triangleTermsBytes(uint32_t triangles, uint32_t 
   return VkDeviceSize(triangles) * instances * SWISH_TRIANGLE_TERM_VEC4S * 16;
 }
 
+namespace {
+std::vector<VkDescriptorType> twoPassTypes() {
+  std::vector<VkDescriptorType> t(SWISH_TF_BINDING_COUNT, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER);
+  t[SWISH_TF_BINDING_TERMS_OUT] = t[SWISH_TF_BINDING_NORMALS_OUT] = t[SWISH_TF_BINDING_TANGENTS_OUT] =
+      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  return t;
+}
+}  // namespace
+
 TangentFramesPass::TangentFramesPass(Context& ctx)
-    : pipeline_(ctx, "tangent_frames.comp", {kWorkgroupSize}, sizeof(layout::TangentFramesParams)),
-      trianglePipeline_(ctx, "triangle_frames.comp", {kWorkgroupSize}, sizeof(layout::TriangleFramesParams)),
-      gatherPipeline_(ctx, "vertex_frames_gather.comp", {kWorkgroupSize}, sizeof(layout::VertexFramesGatherParams)) {}
+    : twoPassLayout_(ctx, twoPassTypes()),
+      pipeline_(ctx, "tangent_frames.comp", {kWorkgroupSize}, sizeof(layout::TangentFramesParams)),
+      trianglePipeline_(ctx, "triangle_frames.comp", {kWorkgroupSize}, sizeof(layout::TriangleFramesParams), twoPassLayout_.get()),
+      gatherPipeline_(ctx, "vertex_frames_gather.comp", {kWorkgroupSize}, sizeof(layout::VertexFramesGatherParams),
+                      twoPassLayout_.get()) {}
+
+DescriptorBinding TangentFramesPass::bindTwoPass(Context& ctx, const TwoPassBuffers& b) const {
+  for (const Buffer* p : {b.positions, b.triangleTerms, b.normalOffsets, b.normalTriangles, b.tangentOffsets, b.tangentTriangles,
+                          b.normalsOut, b.tangentsOut})
+    if (!p) throw Error("tangent frames pass: a buffer of the two-pass binding is missing");
+  std::vector<BoundResource> r(SWISH_TF_BINDING_COUNT);
+  r[SWISH_TF_BINDING_POSITIONS] = BoundResource::texels(*b.positions, VK_FORMAT_R32_SFLOAT);
+  r[SWISH_TF_BINDING_TERMS_OUT] = BoundResource::storage(*b.triangleTerms);
+  r[SWISH_TF_BINDING_TERMS] = BoundResource::texels(*b.triangleTerms, VK_FORMAT_R32G32B32A32_SFLOAT);
+  r[SWISH_TF_BINDING_NORMAL_OFFSETS] = BoundResource::texels(*b.normalOffsets, VK_FORMAT_R32_UINT);
+  r[SWISH_TF_BINDING_NORMAL_TRIANGLES] = BoundResource::texels(*b.normalTriangles, VK_FORMAT_R32_UINT);
+  r[SWISH_TF_BINDING_TANGENT_OFFSETS] = BoundResource::texels(*b.tangentOffsets, VK_FORMAT_R32_UINT);
+  r[SWISH_TF_BINDING_TANGENT_TRIANGLES] = BoundResource::texels(*b.tangentTriangles, VK_FORMAT_R32_UINT);
+  r[SWISH_TF_BINDING_NORMALS_OUT] = BoundResource::storage(*b.normalsOut);
+  r[SWISH_TF_BINDING_TANGENTS_OUT] = BoundResource::storage(*b.tangentsOut);
+  return DescriptorBinding(ctx, twoPassLayout_, r);
+}
 
 void TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
   if (a.vertexCount == 0 || a.instanceCount == 0) return;
-  if (a.triangleTerms != 0 && a.triangleCount > 0) {
-    if (a.triangleTerms % 16 != 0) throw Error("tangent frames pass: the triangle-terms buffer is not 16-byte aligned");
-    layout::TriangleFramesParams tp;
-    tp.positions = layout::Address::of(a.positions);
-    tp.uvs = layout::Address::of(a.uvs);
-    tp.triangles = layout::Address::of(a.triangles);
-    tp.termsOut = layout::Address::of(a.triangleTerms);
-    tp.vertexCount = a.vertexCount;
-    tp.triangleCount = a.triangleCount;
-    tp.instanceCount = a.instanceCount;
-    tp.hasUvs = a.hasUvs ? 1u : 0u;
-    trianglePipeline_.bind(cmd, &tp, sizeof(tp));
-    vkCmdDispatch(cmd, groupCount(a.triangleCount, kWorkgroupSize), 1, 1);
-    computeToComputeBarrier(cmd);  // triangle terms written -> read by the gather
+  if (a.twoPass != VK_NULL_HANDLE) {
+    if (a.triangleCount > 0) {
+      layout::TriangleFramesParams tp;
+      tp.uvs = layout::Address::of(a.uvs);
+      tp.triangles = layout::Address::of(a.triangles);
+      tp.vertexCount = a.vertexCount;
+      tp.triangleCount = a.triangleCount;
+      tp.instanceCount = a.instanceCount;
+      tp.hasUvs = a.hasUvs ? 1u : 0u;
+      trianglePipeline_.bind(cmd, &tp, sizeof(tp));
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, trianglePipeline_.layout(), 0, 1, &a.twoPass, 0, nullptr);
+      vkCmdDispatch(cmd, groupCount(a.triangleCount, kWorkgroupSize), 1, 1);
+      computeToComputeBarrier(cmd);  // triangle terms written -> read by the gather
+    }
     layout::VertexFramesGatherParams gp;
-    gp.terms = layout::Address::of(a.triangleTerms);
-    gp.normalOffsets = layout::Address::of(a.normalOffsets);
-    gp.normalTriangles = layout::Address::of(a.normalTriangles);
-    gp.tangentOffsets = layout::Address::of(a.tangentOffsets);
-    gp.tangentTriangles = layout::Address::of(a.tangentTriangles);
-    gp.normalsOut = layout::Address::of(a.normalsOut);
-    gp.tangentsOut = layout::Address::of(a.tangentsOut);
     gp.vertexCount = a.vertexCount;
     gp.triangleCount = a.triangleCount;
     gp.instanceCount = a.instanceCount;
     gp.hasUvs = a.hasUvs ? 1u : 0u;
     gatherPipeline_.bind(cmd, &gp, sizeof(gp));
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gatherPipeline_.layout(), 0, 1, &a.twoPass, 0, nullptr);
     vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), a.instanceCount, 1);
     return;
   }

@@ -4,11 +4,16 @@
 // formulas and order as computeVertexFrames, no float atomics.
 //
 // Two ways, same results (bit for bit: same per-triangle values, same sums in the same order):
-//  - with a triangle-terms scratch buffer (Args::triangleTerms, triangleTermsBytes(T, instances) bytes)
-//    and Args::triangleCount: triangle_frames.comp computes each triangle's face and UV terms once per
-//    instance, a barrier, then vertex_frames_gather.comp sums them per vertex. Each triangle's terms
-//    are computed once instead of once per adjacent vertex and again for the tangents (~12x fewer);
-//  - without (triangleTerms == 0): the single-pass tangent_frames.comp recomputes them per vertex.
+//  - two passes, with a descriptor set from bindTwoPass (Args::twoPass) and Args::triangleCount:
+//    triangle_frames.comp computes each triangle's face and UV terms once per instance into a scratch
+//    buffer (triangleTermsBytes(T, instances) bytes), a barrier, then vertex_frames_gather.comp sums
+//    them per vertex. Each triangle's terms are computed once instead of once per adjacent vertex and
+//    again for the tangents (~12x fewer). The per-instance streams (positions, terms, the adjacency
+//    walked per instance, the frames written) go through the set as texel and storage buffers, the
+//    cheap ways on lavapipe (descriptor_binding.hpp); the set's buffers replace the address Args
+//    positions, normal/tangent offsets and triangles, normalsOut and tangentsOut;
+//  - one pass, without a set (twoPass == VK_NULL_HANDLE): tangent_frames.comp recomputes the terms per
+//    vertex, everything behind the address Args.
 // Records its dispatches (never submits). The caller puts computeToComputeBarrier between the deform
 // pass (which writes the positions) and this pass, and a barrier to its consumer after it.
 #include <vulkan/vulkan.h>
@@ -16,6 +21,7 @@
 #include <cstdint>
 
 #include "swish/gpu/compute_pipeline.hpp"
+#include "swish/gpu/descriptor_binding.hpp"
 
 namespace swish::gpu {
 
@@ -36,10 +42,23 @@ class TangentFramesPass {
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;
     bool hasUvs = true;
-    // Optional scratch for the two-pass path: vec4[instances][triangleCount][3], written then read
-    // within the recorded commands (a frame in flight needs its own).
-    VkDeviceAddress triangleTerms = 0;
-    uint32_t triangleCount = 0;  // triangles of `triangles`; needed with triangleTerms
+    // The two-pass path: its descriptor set (bindTwoPass) and the triangle count of `triangles`.
+    VkDescriptorSet twoPass = VK_NULL_HANDLE;
+    uint32_t triangleCount = 0;
+  };
+
+  // The buffers of the two-pass path (each bound from its start; the triangle terms are a scratch of
+  // triangleTermsBytes(T, instances) bytes, written then read within the recorded commands, so a frame
+  // in flight needs its own).
+  struct TwoPassBuffers {
+    const Buffer* positions = nullptr;         // float[instances][N][3]
+    const Buffer* triangleTerms = nullptr;     // vec4[instances][T][3]
+    const Buffer* normalOffsets = nullptr;     // uint[N+1]
+    const Buffer* normalTriangles = nullptr;   // uint[]
+    const Buffer* tangentOffsets = nullptr;    // uint[N+1]
+    const Buffer* tangentTriangles = nullptr;  // uint[]
+    const Buffer* normalsOut = nullptr;        // float[instances][N][3]
+    const Buffer* tangentsOut = nullptr;       // vec4[instances][N]
   };
 
   // Bytes of the triangle-terms scratch for `triangles` x `instances`.
@@ -47,9 +66,11 @@ class TangentFramesPass {
 
   TangentFramesPass() = default;
   explicit TangentFramesPass(Context& ctx);
+  DescriptorBinding bindTwoPass(Context& ctx, const TwoPassBuffers& buffers) const;
   void record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
+  DescriptorLayout twoPassLayout_;
   ComputePipeline pipeline_;         // single pass: tangent_frames.comp
   ComputePipeline trianglePipeline_; // two passes: triangle_frames.comp ...
   ComputePipeline gatherPipeline_;   // ... then vertex_frames_gather.comp

@@ -55,11 +55,12 @@ std::vector<PlannedAllocation> modelAllocations(const Model& m, const std::strin
 std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::string& owner, uint32_t instances,
                                                 bool frames, bool maps) {
   const uint64_t n = m.gameMesh.vertexCount(), c = std::max(1u, instances);
-  const uint64_t kk = std::max<uint64_t>(uint64_t(m.meshComponents()), 1), j = m.skeleton.size();
+  // The deform kernel reads the mesh weights as vec4 texels: K (at least 1) padded to a multiple of 4.
+  const uint64_t kk = (std::max<uint64_t>(uint64_t(m.meshComponents()), 1) + 3) / 4 * 4, j = m.skeleton.size();
   std::vector<PlannedAllocation> a;
   auto add = [&](const char* name, uint64_t bytes, bool image = false) { a.push_back({owner, name, bufferBytes(bytes), image}); };
   add("mesh weights", c * kk * 4);
-  add("skin matrices", c * j * 64);
+  add("skin matrices", c * j * 48);  // the top three rows of each affine matrix
   add("positions", c * n * 12);
   if (frames) {
     add("normals", c * n * 12);
@@ -67,7 +68,7 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
   }
   if (maps) {
     const uint64_t texels = uint64_t(m.normalMaps.width) * m.normalMaps.height;
-    add("decode slot maps", c * 4);
+    add("decode jobs", c * 8);  // map + slot of each map decoded
     add("blend characters", c * 8);
     add("decoded maps", c * texels * 2);
     add("normal maps (RG16 snorm array)", c * texels * 4, true);
