@@ -301,8 +301,10 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     for (size_t v = 0; v < nv; ++v) b[v] = blendedSkinMatrix(mesh_.skin, v, m).topRows<3>();
   };
   blendAll(localSkinMatrices(rest), blendOld);
-  std::vector<uint8_t> contact(nv, 0);
-  std::vector<Vec3f> contactPoint(kContactPlanes * nv), contactNormal(kContactPlanes * nv), attachTarget(attached_.size());
+  // Per vertex: its contact planes (closest point and normal of a body part) and how many it has.
+  std::vector<std::array<BodyCollider::Hit, kContactPlanes>> contacts(nv);
+  std::vector<uint8_t> contactCount(nv, 0);
+  std::vector<Vec3f> attachTarget(attached_.size());
   std::vector<float> lambda(cc.stretch.size() + cc.bending.size() + cc.shear.size() + attached_.size());
 
   float lastFrameSpeed = 0.f;
@@ -330,13 +332,8 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     // vertex settles in the crease. Measured on the 70 poses of the 201-pose default bake that failed
     // with one plane and 8 substeps: with two planes and 12 substeps, 40 of the 44 "ends inside the
     // body" failures go.
-    for (size_t v = 0; v < nv; ++v) {
-      std::array<BodyCollider::Hit, kContactPlanes> hits;
-      const size_t n = body.closestParts(x.row(Eigen::Index(v)), reach, std::span(hits));
-      contact[v] = uint8_t(n);
-      for (size_t k = 0; k < n; ++k)
-        contactPoint[kContactPlanes * v + k] = hits[k].point, contactNormal[kContactPlanes * v + k] = hits[k].normal;
-    }
+    for (size_t v = 0; v < nv; ++v)
+      contactCount[v] = uint8_t(body.closestParts(x.row(Eigen::Index(v)), reach, std::span(contacts[v])));
     for (size_t a = 0; a < attached_.size(); ++a) {
       const uint32_t v = attached_[a];
       if (!anchorTarget(anchors_[a], body, attachTarget[a]))  // no body near, or skinning collapsed it
@@ -380,10 +377,10 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
       // slide up to mu times the push (position-level Coulomb friction).
       for (size_t v = 0; v < nv; ++v) {
         V3 xv(x.data() + 3 * v);
-        for (size_t pass = 0; pass < (contact[v] > 1 ? 2u : 1u); ++pass)
-          for (size_t k = 0; k < contact[v]; ++k) {
-            const Vec3f& n = contactNormal[kContactPlanes * v + k];
-            const float depth = s.thickness - n.dot(xv - contactPoint[kContactPlanes * v + k]);
+        for (size_t pass = 0; pass < (contactCount[v] > 1 ? 2u : 1u); ++pass)
+          for (size_t k = 0; k < contactCount[v]; ++k) {
+            const Vec3f& n = contacts[v][k].normal;
+            const float depth = s.thickness - n.dot(xv - contacts[v][k].point);
             if (!(depth > 0.f)) continue;
             xv += depth * n;
             Vec3f slide = xv - xPrev.row(Eigen::Index(v)).transpose();
