@@ -47,9 +47,10 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::string& shaderName, co
   pipeline_ = VkUnique<VkPipeline>(pipeline, [dev](VkPipeline h) { vkDestroyPipeline(dev, h, nullptr); });
 }
 
-void ComputePipeline::bind(VkCommandBuffer cmd, const void* push, uint32_t bytes) const {
+void ComputePipeline::bind(VkCommandBuffer cmd, const void* push, uint32_t bytes, VkDescriptorSet set) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline());
   if (bytes) vkCmdPushConstants(cmd, layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
+  if (set != VK_NULL_HANDLE) vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout(), 0, 1, &set, 0, nullptr);
 }
 
 }  // namespace swish::gpu

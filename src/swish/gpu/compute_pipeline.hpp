@@ -23,8 +23,8 @@ class ComputePipeline {
   VkPipeline pipeline() const { return pipeline_.get(); }
   VkPipelineLayout layout() const { return layout_.get(); }
 
-  // Binds the pipeline and pushes `bytes` of push constants.
-  void bind(VkCommandBuffer cmd, const void* push, uint32_t bytes) const;
+  // Binds the pipeline, pushes `bytes` of push constants and, when given, binds `set` as set 0.
+  void bind(VkCommandBuffer cmd, const void* push, uint32_t bytes, VkDescriptorSet set = VK_NULL_HANDLE) const;
 
  private:
   VkUnique<VkPipelineLayout> layout_;

@@ -53,8 +53,7 @@ void DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.instanceCount = a.instanceCount;
   p.jointCount = a.jointCount;
   p.pad0 = 0;
-  pipeline_.bind(cmd, &p, sizeof(p));
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.layout(), 0, 1, &a.instanceInputs, 0, nullptr);
+  pipeline_.bind(cmd, &p, sizeof(p), a.instanceInputs);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
 }
 

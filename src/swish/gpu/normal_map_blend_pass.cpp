@@ -32,8 +32,7 @@ void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, co
   p.height = a.height;
   p.characterCount = a.characterCount;
   p.pad0 = 0;
-  pipeline_.bind(cmd, &p, sizeof(p));
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.layout(), 0, 1, &binding, 0, nullptr);
+  pipeline_.bind(cmd, &p, sizeof(p), binding);
   vkCmdDispatch(cmd, groupCount(uint64_t(a.width / 4) * (a.height / 4), kWorkgroupSize), 1, a.characterCount);
 }
 

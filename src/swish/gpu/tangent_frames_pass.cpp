@@ -56,8 +56,7 @@ void TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
       tp.triangleCount = a.triangleCount;
       tp.instanceCount = a.instanceCount;
       tp.hasUvs = a.hasUvs ? 1u : 0u;
-      trianglePipeline_.bind(cmd, &tp, sizeof(tp));
-      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, trianglePipeline_.layout(), 0, 1, &a.twoPass, 0, nullptr);
+      trianglePipeline_.bind(cmd, &tp, sizeof(tp), a.twoPass);
       vkCmdDispatch(cmd, groupCount(a.triangleCount, kWorkgroupSize), 1, 1);
       computeToComputeBarrier(cmd);  // triangle terms written -> read by the gather
     }
@@ -66,8 +65,7 @@ void TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
     gp.triangleCount = a.triangleCount;
     gp.instanceCount = a.instanceCount;
     gp.hasUvs = a.hasUvs ? 1u : 0u;
-    gatherPipeline_.bind(cmd, &gp, sizeof(gp));
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gatherPipeline_.layout(), 0, 1, &a.twoPass, 0, nullptr);
+    gatherPipeline_.bind(cmd, &gp, sizeof(gp), a.twoPass);
     vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), a.instanceCount, 1);
     return;
   }
