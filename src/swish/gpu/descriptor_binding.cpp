@@ -1,5 +1,6 @@
 #include "swish/gpu/descriptor_binding.hpp"
 
+#include <algorithm>
 #include <map>
 #include <string>
 
@@ -132,17 +133,18 @@ DescriptorBinding::DescriptorBinding(Context& ctx, const DescriptorLayout& layou
     const Buffer& b = *r.buffer;
     if (r.offset >= b.size()) throw Error(where + ": offset beyond buffer '" + b.name() + "'");
     const VkDeviceSize rest = b.size() - r.offset;
+    const VkDeviceSize bytes = r.range == VK_WHOLE_SIZE ? rest : std::min(r.range, rest);
     if (r.type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
       if (r.offset % limits.minStorageBufferOffsetAlignment)
         throw Error(where + ": storage offset into '" + b.name() + "' is not aligned to the device's minimum");
-      bufferOf[i] = {b.handle(), r.offset, r.range == VK_WHOLE_SIZE ? rest : std::min(r.range, rest)};
+      bufferOf[i] = {b.handle(), r.offset, bytes};
       w.pBufferInfo = &bufferOf[i];
       continue;
     }
     const VkDeviceSize texel = texelBytes(r.format);
     if (r.offset % limits.minTexelBufferOffsetAlignment)
       throw Error(where + ": texel offset into '" + b.name() + "' is not aligned to the device's minimum");
-    const VkDeviceSize texels = std::min(r.range == VK_WHOLE_SIZE ? rest : std::min(r.range, rest), rest) / texel;
+    const VkDeviceSize texels = bytes / texel;
     if (texels == 0) throw Error(where + ": buffer '" + b.name() + "' holds no whole texel");
     if (texels > limits.maxTexelBufferElements)
       throw Error(where + ": buffer '" + b.name() + "' holds " + std::to_string(texels) + " texels, beyond the device's " +
