@@ -29,9 +29,7 @@ struct StagingFolder {
 };
 
 void writeNormalMap(const fs::path& file, const runtime::BlendedNormalMap& map) {
-  std::vector<float> xy(map.xy.size());
-  for (size_t i = 0; i < xy.size(); ++i) xy[i] = runtime::snorm16ToFloat(map.xy[i]);
-  io::writePng(file, io::encodeNormalMap(map.width, map.height, xy, 16));
+  io::writePng(file, io::encodeNormalMap(map.width, map.height, runtime::xyAsFloat(map), 16));
 }
 
 }  // namespace

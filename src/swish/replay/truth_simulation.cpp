@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "swish/bake/bake_config.hpp"
 #include "swish/bake/bake_evaluation.hpp"
 #include "swish/bake/dataset_builder.hpp"
 #include "swish/core/error.hpp"
@@ -216,8 +217,7 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
     m.summary.ok = true;
     m.summary.meanMm = st.mean, m.summary.p95Mm = st.p95, m.summary.maxMm = st.max;
     if (normalMaps_ && normalMap && normalMap->width == shape.normalMap.width && normalMap->height == shape.normalMap.height) {
-      bake::NormalMapImage shown{normalMap->width, normalMap->height, std::vector<float>(normalMap->xy.size())};
-      for (size_t i = 0; i < shown.xy.size(); ++i) shown.xy[i] = runtime::snorm16ToFloat(normalMap->xy[i]);
+      const bake::NormalMapImage shown{normalMap->width, normalMap->height, runtime::xyAsFloat(*normalMap)};
       m.angles = std::make_unique<bake::AngularErrorAccumulator>();
       m.angles->addMaps(shape.normalMap, shown);
       const bake::AngularErrorStats a = m.angles->stats();

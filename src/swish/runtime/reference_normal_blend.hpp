@@ -5,6 +5,7 @@
 //   out  = prev * (1 - alpha) + d * alpha           (GLSL mix, in that order)
 //   stored = round(clamp(out, -1, 1) * 32767)       (NaN stores 0)
 // Vulkan lets a device round float -> snorm either way near a tie, so the GPU matches within 1 LSB.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -22,6 +23,12 @@ struct BlendedNormalMap {
 };
 
 inline float snorm16ToFloat(int16_t v) { return std::max(float(v) / 32767.f, -1.f); }
+// The map's X, Y as floats in [-1, 1], in its layout (for PNG export and comparison with baked maps).
+inline std::vector<float> xyAsFloat(const BlendedNormalMap& map) {
+  std::vector<float> xy(map.xy.size());
+  for (size_t i = 0; i < xy.size(); ++i) xy[i] = snorm16ToFloat(map.xy[i]);
+  return xy;
+}
 int16_t floatToSnorm16(float f);
 
 // Blends `decoded` into `map` in place. Sizes must match (Error otherwise).
