@@ -17,6 +17,7 @@
 #include "support/paths.hpp"
 #include "support/random_model.hpp"
 #include "support/temp_dir.hpp"
+#include "swish/bake/bake_config.hpp"
 #include "swish/bake/dataset_builder.hpp"
 #include "swish/bake/default_character.hpp"
 #include "swish/model/model_file.hpp"

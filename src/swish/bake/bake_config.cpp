@@ -13,7 +13,7 @@ namespace {
 struct Checker {
   std::string source;
   [[noreturn]] void fail(const std::string& key, const std::string& problem) const {
-    throw Error(source + ": " + key + ": " + problem);
+    throw Error((source.empty() ? "" : source + ": ") + key + ": " + problem);
   }
   void onlyKeys(const nlohmann::json& obj, const std::string& prefix, const std::set<std::string>& allowed) const {
     if (!obj.is_object()) fail(prefix.empty() ? "(top level)" : prefix, "must be a JSON object");
@@ -126,6 +126,63 @@ void parseClips(const Checker& c, const nlohmann::json& v, const std::filesystem
   }
 }
 
+// The "simulation", "transfer" and "normal_maps" objects of `j` (named `prefix` in errors): a bake
+// config's part1, or the settings a dataset and a baked model carry (DatasetBuildSettings::toJson).
+void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::string& prefix, DatasetBuildSettings& s) {
+  const nlohmann::json sim = j.value("simulation", nlohmann::json::object());
+  std::string p = prefix + ".simulation";
+  c.onlyKeys(sim, p,
+             {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
+              "iterations", "threads", "gravity", "limb_clearance"});
+  ClothSimSettings& cs = s.simulation;
+  if (sim.contains("preset")) {
+    try {
+      cs.material = clothMaterialPreset(c.string(sim, "preset", "", p));
+    } catch (const Error& e) {
+      c.fail(p + ".preset", e.what());
+    }
+  }
+  s.simulationVertices = size_t(c.number(sim, p, "vertices", 0, 2e6, double(s.simulationVertices), true));
+  cs.thickness = float(c.number(sim, p, "thickness", 0, 0.05, cs.thickness));
+  cs.transitionSeconds = float(c.number(sim, p, "transition_seconds", 0.05, 10, cs.transitionSeconds));
+  cs.settleSeconds = float(c.number(sim, p, "settle_seconds", 0, 10, cs.settleSeconds));
+  cs.frameRate = float(c.number(sim, p, "frame_rate", 5, 1000, cs.frameRate));
+  cs.substeps = int(c.number(sim, p, "substeps", 1, 1000, cs.substeps, true));
+  cs.iterations = int(c.number(sim, p, "iterations", 1, 1000, cs.iterations, true));
+  s.threads = int(c.number(sim, p, "threads", 0, 1024, s.threads, true));
+  // Gravity along -Y in m/s^2 (0 turns it off: see docs/baking.md for why a bake may need that).
+  cs.gravity = Vec3f(0.f, -float(c.number(sim, p, "gravity", 0, 100, -cs.gravity.y())), 0.f);
+  // Metres kept between a limb and the trunk (limb_clearance.hpp); 0 leaves the poses as recorded.
+  s.limbClearance.clearance = float(c.number(sim, p, "limb_clearance", 0, 0.1, s.limbClearance.clearance));
+  try {
+    cs.validate();
+  } catch (const Error& e) {
+    c.fail(p, e.what());
+  }
+
+  const nlohmann::json tr = j.value("transfer", nlohmann::json::object());
+  p = prefix + ".transfer";
+  c.onlyKeys(tr, p, {"smoothing_strength", "smoothing_iterations", "smoothing_weights"});
+  LaplacianSmoothingSettings& ls = s.transfer.smoothing;
+  ls.strength = float(c.number(tr, p, "smoothing_strength", 0, 1, ls.strength));
+  ls.iterations = int(c.number(tr, p, "smoothing_iterations", 0, 1000, ls.iterations, true));
+  const std::string weights = c.string(tr, "smoothing_weights", "cotangent", p);
+  if (weights == "cotangent") ls.weights = LaplacianWeights::Cotangent;
+  else if (weights == "uniform") ls.weights = LaplacianWeights::Uniform;
+  else c.fail(p + ".smoothing_weights", "'" + weights + "' is not one of cotangent, uniform");
+
+  const nlohmann::json nm = j.value("normal_maps", nlohmann::json::object());
+  p = prefix + ".normal_maps";
+  c.onlyKeys(nm, p, {"size", "max_distance", "dilation_rings", "bit_depth"});
+  NormalMapBakeSettings& nb = s.transfer.normalMap;
+  nb.width = nb.height = uint32_t(c.number(nm, p, "size", 4, 4096, nb.width, true));
+  if (nb.width % 4 != 0) c.fail(p + ".size", "must be a multiple of 4 (the VQ codebook works on 4x4 blocks)");
+  nb.maxDistance = float(c.number(nm, p, "max_distance", 1e-4, 1, nb.maxDistance));
+  nb.dilationRings = int(c.number(nm, p, "dilation_rings", 0, 256, nb.dilationRings, true));
+  s.normalMapBitDepth = uint32_t(c.number(nm, p, "bit_depth", 8, 16, s.normalMapBitDepth, true));
+  if (s.normalMapBitDepth != 8 && s.normalMapBitDepth != 16) c.fail(p + ".bit_depth", "must be 8 or 16");
+}
+
 DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const std::filesystem::path& baseDir) {
   c.onlyKeys(j, "part1",
              {"character", "clips", "input_joints", "sampling", "thinning", "simulation", "transfer", "normal_maps",
@@ -157,58 +214,7 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
   s.thinningTolerance = float(c.number(thin, p, "tolerance", 1e-6, 100, 0));
   s.targetPoses = size_t(c.number(thin, p, "target_poses", 2, 1e6, 0, true));
 
-  const nlohmann::json sim = j.value("simulation", nlohmann::json::object());
-  p = "part1.simulation";
-  c.onlyKeys(sim, p,
-             {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
-              "iterations", "threads", "gravity", "limb_clearance"});
-  ClothSimSettings& cs = s.simulation;
-  if (sim.contains("preset")) {
-    try {
-      cs.material = clothMaterialPreset(c.string(sim, "preset", "", p));
-    } catch (const Error& e) {
-      c.fail(p + ".preset", e.what());
-    }
-  }
-  s.simulationVertices = size_t(c.number(sim, p, "vertices", 0, 2e6, double(s.simulationVertices), true));
-  cs.thickness = float(c.number(sim, p, "thickness", 0, 0.05, cs.thickness));
-  cs.transitionSeconds = float(c.number(sim, p, "transition_seconds", 0.05, 10, cs.transitionSeconds));
-  cs.settleSeconds = float(c.number(sim, p, "settle_seconds", 0, 10, cs.settleSeconds));
-  cs.frameRate = float(c.number(sim, p, "frame_rate", 5, 1000, cs.frameRate));
-  cs.substeps = int(c.number(sim, p, "substeps", 1, 1000, cs.substeps, true));
-  cs.iterations = int(c.number(sim, p, "iterations", 1, 1000, cs.iterations, true));
-  s.threads = int(c.number(sim, p, "threads", 0, 1024, s.threads, true));
-  // Gravity along -Y in m/s^2 (0 turns it off: see docs/baking.md for why a bake may need that).
-  cs.gravity = Vec3f(0.f, -float(c.number(sim, p, "gravity", 0, 100, -cs.gravity.y())), 0.f);
-  // Metres kept between a limb and the trunk (limb_clearance.hpp); 0 leaves the poses as recorded.
-  s.limbClearance.clearance = float(c.number(sim, p, "limb_clearance", 0, 0.1, s.limbClearance.clearance));
-  try {
-    cs.validate();
-  } catch (const Error& e) {
-    c.fail(p, e.what());
-  }
-
-  const nlohmann::json tr = j.value("transfer", nlohmann::json::object());
-  p = "part1.transfer";
-  c.onlyKeys(tr, p, {"smoothing_strength", "smoothing_iterations", "smoothing_weights"});
-  LaplacianSmoothingSettings& ls = s.transfer.smoothing;
-  ls.strength = float(c.number(tr, p, "smoothing_strength", 0, 1, ls.strength));
-  ls.iterations = int(c.number(tr, p, "smoothing_iterations", 0, 1000, ls.iterations, true));
-  const std::string weights = c.string(tr, "smoothing_weights", "cotangent", p);
-  if (weights == "cotangent") ls.weights = LaplacianWeights::Cotangent;
-  else if (weights == "uniform") ls.weights = LaplacianWeights::Uniform;
-  else c.fail(p + ".smoothing_weights", "'" + weights + "' is not one of cotangent, uniform");
-
-  const nlohmann::json nm = j.value("normal_maps", nlohmann::json::object());
-  p = "part1.normal_maps";
-  c.onlyKeys(nm, p, {"size", "max_distance", "dilation_rings", "bit_depth"});
-  NormalMapBakeSettings& nb = s.transfer.normalMap;
-  nb.width = nb.height = uint32_t(c.number(nm, p, "size", 4, 4096, nb.width, true));
-  if (nb.width % 4 != 0) c.fail(p + ".size", "must be a multiple of 4 (the VQ codebook works on 4x4 blocks)");
-  nb.maxDistance = float(c.number(nm, p, "max_distance", 1e-4, 1, nb.maxDistance));
-  nb.dilationRings = int(c.number(nm, p, "dilation_rings", 0, 256, nb.dilationRings, true));
-  s.normalMapBitDepth = uint32_t(c.number(nm, p, "bit_depth", 8, 16, s.normalMapBitDepth, true));
-  if (s.normalMapBitDepth != 8 && s.normalMapBitDepth != 16) c.fail(p + ".bit_depth", "must be 8 or 16");
+  parseShapeSections(c, j, "part1", s);
 
   const nlohmann::json pv = j.value("preview", nlohmann::json::object());
   p = "part1.preview";
@@ -218,6 +224,14 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
   return s;
 }
 }  // namespace
+
+PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSettings, const std::string& what) {
+  const Checker c{""};  // errors read "<what>.simulation.substeps: ..."
+  if (!datasetSettings.is_object()) c.fail(what, "the dataset settings must be a JSON object");
+  DatasetBuildSettings s;
+  parseShapeSections(c, datasetSettings, what, s);
+  return s.poseShape();
+}
 
 BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source, const std::filesystem::path& baseDir) {
   const Checker c{source};

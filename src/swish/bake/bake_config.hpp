@@ -64,4 +64,11 @@ struct BakeConfig {
 BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source, const std::filesystem::path& baseDir);
 BakeConfig loadBakeConfig(const std::filesystem::path& file);
 
+// The pose-shape settings back from the JSON form DatasetBuildSettings::toJson writes (its
+// "simulation", "transfer" and "normal_maps" objects, the same keys and ranges as a config's part1),
+// which a dataset's part1_settings.json and a baked model's metadata ("dataset_settings") carry. Absent
+// keys keep their defaults. Throws Error naming `what` and the key ("meta.simulation.substeps: ...")
+// for an unknown key, a value of the wrong type or out of range, or an unknown cloth preset.
+PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSettings, const std::string& what);
+
 }  // namespace swish::bake

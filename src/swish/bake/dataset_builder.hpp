@@ -73,7 +73,7 @@ struct DatasetBuildSettings {
   // Every setting as JSON (for the dataset manifest and the rebuild check above).
   nlohmann::json toJson() const;
   // The settings of the one-pose simulation (pose_shape.hpp); poseShapeSettingsFromJson(toJson())
-  // gives them back.
+  // (bake_config.hpp) gives them back.
   PoseShapeSettings poseShape() const;
 };
 

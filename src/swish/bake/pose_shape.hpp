@@ -18,8 +18,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "swish/bake/cloth_solver.hpp"
 #include "swish/bake/dataset.hpp"
 #include "swish/bake/limb_clearance.hpp"
@@ -36,12 +34,6 @@ struct PoseShapeSettings {
   LimbClearanceSettings limbClearance;  // clearance 0: poses are simulated as recorded
   PoseTransferSettings transfer;
 };
-
-// The settings back from the JSON form DatasetBuildSettings::toJson writes (its "simulation",
-// "transfer" and "normal_maps" objects), which a dataset's part1_settings.json and a baked model's
-// metadata ("dataset_settings") carry. Absent keys keep their defaults. Throws Error naming `what`
-// and the key for a value of the wrong type or out of range, or an unknown cloth preset.
-PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSettings, const std::string& what);
 
 // The pose as the bake simulates and stores it: the root joint at its rest rotation and translation
 // (the shape is a function of the other joints' rotations; dataset_builder.hpp says why).
