@@ -139,6 +139,16 @@ TEST(BakeWhole, DefaultCharacterAndMocapToLoadableModel) {
   EXPECT_LT(meanMm, 30.0);
   const auto report = nlohmann::json::parse(std::ifstream(w.config.reportDir() / "report.json"));
   EXPECT_LT(report["vertex_error_held_out"]["total"]["mean_mm"].get<double>(), 30.0);
+
+  // The A-pose joins the walk's poses (no walking frame is near it) as the last pose, simulates (it is
+  // where every transition starts) and is always trained on, never held out.
+  EXPECT_TRUE(p1["rest_pose_added"].get<bool>());
+  const DatasetPose& rest = ds.poses.back();
+  EXPECT_EQ(rest.id, kept - 1);
+  const Pose restPose = ds.character.skeleton.restPose();
+  for (size_t j = 1; j < restPose.local.size(); ++j)  // the root is canonical anyway
+    EXPECT_TRUE(rest.pose.local[j].isApprox(restPose.local[j], 1e-6f)) << "joint " << j;
+  EXPECT_EQ(report["poses"]["always_trained"], nlohmann::json::array({rest.id}));
 }
 
 TEST(BakeWhole, ReRunRedoesNothing) {

@@ -70,6 +70,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(d.part1->clips.size(), 1u);
   EXPECT_EQ(d.part1->targetPoses, 200u);
   EXPECT_EQ(d.part1->thinningTolerance, 0.f);
+  EXPECT_TRUE(d.part1->includeRestPose);
   EXPECT_EQ(d.part1->inputJoints, defaultInputJointNames());
   EXPECT_EQ(d.part1->simulation.material.name, "jersey");
   EXPECT_EQ(d.part1->transfer.normalMap.width, 360u);
@@ -80,7 +81,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                         {"clips", {{{"file", std::string(__FILE__)}, {"naming", "mixamo"},
                                     {"joint_map", {{"Hips", "Hips"}}}}}},
                         {"input_joints", {"Spine", "Spine1"}},
-                        {"thinning", {{"tolerance", 0.25}}},
+                        {"thinning", {{"tolerance", 0.25}, {"include_rest_pose", false}}},
                         {"simulation", {{"preset", "stiff"}, {"vertices", 4000}, {"threads", 2}, {"substeps", 4}, {"gravity", 0}}},
                         {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
                         {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
@@ -95,6 +96,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(s.inputJoints.size(), 2u);
   EXPECT_FLOAT_EQ(s.thinningTolerance, 0.25f);
   EXPECT_EQ(s.targetPoses, 0u);
+  EXPECT_FALSE(s.includeRestPose);
   EXPECT_EQ(s.simulation.material.name, "stiff");
   EXPECT_EQ(s.simulationVertices, 4000u);
   EXPECT_EQ(s.threads, 2);
@@ -118,6 +120,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");
   says(part1Error({{"thinning", nlohmann::json::object()}}), "part1.thinning: give exactly one");
   says(part1Error({{"thinning", {{"target_poses", 1}}}}), "part1.thinning.target_poses: 1 is outside");
+  says(part1Error({{"thinning", {{"target_poses", 10}, {"include_rest_pose", 1}}}}), "part1.thinning.include_rest_pose");
   says(part1Error({{"clips", {"/nonexistent/walk.bvh"}}}), "part1.clips[0]: file /nonexistent/walk.bvh does not exist");
   says(part1Error({{"clips", nlohmann::json::array()}}), "part1.clips: must be a non-empty array");
   says(part1Error({{"clips", {{{"file", std::string(__FILE__)}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");

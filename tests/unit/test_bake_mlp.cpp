@@ -112,6 +112,55 @@ TEST(BakeMlp, TrainsASmoothMapDeterministicallyAndKeepsTheBestEpoch) {
   EXPECT_LT(err, 0.1 * spread);
 }
 
+TEST(BakeMlp, SeededSplitNeverHoldsAPinnedIndex) {
+  // Without pins: the plain Fisher-Yates draw (the split bakes made before pins existed).
+  Rng a(test::testSeed(21)), b(test::testSeed(21));
+  const IndexSplit plain = seededSplit(40, 6, a);
+  std::vector<uint32_t> order(40);
+  for (uint32_t i = 0; i < 40; ++i) order[i] = i;
+  for (size_t i = order.size() - 1; i > 0; --i) std::swap(order[i], order[b.below(i + 1)]);
+  std::vector<uint32_t> held(order.begin(), order.begin() + 6);
+  std::sort(held.begin(), held.end());
+  EXPECT_EQ(plain.held, held);
+  EXPECT_EQ(plain.kept.size(), 34u);
+
+  for (uint64_t seed = 0; seed < 50; ++seed) {
+    Rng r(seed);
+    const std::vector<uint32_t> pins{3, 39};
+    const IndexSplit s = seededSplit(40, 10, r, pins);
+    ASSERT_EQ(s.held.size(), 10u);
+    ASSERT_EQ(s.kept.size(), 30u);
+    for (uint32_t p : pins) {
+      EXPECT_FALSE(std::binary_search(s.held.begin(), s.held.end(), p)) << "seed " << seed;
+      EXPECT_TRUE(std::binary_search(s.kept.begin(), s.kept.end(), p)) << "seed " << seed;
+    }
+    EXPECT_TRUE(std::is_sorted(s.held.begin(), s.held.end()));
+    EXPECT_TRUE(std::is_sorted(s.kept.begin(), s.kept.end()));
+  }
+  Rng r(1);
+  EXPECT_EQ(seededSplit(3, 5, r, std::vector<uint32_t>{0, 1}).held, std::vector<uint32_t>{2});  // at most n - pinned
+}
+
+TEST(BakeMlp, AlwaysTrainSamplesAreNeverValidated) {
+  Rng rng(test::testSeed(22));
+  MatXf x(3, 50), y(2, 50);
+  for (int i = 0; i < 50; ++i) {
+    x.col(i) << float(rng.normal()), float(rng.normal()), float(rng.normal());
+    y.col(i) << x(0, i) + x(1, i), x(2, i) * x(0, i);
+  }
+  MlpTrainOptions o;
+  o.hiddenLayers = 1, o.hiddenWidth = 8, o.maxEpochs = 5, o.validationFraction = 0.3;
+  o.alwaysTrain = {0, 17, 49};
+  const MlpTrainResult r = trainMlp(x, y, o);
+  EXPECT_EQ(r.validationSamples.size(), 15u);
+  for (uint32_t p : o.alwaysTrain) {
+    EXPECT_FALSE(std::binary_search(r.validationSamples.begin(), r.validationSamples.end(), p));
+    EXPECT_TRUE(std::binary_search(r.trainingSamples.begin(), r.trainingSamples.end(), p));
+  }
+  o.alwaysTrain = {50};
+  EXPECT_THROW(trainMlp(x, y, o), Error);
+}
+
 TEST(BakeMlp, ConstantInputsAndOutputsStayFinite) {
   MatXf x = MatXf::Random(6, 40), y(2, 40);
   x.row(2).setConstant(0.5f);  // a joint coordinate that never changes

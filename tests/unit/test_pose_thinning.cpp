@@ -107,6 +107,26 @@ TEST(PoseThinning, BisectionReachesTargetCount) {
   EXPECT_EQ(thinPosesToCount(s, s.size() + 5).kept.size(), s.size());
 }
 
+TEST(PoseThinning, NearestKeptDistanceIsTheBruteForceMinimum) {
+  const PoseSamples s = randomWalks(4, 50, 6, test::testSeed(11));
+  const ThinningResult t = thinPoses(s, 0.4f);
+  ASSERT_GT(t.kept.size(), 3u);
+  // Every sample is within the tolerance of a kept pose (the thinning's guarantee), and a kept pose
+  // is at distance 0 from itself.
+  for (size_t i = 0; i < s.size(); i += 7) {
+    const float d = nearestKeptDistance(s, t.kept, std::span<const float>(s.row(i), size_t(s.dim)));
+    float brute = INFINITY;
+    for (uint32_t k : t.kept) brute = std::min(brute, distance(s, i, k));
+    EXPECT_NEAR(d, brute, 1e-5f);
+    EXPECT_LE(d, 0.4f + 1e-5f);
+  }
+  EXPECT_EQ(nearestKeptDistance(s, t.kept, std::span<const float>(s.row(t.kept[2]), size_t(s.dim))), 0.f);
+  const std::vector<float> far(6, 100.f);
+  EXPECT_GT(nearestKeptDistance(s, t.kept, far), 100.f);
+  EXPECT_TRUE(std::isinf(nearestKeptDistance(s, {}, far)));
+  EXPECT_THROW(nearestKeptDistance(s, t.kept, std::vector<float>(5, 0.f)), Error);
+}
+
 TEST(PoseThinning, BadInputIsAnError) {
   PoseSamples s = randomWalks(1, 10, 6, 1);
   EXPECT_THROW(thinPoses(s, -1.f), Error);

@@ -208,11 +208,12 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
   if (!j.contains("thinning")) c.fail("part1.thinning", "is required: {\"tolerance\": t} or {\"target_poses\": n}");
   const nlohmann::json& thin = j.at("thinning");
   p = "part1.thinning";
-  c.onlyKeys(thin, p, {"tolerance", "target_poses"});
+  c.onlyKeys(thin, p, {"tolerance", "target_poses", "include_rest_pose"});
   if (thin.contains("tolerance") == thin.contains("target_poses"))
     c.fail(p, "give exactly one of \"tolerance\" and \"target_poses\"");
   s.thinningTolerance = float(c.number(thin, p, "tolerance", 1e-6, 100, 0));
   s.targetPoses = size_t(c.number(thin, p, "target_poses", 2, 1e6, 0, true));
+  s.includeRestPose = c.boolean(thin, p, "include_rest_pose", s.includeRestPose);
 
   parseShapeSections(c, j, "part1", s);
 

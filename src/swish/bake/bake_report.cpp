@@ -45,6 +45,9 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   nlohmann::json r;
   r["character"] = ds.character.name;
   r["poses"] = {{"dataset", ds.poses.size()}, {"training", out.trainingPoses.size()}, {"held_out", out.testPoses.size()}};
+  nlohmann::json pinned = nlohmann::json::array();  // dataset pose ids always trained on (the rest pose)
+  for (uint32_t i : out.pinnedPoses) pinned.push_back(ds.poses[i].id);
+  r["poses"]["always_trained"] = pinned;
   r["settings"] = out.metadata.value("settings", nlohmann::json::object());
   nlohmann::json perK = nlohmann::json::array();
   const auto rms = truncationRmsMm(out.meshPca);
@@ -116,7 +119,9 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   std::ostringstream md;
   md << "# Bake report: " << ds.character.name << "\n\n";
   md << ds.poses.size() << " poses: " << out.trainingPoses.size() << " for training, " << out.testPoses.size()
-     << " held out (nothing is fitted on them). All errors below are on the held-out poses, through the runtime path "
+     << " held out (nothing is fitted on them)"
+     << (out.pinnedPoses.empty() ? "" : "; the rest pose part 1 added is always among the training poses")
+     << ". All errors below are on the held-out poses, through the runtime path "
         "(Theta -> MLP -> PCA -> skinning; nearest code -> VQ decode).\n\n";
   md << "## Mesh\n\n| error (mm) | mean | p95 | max |\n|---|---|---|---|\n";
   auto row = [&](const char* name, const DistanceStats& s) {

@@ -61,15 +61,17 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   };
 
   // Held-out split (seeded shuffle, sorted back so results do not depend on dataset order quirks).
+  // The rest pose part 1 added (dataset_builder.hpp) is always trained on, never held out: it is
+  // there so that the network knows the A-pose, not to be measured.
+  std::vector<uint32_t>& pinned = out.pinnedPoses;
+  const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") && ds.settings["rest_pose_id"].is_number_integer();
+  const int64_t restId = hasRest ? ds.settings["rest_pose_id"].get<int64_t>() : int64_t(-1);
+  for (size_t i = 0; i < poses; ++i)
+    if (restId >= 0 && int64_t(ds.poses[i].id) == restId) pinned.push_back(uint32_t(i));
   Rng rng(st.seed);
-  std::vector<uint32_t> order(poses);
-  for (size_t i = 0; i < poses; ++i) order[i] = uint32_t(i);
-  for (size_t i = poses - 1; i > 0; --i) std::swap(order[i], order[rng.below(i + 1)]);
-  const size_t nTest = std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses))));
-  out.testPoses.assign(order.begin(), order.begin() + long(nTest));
-  out.trainingPoses.assign(order.begin() + long(nTest), order.end());
-  std::sort(out.testPoses.begin(), out.testPoses.end());
-  std::sort(out.trainingPoses.begin(), out.trainingPoses.end());
+  IndexSplit split = seededSplit(poses, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
+  out.testPoses = std::move(split.held);
+  out.trainingPoses = std::move(split.kept);
   const size_t nTrain = out.trainingPoses.size();
 
   // 1. Mesh PCA in pre-skinning space.
@@ -131,6 +133,9 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   if (C) lambda.bottomRows(C) = normalCodes;
   MlpTrainOptions mo = st.mlp;
   mo.seed = st.seed + 5;
+  for (uint32_t p : pinned)  // its column among the training poses
+    mo.alwaysTrain.push_back(
+        uint32_t(std::lower_bound(out.trainingPoses.begin(), out.trainingPoses.end(), p) - out.trainingPoses.begin()));
   if (mo.outputWeights.empty()) {
     // Mesh weights by their share of the shape variance (the loss then follows the vertex error),
     // mixed with a uniform floor so that small components still train; the normal code as one block
@@ -149,7 +154,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
                   {"character", ds.character.name},
                   {"settings", st.toJson()},
                   {"dataset_settings", ds.settings},
-                  {"poses", {{"training", nTrain}, {"held_out", nTest}}}};
+                  {"poses", {{"training", nTrain}, {"held_out", out.testPoses.size()}}}};
   ModelParts parts;
   parts.character = &ds.character;
   parts.inputJoints = ds.inputJoints;

@@ -50,6 +50,7 @@ struct BakeTrainOutput {
   MlpTrainResult regressor;
   BakeEvaluation evaluation;
   std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
+  std::vector<uint32_t> pinnedPoses;  // indices into dataset.poses always trained on (the rest pose part 1 added)
   std::vector<StageTime> stages;
   nlohmann::json metadata;                          // what went into Model::metadata
 };

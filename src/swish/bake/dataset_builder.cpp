@@ -130,7 +130,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
        {{"characters", sampling.characters}, {"seconds_per_character", sampling.secondsPerCharacter},
         {"sample_rate", sampling.sampleRate}, {"mirror_odd_characters", sampling.mirrorOddCharacters},
         {"speed_jitter", sampling.speedJitter}, {"seed", sampling.seed}}},
-      {"thinning", {{"tolerance", thinningTolerance}, {"target_poses", targetPoses}}},
+      {"thinning", {{"tolerance", thinningTolerance}, {"target_poses", targetPoses}, {"include_rest_pose", includeRestPose}}},
       {"simulation",
        {{"preset", m.material.name}, {"vertices", simulationVertices}, {"thickness", m.thickness},
         {"transition_seconds", m.transitionSeconds}, {"settle_seconds", m.settleSeconds},
@@ -151,7 +151,8 @@ nlohmann::json DatasetBuildResult::toJson() const {
   nlohmann::json st = nlohmann::json::array();
   for (const DatasetBuildStep& s : steps) st.push_back({{"step", s.name}, {"seconds", s.seconds}});
   return {{"clip_frames", clipFrames},     {"samples", samples},
-          {"kept_poses", keptPoses},       {"tolerance", tolerance},
+          {"kept_poses", keptPoses},       {"rest_pose_added", restPoseAdded},
+          {"tolerance", tolerance},
           {"poses_corrected", posesCorrected}, {"max_correction_degrees", maxCorrectionDegrees},
           {"simulation_vertices", simulationVertices},
           {"simulated", simulated},        {"simulations_reused", simulationsReused},
@@ -213,13 +214,24 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   std::vector<Pose> poses;
   for (uint32_t k : thin.kept)
     poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, samples.origins[k])));
-  res.keptPoses = poses.size();
   {
     char line[200];
     std::snprintf(line, sizeof line, "part 1: %zu samples thinned to %zu poses (tolerance %.4f, %d passes) in %.2f s",
-                  res.samples, res.keptPoses, double(thin.tolerance), thin.passes, since(t));
+                  res.samples, poses.size(), double(thin.tolerance), thin.passes, since(t));
     log(line);
   }
+  if (s.includeRestPose) {
+    const Pose rest = canonicalPose(character.skeleton, character.skeleton.restPose());
+    const float nearest = nearestKeptDistance(samples, thin.kept, thetaOfPose(character.skeleton, rest, s.inputJoints));
+    if (nearest > thin.tolerance) {
+      poses.push_back(rest);
+      res.restPoseAdded = true;
+    }
+    char line[200];
+    std::snprintf(line, sizeof line, "part 1: the rest pose is %.4f from the nearest kept pose: ", double(nearest));
+    log(line + (res.restPoseAdded ? "added as pose " + std::to_string(poses.size() - 1) : std::string("already covered")));
+  }
+  res.keptPoses = poses.size();
   step("sampling + thinning", t);
 
   // Clearance, simulation and transfer of one pose are PoseShapeSimulator's steps (pose_shape.hpp),
@@ -261,6 +273,8 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   settingsJson["pose_list_digest"] = std::to_string(poseListDigest(poses));
   settingsJson["kept_poses"] = poses.size();
   settingsJson["thinning_tolerance_used"] = thin.tolerance;
+  // Part 2 keeps this pose in its training split (bake_training.cpp); -1: none was added.
+  settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
   res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
   const DatasetWriter writer(datasetDir, character, inputJoints, settingsJson, s.normalMapBitDepth);
 

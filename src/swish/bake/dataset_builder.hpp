@@ -56,6 +56,11 @@ struct DatasetBuildSettings {
   // Thinning: exactly one of the two is > 0.
   float thinningTolerance = 0.f;
   size_t targetPoses = 0;
+  // The character's rest pose (the A-pose every simulation starts from) joins the kept poses, last,
+  // unless a kept pose is within the tolerance of it. Gameplay clips rarely hold the A-pose, and a
+  // network that never saw it extrapolates there (arms among the inputs: several cm off); part 2
+  // always trains on it (bake_training.cpp).
+  bool includeRestPose = true;
 
   size_t simulationVertices = kDefaultSimulationVertices;  // 0: the welded game mesh, not subdivided
   ClothSimSettings simulation;
@@ -89,7 +94,8 @@ struct DatasetBuildStep {
 struct DatasetBuildResult {
   size_t clipFrames = 0;           // frames over all clips
   size_t samples = 0;              // Theta samples before thinning
-  size_t keptPoses = 0;            // after thinning
+  size_t keptPoses = 0;            // after thinning (the rest pose included when it was added)
+  bool restPoseAdded = false;      // the rest pose was appended to the thinned poses (its id: keptPoses - 1)
   size_t posesCorrected = 0;       // poses whose limbs were turned out of the trunk
   float maxCorrectionDegrees = 0.f;
   float tolerance = 0.f;           // the thinning tolerance used

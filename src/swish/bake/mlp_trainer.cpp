@@ -47,6 +47,27 @@ Mlp toModelMlp(const MlpNetwork<float>& net) {
 
 }  // namespace
 
+
+IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t> pinned) {
+  std::vector<bool> isPinned(n, false);
+  for (uint32_t i : pinned)
+    if (i < n) isPinned[i] = true;
+  std::vector<uint32_t> order;
+  order.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (!isPinned[i]) order.push_back(uint32_t(i));
+  for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+  held = std::min(held, order.size());
+  IndexSplit s;
+  s.held.assign(order.begin(), order.begin() + long(held));
+  s.kept.assign(order.begin() + long(held), order.end());
+  for (size_t i = 0; i < n; ++i)
+    if (isPinned[i]) s.kept.push_back(uint32_t(i));
+  std::sort(s.held.begin(), s.held.end());
+  std::sort(s.kept.begin(), s.kept.end());
+  return s;
+}
+
 MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrainOptions& o) {
   const Eigen::Index n = inputs.cols();
   if (n < 2) throw Error("MLP training: needs at least 2 samples, got " + std::to_string(n));
@@ -68,15 +89,14 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
   MlpTrainResult r;
   r.activation = o.activation;
 
-  // Split: a seeded shuffle; validation takes the first share.
-  std::vector<uint32_t> order(static_cast<size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) order[size_t(i)] = uint32_t(i);
-  for (size_t i = order.size() - 1; i > 0; --i) std::swap(order[i], order[rng.below(i + 1)]);
+  // Split: a seeded shuffle; validation takes the first share, never an alwaysTrain sample.
+  for (uint32_t i : o.alwaysTrain)
+    if (Eigen::Index(i) >= n) throw Error("MLP training: always-train sample " + std::to_string(i) + " of " + std::to_string(n));
   const size_t nVal = std::clamp<size_t>(size_t(std::lround(o.validationFraction * double(n))), 1, size_t(n) - 1);
-  r.validationSamples.assign(order.begin(), order.begin() + long(nVal));
-  r.trainingSamples.assign(order.begin() + long(nVal), order.end());
-  std::sort(r.validationSamples.begin(), r.validationSamples.end());
-  std::sort(r.trainingSamples.begin(), r.trainingSamples.end());
+  IndexSplit split = seededSplit(size_t(n), nVal, rng, o.alwaysTrain);
+  if (split.held.empty()) throw Error("MLP training: every sample is always-train; none left for validation");
+  r.validationSamples = std::move(split.held);
+  r.trainingSamples = std::move(split.kept);
 
   auto gather = [](const MatXf& m, const std::vector<uint32_t>& idx) {
     MatXf out(m.rows(), Eigen::Index(idx.size()));

@@ -3,9 +3,11 @@
 // Adam on standardised inputs and outputs, a held-out validation split and early stopping (the best
 // validation epoch is kept). Deterministic for a seed: one thread, fixed shuffles from swish::Rng.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "swish/bake/mlp_network.hpp"
+#include "swish/core/rng.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::bake {
@@ -26,7 +28,18 @@ struct MlpTrainOptions {
   // Per output weight in the loss (empty: all 1). The bake weights mesh components by their variance
   // so that the loss follows the vertex error the PCA basis turns them into.
   std::vector<double> outputWeights;
+  // Samples (input columns) never drawn into the validation split: poses the network must fit, such
+  // as the rest pose (dataset_builder.hpp, includeRestPose).
+  std::vector<uint32_t> alwaysTrain;
 };
+
+// A seeded split of the indices 0..n-1: `held` of them drawn by a Fisher-Yates shuffle, the rest
+// kept; both lists ascending. `pinned` indices are always kept (never drawn); with none pinned the
+// draw is that of shuffling all n. At most n - pinned are held.
+struct IndexSplit {
+  std::vector<uint32_t> held, kept;
+};
+IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t> pinned = {});
 
 struct TrainingEpoch {
   int epoch = 0;

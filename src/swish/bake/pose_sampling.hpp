@@ -46,6 +46,10 @@ struct PoseSamplingOptions {
 PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
                         const PoseSamplingOptions& options = {});
 
+// The sample (Theta vector, as samplePoses makes them) of one full-skeleton pose. Throws Error when a
+// joint name is not in the skeleton.
+std::vector<float> thetaOfPose(const Skeleton& skeleton, const Pose& pose, const std::vector<std::string>& joints);
+
 // The full-skeleton pose a sample stands for (same interpolation and mirroring as samplePoses).
 Pose poseOfSample(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
                   const PoseSamples::Origin& origin);

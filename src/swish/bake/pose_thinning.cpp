@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <array>
+#include <string>
 
 #include "swish/core/error.hpp"
 
@@ -172,6 +173,20 @@ ThinningResult thinPass(const PoseSamples& samples, float tolerance, size_t maxK
 ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept) {
   checkSamples(samples);
   return thinPass(samples, tolerance, maxKept, principalAxes(samples));
+}
+
+float nearestKeptDistance(const PoseSamples& samples, const std::vector<uint32_t>& kept, std::span<const float> x) {
+  if (x.size() != size_t(samples.dim))
+    throw Error("pose thinning: a pose of " + std::to_string(x.size()) + " values against samples of " +
+                std::to_string(samples.dim));
+  double best = INFINITY;
+  for (uint32_t k : kept) {
+    const float* r = samples.row(k);
+    double d = 0;
+    for (int i = 0; i < samples.dim; ++i) d += double(r[i] - x[size_t(i)]) * double(r[i] - x[size_t(i)]);
+    best = std::min(best, d);
+  }
+  return float(std::sqrt(best));
 }
 
 ThinningResult thinPosesToCount(const PoseSamples& samples, size_t target, const ThinToCountOptions& options) {

@@ -13,6 +13,7 @@
 // Neither changes the result: it is exactly the plain greedy pass over the samples in order.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "swish/bake/pose_sampling.hpp"
@@ -39,6 +40,10 @@ struct ThinToCountOptions {
 // Search on the tolerance for `target` kept poses (bisection in log space, sped up by log-log
 // interpolation of the counts). The greedy count is not strictly monotone in the
 // tolerance, so the result is the closest count found; within the slack for any realistic cloud.
+// Euclidean distance from `x` (samples.dim values) to the nearest of the `kept` samples; infinity when
+// none is kept. A brute-force scan: for a handful of extra poses, not for thinning itself.
+float nearestKeptDistance(const PoseSamples& samples, const std::vector<uint32_t>& kept, std::span<const float> x);
+
 ThinningResult thinPosesToCount(const PoseSamples& samples, size_t target, const ThinToCountOptions& options = {});
 
 }  // namespace swish::bake
