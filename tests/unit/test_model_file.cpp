@@ -2,6 +2,7 @@
 // version handling, and that a failed save never damages an existing file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -42,6 +43,22 @@ TEST(AtomicWrite, WritesNewFileAndReplacesExistingOne) {
   swish::writeFileAtomic(target, bytes);
   EXPECT_EQ(readText(target), std::string("\0\1\2\xff\0", 5));
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+}
+
+TEST(AtomicWrite, StaleNumberedOutputsOfAnEarlierRunAreRemovedAndNothingElse) {
+  TempDir dir;
+  for (const char* n : {"pose_00001_front.png", "pose_00002_front.png", "pose_00002_normal_map.png", "pose_00007_front.png",
+                        "pose_notes.txt", "my_front.png", "preview.json"})
+    swish::writeTextFileAtomic(dir / n, n);
+  fs::create_directory(dir / "pose_00009_front.png");  // not a regular file: left alone
+  const std::vector<fs::path> written{dir / "pose_00002_front.png", dir / "pose_00002_normal_map.png", dir / "preview.json"};
+  constexpr std::string_view suffixes[] = {"_front.png", "_normal_map.png"};
+  EXPECT_EQ(swish::removeStaleOutputs(dir.path(), "pose_", suffixes, written), 2u);
+  std::vector<std::string> left = dir.entries();
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"my_front.png", "pose_00002_front.png", "pose_00002_normal_map.png",
+                                                     "pose_00009_front.png", "pose_notes.txt", "preview.json"}));
+  EXPECT_EQ(swish::removeStaleOutputs(dir / "absent", "pose_", suffixes, written), 0u);  // no folder: nothing to do
 }
 
 TEST(AtomicWrite, StreamAndRawWritesKeepTheirOrder) {

@@ -155,6 +155,7 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   }
   md << "## Worst held-out poses\n\n| pose | mean mm | max mm | truncation mm | normal deg | gallery |\n|---|---|---|---|---|---|\n";
   std::filesystem::create_directories(dir / "gallery");
+  std::vector<std::filesystem::path> galleryFiles;
   size_t shown = 0;
   for (size_t i : worstPoses(ev, 8)) {
     const auto& p = ev.perPose[i];
@@ -171,6 +172,8 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
         std::vector<float> xy(dec.xy.size());
         for (size_t k = 0; k < xy.size(); ++k) xy[k] = runtime::snorm8ToFloat(dec.xy[k]);
         io::writePng(dir / (stem + "_runtime.png"), io::encodeNormalMap(dec.width, dec.height, xy, 8));
+        galleryFiles.push_back(dir / (stem + "_truth.png"));
+        galleryFiles.push_back(dir / (stem + "_runtime.png"));
         cell = "![truth](" + stem + "_truth.png) ![runtime](" + stem + "_runtime.png)";
         ++shown;
       }
@@ -178,6 +181,9 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
     md << "| " << p.poseId << " | " << f2(p.meanMm) << " | " << f2(p.maxMm) << " | " << f2(p.truncationMeanMm) << " | "
        << f2(p.normalTotalDegrees) << " | " << cell << " |\n";
   }
+  // The worst poses of an earlier bake are other poses: their images must not linger in the gallery.
+  constexpr std::string_view kGallerySuffixes[] = {"_truth.png", "_runtime.png"};
+  removeStaleOutputs(dir / "gallery", "pose_", kGallerySuffixes, galleryFiles);
   md << "\n## Time per stage\n\n| stage | seconds |\n|---|---|\n";
   for (const auto& s : out.stages) md << "| " << s.stage << " | " << f2(s.seconds) << " |\n";
   writeTextFileAtomic(dir / "report.md", md.str());

@@ -122,6 +122,9 @@ std::vector<std::filesystem::path> writeDatasetPreview(const Dataset& d, const s
   const auto json = folder / "preview.json";
   writeTextFileAtomic(json, nlohmann::json{{"poses", summary}, {"datasetPoses", n}}.dump(2));
   written.push_back(json);
+  // A re-bake previews other pose ids: the previous run's images must not linger beside these.
+  constexpr std::string_view kSuffixes[] = {"_front.png", "_normal_map.png"};
+  removeStaleOutputs(folder, "pose_", kSuffixes, written);
   return written;
 }
 

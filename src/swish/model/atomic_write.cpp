@@ -4,11 +4,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "swish/core/error.hpp"
 
@@ -187,6 +189,25 @@ void writeFileAtomicWith(const fs::path& target, const std::function<void(std::o
   AtomicFileWriter w(target);
   write(w.stream());  // an exception here leaves through ~AtomicFileWriter, which discards
   w.commit();
+}
+
+size_t removeStaleOutputs(const std::filesystem::path& folder, std::string_view prefix,
+                          std::span<const std::string_view> suffixes, std::span<const std::filesystem::path> written) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<fs::path> stale;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    if (!it->is_regular_file(ec)) continue;
+    const std::string name = it->path().filename().string();
+    if (!name.starts_with(prefix)) continue;
+    if (std::none_of(suffixes.begin(), suffixes.end(), [&](std::string_view s) { return name.ends_with(s); })) continue;
+    if (std::any_of(written.begin(), written.end(), [&](const fs::path& w) { return w.filename() == it->path().filename(); }))
+      continue;
+    stale.push_back(it->path());
+  }
+  size_t removed = 0;
+  for (const fs::path& p : stale) removed += fs::remove(p, ec) ? 1 : 0;  // ec: best effort, see the header
+  return removed;
 }
 
 }  // namespace swish

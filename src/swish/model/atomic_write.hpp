@@ -22,6 +22,13 @@ void writeTextFileAtomic(const std::filesystem::path& target, std::string_view t
 // (a failed stream becomes an Error).
 void writeFileAtomicWith(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write);
 
+// After a writer has replaced its set of numbered outputs (pose_00012_front.png...), removes the files
+// of an earlier run in `folder` that it did not write this time: regular files whose name starts with
+// `prefix` and ends with one of `suffixes`, and whose name is not that of a file in `written`. Files of other names are
+// never touched. Returns how many were removed; a file that cannot be removed is left (best effort).
+size_t removeStaleOutputs(const std::filesystem::path& folder, std::string_view prefix,
+                          std::span<const std::string_view> suffixes, std::span<const std::filesystem::path> written);
+
 // The mechanism behind the functions above, for writers that stream large outputs piece by piece:
 //   AtomicFileWriter w(path);
 //   w.write(bytes); w.stream() << "text";   // any mix
