@@ -142,9 +142,12 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
   SCOPED_TRACE("seed " + std::to_string(seed));
   Rng rng(seed);
   if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
-  const gpu::NormalMapBlendPass pass(ctx());
-  for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}}) {
+  // 12 .. 4 texels wide: fewer block columns than the pass's smallest exact workgroup (the bounds-checked
+  // form); 64 and 72 wide: 16 and 18 block columns, covered exactly.
+  for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}}) {
     SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height));
+    const gpu::NormalMapBlendPass pass(ctx(), width);
+    EXPECT_EQ(pass.exact(), width >= 64);
     const uint32_t characters = 5, slots = 2;
     const size_t per = size_t(width) * height * 2;
     std::vector<runtime::DecodedNormalMap> decoded(slots, {width, height, std::vector<int8_t>(per)});
@@ -165,21 +168,29 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
     }
     CheckedInput decodedIn(ctx(), std::span<const int8_t>(decodedAll), "decoded");
     CheckedInput charsIn(ctx(), std::span<const gpu::NormalMapBlendPass::Character>(chars), "characters");
-    gpu::NormalMapImages prevImg(ctx(), width, height, characters), outImg(ctx(), width, height, characters);
-    prevImg.upload(ctx(), prevAll);
+    CheckedInput prevIn(ctx(), std::span<const int16_t>(prevAll), "previous maps");
+    GuardedOutput outTexels(ctx(), prevAll.size() * sizeof(int16_t), "blended maps");
+    // One layer more than characters: the copy into the images must write the characters' layers only.
+    gpu::NormalMapImages outImg(ctx(), width, height, characters + 1);
     {
-      const auto binding = pass.makeBinding(ctx(), prevImg, outImg, decodedIn.buffer());
+      const auto binding = pass.makeBinding(ctx(), prevIn.buffer(), outTexels.buffer(), decodedIn.buffer());
       gpu::NormalMapBlendPass::Args a;
       a.characters = charsIn.address();
       a.width = width;
       a.height = height;
       a.characterCount = characters;
+      a.outTexels = outTexels.buffer().handle();
+      a.outMaps = outImg.image();
       ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, binding.get(), a); });
     }
-    for (const CheckedInput* c : {&decodedIn, &charsIn})
-      if (auto s = c->unchanged(ctx()); !s.empty()) ADD_FAILURE() << s;
-    EXPECT_EQ(prevImg.download(ctx()), prevAll) << "the previous maps must be read, never written";
-    const auto out = outImg.download(ctx());
+    for (const CheckedInput* c : {&decodedIn, &charsIn, &prevIn})
+      if (auto s = c->unchanged(ctx()); !s.empty()) ADD_FAILURE() << s;  // the previous maps too: read, never written
+    if (auto s = outTexels.guardsIntact(ctx()); !s.empty()) ADD_FAILURE() << s;
+    const auto images = outImg.download(ctx());
+    const std::vector<int16_t> out(images.begin(), images.begin() + std::ptrdiff_t(characters * per));
+    EXPECT_EQ(outTexels.read<int16_t>(ctx()), out) << "the images must hold a copy of the blended texels";
+    EXPECT_EQ(std::vector<int16_t>(images.begin() + std::ptrdiff_t(characters * per), images.end()), std::vector<int16_t>(per, 0))
+        << "a layer beyond the characters was written";
     for (uint32_t c = 0; c < characters; ++c) {
       runtime::BlendedNormalMap ref = prev[c];
       runtime::referenceNormalBlend(ref, decoded[chars[c].decodedSlot], chars[c].alpha);

@@ -26,7 +26,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
   if (tangentFrames_) tangentFramesPass_ = TangentFramesPass(ctx);
   if (normalMaps_) {
     decode_ = VqDecodePass(ctx);
-    blend_ = NormalMapBlendPass(ctx);
+    blend_ = NormalMapBlendPass(ctx, model.mapWidth());
   }
   for (uint32_t s = 0; s < o.framesInFlight; ++s) frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s);
   for (uint32_t s = 0; s < o.framesInFlight; ++s) {
@@ -46,7 +46,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
     }
     if (normalMaps_) {
       const uint32_t prev = (s + o.framesInFlight - 1) % o.framesInFlight;
-      f.blendBinding = blend_.makeBinding(ctx, frames_[prev].normalMaps, f.normalMaps, f.decodedMaps);
+      f.blendBinding = blend_.makeBinding(ctx, frames_[prev].blendedTexels, f.blendedTexels, f.decodedMaps);
     }
   }
 }
@@ -167,6 +167,8 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
     b.width = m.mapWidth();
     b.height = m.mapHeight();
     b.characterCount = in.instanceCount;
+    b.outTexels = f.blendedTexels.handle();
+    b.outMaps = f.normalMaps.image();
     blend_.record(cmd, f.blendBinding.get(), b);
     f.timestamps.mark(cmd, kAfterBlend);
   }
@@ -224,6 +226,7 @@ void FrameRecorder::uploadNormalMaps(uint32_t slot, const std::vector<runtime::B
     std::copy(maps[i].xy.begin(), maps[i].xy.end(), all.begin() + i * per);
   }
   f.normalMaps.upload(*ctx_, all);
+  f.blendedTexels.upload(*ctx_, all.data(), all.size() * sizeof(int16_t));  // what the next frame's blend reads
 }
 
 }  // namespace swish::gpu

@@ -2,9 +2,11 @@
 // Records one frame of swish's GPU work for a batch of instances of one model into a command buffer
 // the caller owns (the caller submits; nothing here submits frame work):
 //   deform (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
-//   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch)
+//   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch,
+//   then a copy into the normal-map images)
 // with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
-// uses slot f % framesInFlight and its blend reads the previous slot's normal maps.
+// uses slot f % framesInFlight and its blend reads the previous slot's blended maps (blendedTexels, the
+// buffer its normal-map images are a copy of).
 //
 // Caller contract: before record(f), wait for the fence of the submission that used slot
 // f % framesInFlight last (frame f - framesInFlight); submit frames in order on one queue. After

@@ -7,6 +7,7 @@
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/deform_pass.hpp"
 #include "swish/gpu/gpu_model.hpp"
+#include "swish/gpu/normal_map_blend_pass.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 
 namespace swish::gpu {
@@ -29,7 +30,18 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
     decodeSlotMaps = Buffer(ctx, 2 * c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode jobs");
     blendCharacters = Buffer(ctx, c * sizeof(layout::NormalMapBlendCharacter), MemoryKind::HostVisible, tag + "blend characters");
     decodedMaps = Buffer(ctx, c * m.mapWidth() * m.mapHeight() * 2, MemoryKind::DeviceLocal, tag + "decoded maps");
+    blendedTexels = Buffer(ctx, NormalMapBlendPass::texelBytes(m.mapWidth(), m.mapHeight(), uint32_t(c)), MemoryKind::DeviceLocal,
+                           tag + "blended normal maps");
     normalMaps = NormalMapImages(ctx, m.mapWidth(), m.mapHeight(), uint32_t(c));
+    // The blend's state starts as the images do: all 0.
+    ctx.submitAndWait([&](VkCommandBuffer cmd) {
+      vkCmdFillBuffer(cmd, blendedTexels.handle(), 0, VK_WHOLE_SIZE, 0);
+      VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+      mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0,
+                           nullptr);
+    });
     slotMap.assign(c, kNoMap);
     slotLastUsed.assign(c, 0);
   }

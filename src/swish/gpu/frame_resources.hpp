@@ -42,10 +42,11 @@ struct FrameResources {
   Buffer tangents;         // float[instances][N][4]
   Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8): decoded database maps, one slot per instance
   Buffer triangleTerms;    // vec4[instances][T][3], scratch of the two-pass tangent frames
+  Buffer blendedTexels;    // uint32[instances][H][W] (snorm16 X | Y << 16): the blend's output, copied into normalMaps
   NormalMapImages normalMaps;  // one layer per instance
   DescriptorBinding deformInputs;   // meshWeights, skinMatrices
   DescriptorBinding tangentFrames;  // positions, triangleTerms, the model's adjacency, normals, tangents
-  DescriptorBinding blendBinding;   // prev frame's normalMaps -> this frame's normalMaps, decodedMaps
+  DescriptorBinding blendBinding;   // prev frame's blendedTexels -> this frame's blendedTexels, decodedMaps
 
   // Which database map each slot of decodedMaps holds (kNoMap: none yet) and the last frame that
   // selected it. Database maps never change, so a decoded slot stays valid until it is given to another

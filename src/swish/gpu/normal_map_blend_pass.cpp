@@ -1,31 +1,45 @@
 #include "swish/gpu/normal_map_blend_pass.hpp"
 
+#include <algorithm>
 #include <cstddef>
 
 #include "shaders/swish_layouts.h"
 #include "swish/core/error.hpp"
-#include "swish/gpu/normal_map_images.hpp"
+#include "swish/gpu/buffer.hpp"
+#include "swish/gpu/context.hpp"
 
 namespace swish::gpu {
 
 static_assert(sizeof(NormalMapBlendPass::Character) == sizeof(layout::NormalMapBlendCharacter) &&
               offsetof(NormalMapBlendPass::Character, alpha) == offsetof(layout::NormalMapBlendCharacter, alpha));
 
-NormalMapBlendPass::NormalMapBlendPass(Context& ctx)
-    : layout_(ctx, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER}),
-      pipeline_(ctx, "normal_map_blend.comp", {kWorkgroupSize}, sizeof(layout::NormalMapBlendParams), layout_.get()) {}
+NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width)
+    : width_(width),
+      layout_(ctx, {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER}) {
+  if (width == 0 || width % 4) throw Error("normal-map blend: map width " + std::to_string(width) + " is not a multiple of 4");
+  const VkPhysicalDeviceLimits& lim = ctx.properties().limits;
+  const uint32_t blocksX = width / 4;
+  const uint32_t most = std::min({kMaxRowGroup, lim.maxComputeWorkGroupSize[0], lim.maxComputeWorkGroupInvocations});
+  for (uint32_t d = std::min(most, blocksX); d >= kMinRowGroup && !exact_; --d)
+    if (blocksX % d == 0) rowGroup_ = d, exact_ = true;
+  if (!exact_) rowGroup_ = std::min(kFallbackGroup, most);
+  pipeline_ = ComputePipeline(ctx, "normal_map_blend.comp", {rowGroup_, exact_ ? 1u : 0u}, sizeof(layout::NormalMapBlendParams),
+                              layout_.get());
+}
 
-DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const NormalMapImages& prev, const NormalMapImages& out,
-                                                  const Buffer& decoded) const {
+DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const Buffer& prev, const Buffer& out, const Buffer& decoded) const {
   return DescriptorBinding(ctx, layout_,
-                           {BoundResource::storageImage(prev.arrayView()), BoundResource::storageImage(out.arrayView()),
+                           {BoundResource::texels(prev, VK_FORMAT_R32G32B32A32_UINT), BoundResource::storage(out),
                             BoundResource::texels(decoded, VK_FORMAT_R32G32_UINT)});
 }
 
 void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& a) const {
   if (a.characterCount == 0 || a.width == 0 || a.height == 0) return;
-  if (a.width % 4 || a.height % 4)
-    throw Error("normal-map blend: map size " + std::to_string(a.width) + "x" + std::to_string(a.height) + " is not a multiple of 4");
+  if (a.width != width_ || a.height % 4)
+    throw Error("normal-map blend: map size " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                " is not a multiple of 4 or not the pass's width " + std::to_string(width_));
+  if (a.outTexels == VK_NULL_HANDLE || a.outMaps == VK_NULL_HANDLE)
+    throw Error("normal-map blend: no output buffer or images to copy the blended maps into");
   layout::NormalMapBlendParams p;
   p.characters = layout::Address::of(a.characters);
   p.width = a.width;
@@ -33,7 +47,36 @@ void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, co
   p.characterCount = a.characterCount;
   p.pad0 = 0;
   pipeline_.bind(cmd, &p, sizeof(p), binding);
-  vkCmdDispatch(cmd, groupCount(uint64_t(a.width / 4) * (a.height / 4), kWorkgroupSize), 1, a.characterCount);
+  vkCmdDispatch(cmd, groupCount(a.width / 4, rowGroup_), a.height / 4, a.characterCount);
+
+  // The blended texels, written by the dispatch, are read by the copy. The images' layers go to
+  // TRANSFER_DST_OPTIMAL for the copy (the layout copies ask for) and back to GENERAL; the first barrier
+  // also orders the copy's image writes after every earlier access to the images on this queue (all
+  // ordered before the dispatch).
+  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  VkImageMemoryBarrier ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  ib.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  ib.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
+  ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  ib.image = a.outMaps;
+  ib.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, a.characterCount};
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr, 1, &ib);
+  VkBufferImageCopy c{};  // tightly packed rows and layers: the texels' layout is the image's
+  c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, a.characterCount};
+  c.imageExtent = {a.width, a.height, 1};
+  vkCmdCopyBufferToImage(cmd, a.outTexels, a.outMaps, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+  // Back to GENERAL and to the compute stage, so that a consumer's barrier from
+  // COMPUTE_SHADER/SHADER_WRITE (the contract of FrameRecorder and of the public API) chains to the
+  // copy's writes.
+  ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  ib.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  ib.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &ib);
 }
 
 }  // namespace swish::gpu

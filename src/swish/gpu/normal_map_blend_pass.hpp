@@ -1,15 +1,23 @@
 #pragma once
 // The normal-map blend pass (shaders/normal_map_blend.comp): the temporal filter's blend of each
 // character's newly selected, decoded map into its normal map, out = mix(prev, decoded, alpha), for all
-// characters in one dispatch (one layer of a NormalMapImages array per character), one invocation per
-// 4x4 block of a character.
+// characters in one dispatch, one invocation per 4x4 block of a character, then one copy of the result
+// into the layers of the characters' RG16_SNORM image array (NormalMapImages), which renderers sample.
 //
-// prev, out and the decoded slots (VqDecodePass output, read as texels) are bound through a descriptor
-// set made by makeBinding(); prev and out may be the same images (one frame in flight). Records one
-// dispatch (never submits). The caller places computeToComputeBarrier after the VQ decode pass and
+// The blend works on buffers of packed texels (uint32[layer][height][width], snorm16 X | Y << 16: the
+// memory layout of R16G16_SNORM), not on the images: prev is the previous frame's buffer, out this
+// frame's. On lavapipe a storage-image load or store of RG16_SNORM converts the format lane by lane;
+// the buffer form reads and writes 4 texels per texel fetch or store, and the copy into the images is
+// a memcpy (22 characters of 256x256: see normal_map_blend.comp for the figures).
+//
+// prev, out and the decoded slots (VqDecodePass output) are bound through a descriptor set made by
+// makeBinding(); prev and out may be the same buffer (one frame in flight). Records one dispatch and
+// one copy (never submits). The caller places computeToComputeBarrier after the VQ decode pass and
 // before this one (which also orders this frame's read of `prev` after the previous frame's write of it
-// on the same queue), and a barrier COMPUTE_SHADER/SHADER_WRITE -> its own stage/SHADER_READ before
-// sampling `out`.
+// on the same queue). The images are written by a transfer, after which record() places a barrier
+// TRANSFER/TRANSFER_WRITE -> COMPUTE_SHADER/SHADER_READ|WRITE, so that the documented contract for a
+// renderer holds unchanged: a barrier COMPUTE_SHADER/SHADER_WRITE -> its own stage/SHADER_READ
+// before sampling `out` (the two form a dependency chain).
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
@@ -30,23 +38,40 @@ class NormalMapBlendPass {
     float alpha;           // weight of the new map
   };
 
-  static constexpr uint32_t kWorkgroupSize = 64;  // 4x4 blocks
+  // Workgroups: a divisor of the block columns (width / 4) between kMinRowGroup and kMaxRowGroup (the
+  // largest there is), so that the dispatch covers each map exactly; else kFallbackGroup with a bounds
+  // check in the shader.
+  static constexpr uint32_t kMinRowGroup = 16, kMaxRowGroup = 256, kFallbackGroup = 64;
+
+  // Bytes of `layers` maps of packed texels (the prev and out buffers).
+  static VkDeviceSize texelBytes(uint32_t width, uint32_t height, uint32_t layers) {
+    return VkDeviceSize(width) * height * layers * 4;
+  }
 
   struct Args {
     VkDeviceAddress characters = 0;  // Character[characterCount]
-    uint32_t width = 0, height = 0;  // multiples of 4, those of the bound images and decoded slots
-    uint32_t characterCount = 0;     // <= layers of the bound images
+    uint32_t width = 0, height = 0;  // multiples of 4, those of the bound buffers, decoded slots and images; width
+                                     // that of the pass
+    uint32_t characterCount = 0;     // <= layers of the bound buffers and of outMaps
+    VkBuffer outTexels = VK_NULL_HANDLE;  // the `out` buffer of the binding, copied into outMaps
+    VkImage outMaps = VK_NULL_HANDLE;     // a NormalMapImages::image() (layout GENERAL): layers 0..characterCount-1 written
   };
 
   NormalMapBlendPass() = default;
-  explicit NormalMapBlendPass(Context& ctx);
+  // For maps `width` texels wide (a multiple of 4; the dispatch shape depends on it).
+  NormalMapBlendPass(Context& ctx, uint32_t width);
+  uint32_t width() const { return width_; }
+  uint32_t rowGroup() const { return rowGroup_; }  // block columns per workgroup
+  bool exact() const { return exact_; }             // rowGroup() divides width / 4
 
-  // A descriptor set binding `prev` (read), `out` (written) and the decoded slots `decoded`
-  // (uint16[slots][height][width], from its start).
-  DescriptorBinding makeBinding(Context& ctx, const NormalMapImages& prev, const NormalMapImages& out, const Buffer& decoded) const;
+  // A descriptor set binding the packed texels `prev` (read), `out` (written) and the decoded slots
+  // `decoded` (uint16[slots][height][width], from its start).
+  DescriptorBinding makeBinding(Context& ctx, const Buffer& prev, const Buffer& out, const Buffer& decoded) const;
   void record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& args) const;
 
  private:
+  uint32_t width_ = 0, rowGroup_ = 0;
+  bool exact_ = false;
   DescriptorLayout layout_;
   ComputePipeline pipeline_;
 };

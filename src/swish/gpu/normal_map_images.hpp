@@ -7,9 +7,10 @@
 // 360x360 maps at 0.5 MB per character.
 //
 // Layout: VK_IMAGE_LAYOUT_GENERAL for its whole life (set at creation, contents cleared to 0).
-// Usage: storage (the blend pass), sampled (the host renderer), transfer src/dst (readback, clears).
-// A renderer sampling it after swish's blend pass needs a barrier: compute shader write ->
-// its own stage's shader read, on the queue family of the Context.
+// Usage: storage, sampled (the host renderer), transfer src/dst (the blend pass's copy of its result,
+// readback, clears). A renderer sampling it after swish's blend pass needs a barrier: compute shader
+// write -> its own stage's shader read, on the queue family of the Context (the blend pass ends its
+// copy with a barrier to the compute stage, so that this barrier covers the copy's writes).
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
