@@ -7,9 +7,13 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <filesystem>
+#include <string>
 #include <vector>
 
+#include "support/paths.hpp"
 #include "swish/core/rng.hpp"
+#include "swish/model/model_file.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 
 using namespace swish;
@@ -65,9 +69,37 @@ void runMlp(benchmark::State& state, CpuKernel kernel) {
 void BM_MlpAuto(benchmark::State& state) { runMlp(state, CpuKernel::Auto); }
 void BM_MlpPortable(benchmark::State& state) { runMlp(state, CpuKernel::Portable); }
 
+// The committed default model's own network (assets/default/bake.json says its shape: its recipe
+// may be wider than the paper's), on Theta of the model's rest pose and random poses.
+void BM_MlpDefaultModel(benchmark::State& state) {
+  const std::filesystem::path file = test::sourceDir() / "assets/default/default.swish";
+  if (!std::filesystem::exists(file)) {
+    state.SkipWithError("no committed default model");
+    return;
+  }
+  static const Model model = loadModel(file);
+  const MlpEvaluator eval(model, CpuKernel::Auto);
+  const size_t batch = size_t(state.range(0));
+  Rng rng(11);
+  std::vector<float> theta(batch * size_t(eval.inputSize())), lambda(batch * size_t(eval.outputSize()));
+  for (float& t : theta) t = rng.uniformf(-1.f, 1.f);
+  for (auto _ : state) {
+    eval.evaluateBatch(theta, lambda, batch);
+    benchmark::DoNotOptimize(lambda.data());
+    benchmark::ClobberMemory();
+  }
+  std::string shape = std::to_string(eval.inputSize());
+  for (const auto& l : model.mlp.layers) shape.append("-").append(std::to_string(l.weight.rows()));
+  state.SetLabel(std::string(toString(eval.kernel())) + " " + shape);
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(batch));
+  state.counters["time_per_instance"] = benchmark::Counter(double(state.iterations()) * double(batch),
+                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
 
 BENCHMARK(BM_MlpAuto)->Arg(22)->Arg(1)->Arg(256);
 BENCHMARK(BM_MlpPortable)->Arg(22)->Arg(1);
+BENCHMARK(BM_MlpDefaultModel)->Arg(22)->Arg(1);
 
 BENCHMARK_MAIN();

@@ -27,6 +27,10 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_EQ(c.train.mlp.hiddenLayers, 5);
   EXPECT_EQ(c.train.mlp.hiddenWidth, 32);
   EXPECT_EQ(c.train.databaseSize, 128);
+  EXPECT_EQ(c.train.normalCodeWeight, 1.0);
+  const BakeConfig w = parseBakeConfig({{"output", "out"}, {"train", {{"normal_code_weight", 0.1}}}}, "recipe.json", "/base");
+  EXPECT_DOUBLE_EQ(w.train.normalCodeWeight, 0.1);
+  EXPECT_DOUBLE_EQ(w.train.toJson()["normal_code_weight"].get<double>(), 0.1);  // what the model's metadata records
 }
 
 TEST(BakeConfig, ErrorsNameTheKey) {
@@ -39,6 +43,8 @@ TEST(BakeConfig, ErrorsNameTheKey) {
             std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"activation", "relu"}}}}).find("train.activation"), std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"learning_rate", "fast"}}}}).find("train.learning_rate: must be a number"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"normal_code_weight", 0}}}}).find("train.normal_code_weight: 0 is outside"),
             std::string::npos);
   EXPECT_NE(errorOf({{"name", "../x"}, {"output", "o"}}).find("name"), std::string::npos);
   EXPECT_NE(errorOf({{"name", "x"}}).find("output: is required"), std::string::npos);

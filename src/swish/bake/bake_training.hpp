@@ -26,6 +26,9 @@ struct BakeTrainSettings {
   VqOptions vq;
   bool bc5Baseline = true;
   MlpTrainOptions mlp;
+  // The normal code's share of the MLP loss against the mesh weights' (1: the two blocks weigh the
+  // same). The network is shared, so capacity spent on the code is taken from the mesh.
+  double normalCodeWeight = 1.0;
   double testFraction = 0.1;       // held out for the report
   float temporalTimeConstant = 0.1f;
   uint64_t seed = 1;
