@@ -4,12 +4,18 @@
 //
 // Both kernels use one descriptor set layout (TangentFramesPass::bindTwoPass); the per-instance
 // streams are in it, model data read once per triangle stays behind addresses:
-// Triangle terms (written by the triangle pass, read by the gather): vec4[instance][triangle][3]
-//   [0] = cross(e1, e2) of the triangle's edges from corner 0 (the face normal term, xyz; w = 0)
-//   [1] = the UV tangent term (e1 * d2.y - e2 * d1.y) / r (xyz), w = 1 if the triangle has a usable UV
-//         parameterisation (r != 0 and finite), w = 0 if core/mesh_frames.cpp skips it
-//   [2] = the UV bitangent term (e2 * d1.x - e1 * d2.x) / r (xyz; w = 0)
-// [1] and [2] are written only when the mesh has UVs.
+// Triangle terms (written by the triangle pass, read by the gather), for triangle t of an instance: the
+// face normal term N = cross(e1, e2) of the triangle's edges from corner 0, the UV
+// tangent term U = (e1 * d2.y - e2 * d1.y) / r and the UV bitangent term B = (e2 * d1.x - e1 * d2.x) / r,
+// U = B = 0 where core/mesh_frames.cpp skips the triangle (r == 0 or not finite) or the mesh has no UVs
+// (adding +0 to a sum that starts at +0 leaves it bit for bit as skipping does). Nine floats, no padding
+// (on lavapipe each stored float costs the same, per lane). Instance i's terms are the
+// SWISH_TERMS_INSTANCE_FLOATS(T) floats from float i * SWISH_TERMS_INSTANCE_FLOATS(T) (a multiple of 4):
+//   vec4[T][2]: [2t] = (N.xyz, U.x), [2t + 1] = (U.yz, B.xy)
+//   then float[T]: [t] = B.z
+// The gather walks the vertex's welded (normal) adjacency once, with the triangles that are not the
+// vertex's own marked by SWISH_NOT_OWN_TRIANGLE: they add to the normal sum only (the own triangles,
+// core/mesh_frames.cpp's tangent adjacency, are a subsequence of the welded ones, in the same order).
 #ifndef SWISH_TRIANGLE_FRAMES_LAYOUT_H
 #define SWISH_TRIANGLE_FRAMES_LAYOUT_H
 
@@ -22,18 +28,18 @@ namespace swish::gpu::layout {
 #define SWISH_TF_ADDRESS uvec2
 #endif
 
-#define SWISH_TRIANGLE_TERM_VEC4S 3
+#define SWISH_TERMS_INSTANCE_FLOATS(triangleCount) ((((triangleCount) * 9u + 3u) / 4u) * 4u)
+#define SWISH_NOT_OWN_TRIANGLE 0x80000000u  // flag of a welded adjacency entry (triangle index below it)
 
 #define SWISH_TF_BINDING_POSITIONS 0          // uniform texel buffer R32_SFLOAT: float[instance][N][3]
-#define SWISH_TF_BINDING_TERMS_OUT 1          // storage buffer: vec4[instance][T][3] (triangle pass writes)
-#define SWISH_TF_BINDING_TERMS 2              // uniform texel buffer R32G32B32A32_SFLOAT: the same terms (gather reads)
-#define SWISH_TF_BINDING_NORMAL_OFFSETS 3     // uniform texel buffer R32_UINT: uint[N+1] (welded adjacency)
-#define SWISH_TF_BINDING_NORMAL_TRIANGLES 4   // uniform texel buffer R32_UINT
-#define SWISH_TF_BINDING_TANGENT_OFFSETS 5    // uniform texel buffer R32_UINT: uint[N+1] (own triangles)
-#define SWISH_TF_BINDING_TANGENT_TRIANGLES 6  // uniform texel buffer R32_UINT
-#define SWISH_TF_BINDING_NORMALS_OUT 7        // storage buffer: float[instance][N][3]
-#define SWISH_TF_BINDING_TANGENTS_OUT 8       // storage buffer: vec4[instance][N]
-#define SWISH_TF_BINDING_COUNT 9
+#define SWISH_TF_BINDING_TERMS_OUT 1          // storage buffer: float[] (triangle pass writes the terms)
+#define SWISH_TF_BINDING_TERMS 2              // uniform texel buffer R32G32B32A32_SFLOAT: the terms (gather: vec4 pairs)
+#define SWISH_TF_BINDING_TERMS_Z 3            // uniform texel buffer R32_SFLOAT: the terms (gather: B.z floats)
+#define SWISH_TF_BINDING_NORMAL_OFFSETS 4     // uniform texel buffer R32_UINT: uint[N+1] (welded adjacency)
+#define SWISH_TF_BINDING_FRAME_TRIANGLES 5    // uniform texel buffer R32_UINT: welded adjacency, flagged
+#define SWISH_TF_BINDING_NORMALS_OUT 6        // storage buffer: float[instance][N][3]
+#define SWISH_TF_BINDING_TANGENTS_OUT 7       // storage buffer: vec4[instance][N]
+#define SWISH_TF_BINDING_COUNT 8
 
 // triangle_frames.comp: one thread per triangle, looping over the instances.
 struct TriangleFramesParams {

@@ -9,8 +9,9 @@
 // One thread per triangle, looping over the instances: the triangle's corner indices and UV terms
 // (instance-independent) are loaded and computed once for all instances. The per-instance streams go
 // through the pass's descriptor set (binding numbers in swish_triangle_frames_layout.h): positions are
-// fetched as texels and the terms stored as whole vec4s of a storage buffer, the cheap ways on
-// lavapipe (descriptor_binding.hpp).
+// fetched as texels and the terms stored as nine floats of a storage buffer, the cheap ways on
+// lavapipe (descriptor_binding.hpp): lavapipe stores lane by lane and float by float, so the nine
+// floats cost 3/4 of the three padded vec4s (with a usable-UV flag) this pass stored before.
 #extension GL_GOOGLE_include_directive : require
 #include "swish_buffers.glsl"
 #include "swish_frame_math.glsl"
@@ -19,7 +20,7 @@
 layout(local_size_x_id = 0) in;
 layout(push_constant) uniform Push { TriangleFramesParams p; };
 layout(set = 0, binding = SWISH_TF_BINDING_POSITIONS) uniform samplerBuffer positionTexels;  // float[instance][N][3]
-layout(set = 0, binding = SWISH_TF_BINDING_TERMS_OUT, std430) writeonly buffer TermsOut { vec4 termsOut[]; };
+layout(set = 0, binding = SWISH_TF_BINDING_TERMS_OUT, std430) writeonly buffer TermsOut { float termsOut[]; };
 
 vec3 position(uint base, uint corner) {
   const int i = int(base + 3u * corner);
@@ -45,21 +46,28 @@ void main() {
   // core/mesh_frames.cpp skips a triangle whose UV determinant is 0 or not finite.
   const bool usable = hasUvs && r != 0.0 && isFinite(r);
 
+  const uint instanceFloats = SWISH_TERMS_INSTANCE_FLOATS(p.triangleCount);
   for (uint instance = 0u; instance < p.instanceCount; ++instance) {
     const uint base = instance * p.vertexCount * 3u;
     const vec3 p0 = position(base, c0);
     precise vec3 e1 = position(base, c1) - p0;
     precise vec3 e2 = position(base, c2) - p0;
-    const uint o = (instance * p.triangleCount + t) * SWISH_TRIANGLE_TERM_VEC4S;
-    termsOut[o] = vec4(crossCpu(e1, e2), 0.0);
-    if (hasUvs) {
-      precise vec3 tangentTerm = vec3(0.0), bitangentTerm = vec3(0.0);
-      if (usable) {
-        tangentTerm = (e1 * d2.y - e2 * d1.y) / r;
-        bitangentTerm = (e2 * d1.x - e1 * d2.x) / r;
-      }
-      termsOut[o + 1u] = vec4(tangentTerm, usable ? 1.0 : 0.0);
-      termsOut[o + 2u] = vec4(bitangentTerm, 0.0);
+    const vec3 n = crossCpu(e1, e2);
+    // Zero where the CPU skips the triangle's UV terms (see swish_triangle_frames_layout.h).
+    precise vec3 tangentTerm = vec3(0.0), bitangentTerm = vec3(0.0);
+    if (usable) {
+      tangentTerm = (e1 * d2.y - e2 * d1.y) / r;
+      bitangentTerm = (e2 * d1.x - e1 * d2.x) / r;
     }
+    const uint o = instance * instanceFloats + 8u * t;
+    termsOut[o] = n.x;
+    termsOut[o + 1u] = n.y;
+    termsOut[o + 2u] = n.z;
+    termsOut[o + 3u] = tangentTerm.x;
+    termsOut[o + 4u] = tangentTerm.y;
+    termsOut[o + 5u] = tangentTerm.z;
+    termsOut[o + 6u] = bitangentTerm.x;
+    termsOut[o + 7u] = bitangentTerm.y;
+    termsOut[instance * instanceFloats + 8u * p.triangleCount + t] = bitangentTerm.z;
   }
 }

@@ -175,9 +175,7 @@ void BM_TangentFrames(benchmark::State& state) {
     b.positions = &s.positions;
     b.triangleTerms = &terms;
     b.normalOffsets = &g.normalOffsets;
-    b.normalTriangles = &g.normalTriangles;
-    b.tangentOffsets = &g.tangentOffsets;
-    b.tangentTriangles = &g.tangentTriangles;
+    b.frameTriangles = &g.frameTriangles;
     b.normalsOut = &normals;
     b.tangentsOut = &tangents;
     binding = pass.bindTwoPass(*ctx, b);

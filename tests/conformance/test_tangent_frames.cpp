@@ -14,6 +14,7 @@
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
 #include "swish/core/mesh_frames.hpp"
+#include "swish/core/error.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 #include "swish/runtime/reference_tangent_frames.hpp"
 
@@ -53,6 +54,8 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
   CheckedInput nTri(ctx, std::span<const uint32_t>(topo.normalAdjacency.triangles), "normal triangles");
   CheckedInput tOff(ctx, std::span<const uint32_t>(topo.tangentAdjacency.offsets), "tangent offsets");
   CheckedInput tTri(ctx, std::span<const uint32_t>(topo.tangentAdjacency.triangles), "tangent triangles");
+  const std::vector<uint32_t> frameTriangles = gpu::TangentFramesPass::frameTriangles(topo);
+  CheckedInput fTri(ctx, std::span<const uint32_t>(frameTriangles), "flagged triangles");
   GuardedOutput normals(ctx, size_t(instances) * n * 3 * 4, "normals");
   GuardedOutput tangents(ctx, size_t(instances) * n * 4 * 4, "tangents");
   const uint32_t triangles = uint32_t(g.triangles.rows());
@@ -64,9 +67,7 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
     b.positions = &pos.buffer();
     b.triangleTerms = &terms.buffer();
     b.normalOffsets = &nOff.buffer();
-    b.normalTriangles = &nTri.buffer();
-    b.tangentOffsets = &tOff.buffer();
-    b.tangentTriangles = &tTri.buffer();
+    b.frameTriangles = &fTri.buffer();
     b.normalsOut = &normals.buffer();
     b.tangentsOut = &tangents.buffer();
     twoPassBinding = pass.bindTwoPass(ctx, b);
@@ -90,7 +91,7 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
   Frames f;
   f.normals = normals.read<float>(ctx);
   f.tangents = tangents.read<float>(ctx);
-  for (const CheckedInput* c : {&pos, &uvs, &tris, &nOff, &nTri, &tOff, &tTri})
+  for (const CheckedInput* c : {&pos, &uvs, &tris, &nOff, &nTri, &tOff, &tTri, &fTri})
     if (auto s = c->unchanged(ctx); !s.empty()) f.problems.push_back(s);
   for (const GuardedOutput* o : {&normals, &tangents, &terms})
     if (auto s = o->guardsIntact(ctx); !s.empty()) f.problems.push_back(s);
@@ -232,6 +233,19 @@ TEST_F(TangentFramesSpecialCases, FlatIntegerGridIsExact) {
     EXPECT_TRUE(test::matchesReference("tangents", gpu.tangents, ref.tangents, [](size_t) { return 0.0; }));
   }
   EXPECT_EQ(std::abs(ref.normals[2]), 1.f);  // the case really is the flat one
+}
+
+// The two-pass gather walks the welded adjacency once, with the entries that are not the vertex's own
+// triangles flagged; the own triangles must be a subsequence of the welded ones (their order is the
+// order of the tangent sums).
+TEST(TangentFramesAdjacency, FlagsTheWeldedOnlyEntriesAndRejectsAnotherOrder) {
+  MeshFrameTopology topo;
+  topo.normalAdjacency = {{0, 3, 5}, {1, 4, 7, 2, 3}};
+  topo.tangentAdjacency = {{0, 2, 3}, {1, 7, 3}};
+  const uint32_t f = gpu::TangentFramesPass::kNotOwnTriangle;
+  EXPECT_EQ(gpu::TangentFramesPass::frameTriangles(topo), (std::vector<uint32_t>{1, 4 | f, 7, 2 | f, 3}));
+  topo.tangentAdjacency = {{0, 2, 3}, {7, 1, 3}};
+  EXPECT_THROW(gpu::TangentFramesPass::frameTriangles(topo), Error);
 }
 
 }  // namespace

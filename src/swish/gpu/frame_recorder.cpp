@@ -37,9 +37,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
       b.positions = &f.positions;
       b.triangleTerms = &f.triangleTerms;
       b.normalOffsets = &model.normalOffsets;
-      b.normalTriangles = &model.normalTriangles;
-      b.tangentOffsets = &model.tangentOffsets;
-      b.tangentTriangles = &model.tangentTriangles;
+      b.frameTriangles = &model.frameTriangles;
       b.normalsOut = &f.normals;
       b.tangentsOut = &f.tangents;
       f.tangentFrames = tangentFramesPass_.bindTwoPass(ctx, b);

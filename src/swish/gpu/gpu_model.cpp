@@ -5,6 +5,7 @@
 #include "swish/core/error.hpp"
 #include "swish/core/mesh_frames.hpp"
 #include "swish/gpu/context.hpp"
+#include "swish/gpu/tangent_frames_pass.hpp"
 
 namespace swish::gpu {
 
@@ -68,6 +69,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   normalTriangles = uploaded(ctx, name + ": normal adjacency", topo.normalAdjacency.triangles);
   tangentOffsets = uploaded(ctx, name + ": tangent adjacency offsets", topo.tangentAdjacency.offsets);
   tangentTriangles = uploaded(ctx, name + ": tangent adjacency", topo.tangentAdjacency.triangles);
+  frameTriangles = uploaded(ctx, name + ": flagged adjacency", TangentFramesPass::frameTriangles(topo));
 
   const NormalMapDatabase& db = m.normalMaps;
   if (!db.empty()) {

@@ -37,6 +37,7 @@ class GpuModel {
 
   Buffer mean, basis, skinJoints, skinWeights;
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;
+  Buffer frameTriangles;  // TangentFramesPass::frameTriangles: the two-pass gather's one walk of both adjacencies
   Buffer codebook, indices;
 
  private:

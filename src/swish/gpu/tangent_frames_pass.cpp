@@ -9,7 +9,27 @@
 namespace swish::gpu {
 
 VkDeviceSize TangentFramesPass::triangleTermsBytes(uint32_t triangles, uint32_t instances) {
-  return VkDeviceSize(triangles) * instances * SWISH_TRIANGLE_TERM_VEC4S * 16;
+  return VkDeviceSize(SWISH_TERMS_INSTANCE_FLOATS(VkDeviceSize(triangles))) * 4 * instances;
+}
+
+static_assert(TangentFramesPass::kNotOwnTriangle == SWISH_NOT_OWN_TRIANGLE);
+
+std::vector<uint32_t> TangentFramesPass::frameTriangles(const MeshFrameTopology& topo) {
+  const VertexTriangleAdjacency &welded = topo.normalAdjacency, &own = topo.tangentAdjacency;
+  if (welded.offsets.size() != own.offsets.size())
+    throw Error("tangent frames: the welded and own adjacency have different vertex counts");
+  std::vector<uint32_t> out(welded.triangles);
+  for (size_t v = 0; v + 1 < welded.offsets.size(); ++v) {
+    uint32_t j = own.offsets[v];
+    for (uint32_t i = welded.offsets[v]; i < welded.offsets[v + 1]; ++i) {
+      if (out[i] & SWISH_NOT_OWN_TRIANGLE) throw Error("tangent frames: triangle index " + std::to_string(out[i]) + " too large");
+      if (j < own.offsets[v + 1] && own.triangles[j] == out[i]) ++j;
+      else out[i] |= SWISH_NOT_OWN_TRIANGLE;
+    }
+    if (j != own.offsets[v + 1])
+      throw Error("tangent frames: vertex " + std::to_string(v) + "'s own triangles are not a subsequence of its welded ones");
+  }
+  return out;
 }
 
 namespace {
@@ -29,17 +49,15 @@ TangentFramesPass::TangentFramesPass(Context& ctx)
                       twoPassLayout_.get()) {}
 
 DescriptorBinding TangentFramesPass::bindTwoPass(Context& ctx, const TwoPassBuffers& b) const {
-  for (const Buffer* p : {b.positions, b.triangleTerms, b.normalOffsets, b.normalTriangles, b.tangentOffsets, b.tangentTriangles,
-                          b.normalsOut, b.tangentsOut})
+  for (const Buffer* p : {b.positions, b.triangleTerms, b.normalOffsets, b.frameTriangles, b.normalsOut, b.tangentsOut})
     if (!p) throw Error("tangent frames pass: a buffer of the two-pass binding is missing");
   std::vector<BoundResource> r(SWISH_TF_BINDING_COUNT);
   r[SWISH_TF_BINDING_POSITIONS] = BoundResource::texels(*b.positions, VK_FORMAT_R32_SFLOAT);
   r[SWISH_TF_BINDING_TERMS_OUT] = BoundResource::storage(*b.triangleTerms);
   r[SWISH_TF_BINDING_TERMS] = BoundResource::texels(*b.triangleTerms, VK_FORMAT_R32G32B32A32_SFLOAT);
+  r[SWISH_TF_BINDING_TERMS_Z] = BoundResource::texels(*b.triangleTerms, VK_FORMAT_R32_SFLOAT);
   r[SWISH_TF_BINDING_NORMAL_OFFSETS] = BoundResource::texels(*b.normalOffsets, VK_FORMAT_R32_UINT);
-  r[SWISH_TF_BINDING_NORMAL_TRIANGLES] = BoundResource::texels(*b.normalTriangles, VK_FORMAT_R32_UINT);
-  r[SWISH_TF_BINDING_TANGENT_OFFSETS] = BoundResource::texels(*b.tangentOffsets, VK_FORMAT_R32_UINT);
-  r[SWISH_TF_BINDING_TANGENT_TRIANGLES] = BoundResource::texels(*b.tangentTriangles, VK_FORMAT_R32_UINT);
+  r[SWISH_TF_BINDING_FRAME_TRIANGLES] = BoundResource::texels(*b.frameTriangles, VK_FORMAT_R32_UINT);
   r[SWISH_TF_BINDING_NORMALS_OUT] = BoundResource::storage(*b.normalsOut);
   r[SWISH_TF_BINDING_TANGENTS_OUT] = BoundResource::storage(*b.tangentsOut);
   return DescriptorBinding(ctx, twoPassLayout_, r);

@@ -7,7 +7,8 @@
 //  - two passes, with a descriptor set from bindTwoPass (Args::twoPass) and Args::triangleCount:
 //    triangle_frames.comp computes each triangle's face and UV terms once per instance into a scratch
 //    buffer (triangleTermsBytes(T, instances) bytes), a barrier, then vertex_frames_gather.comp sums
-//    them per vertex. Each triangle's terms are computed once instead of once per adjacent vertex and
+//    them per vertex in one walk of the welded adjacency with the vertex's own triangles marked
+//    (frameTriangles). Each triangle's terms are computed once instead of once per adjacent vertex and
 //    again for the tangents (~12x fewer). The per-instance streams (positions, terms, the adjacency
 //    walked per instance, the frames written) go through the set as texel and storage buffers, the
 //    cheap ways on lavapipe (descriptor_binding.hpp); the set's buffers replace the address Args
@@ -19,6 +20,9 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <vector>
+
+#include "swish/core/mesh_frames.hpp"
 
 #include "swish/gpu/compute_pipeline.hpp"
 #include "swish/gpu/descriptor_binding.hpp"
@@ -51,18 +55,21 @@ class TangentFramesPass {
   // triangleTermsBytes(T, instances) bytes, written then read within the recorded commands, so a frame
   // in flight needs its own).
   struct TwoPassBuffers {
-    const Buffer* positions = nullptr;         // float[instances][N][3]
-    const Buffer* triangleTerms = nullptr;     // vec4[instances][T][3]
-    const Buffer* normalOffsets = nullptr;     // uint[N+1]
-    const Buffer* normalTriangles = nullptr;   // uint[]
-    const Buffer* tangentOffsets = nullptr;    // uint[N+1]
-    const Buffer* tangentTriangles = nullptr;  // uint[]
-    const Buffer* normalsOut = nullptr;        // float[instances][N][3]
-    const Buffer* tangentsOut = nullptr;       // vec4[instances][N]
+    const Buffer* positions = nullptr;       // float[instances][N][3]
+    const Buffer* triangleTerms = nullptr;   // triangleTermsBytes(T, instances) (swish_triangle_frames_layout.h)
+    const Buffer* normalOffsets = nullptr;   // uint[N+1], the welded adjacency's
+    const Buffer* frameTriangles = nullptr;  // uint[]: frameTriangles(topology)
+    const Buffer* normalsOut = nullptr;      // float[instances][N][3]
+    const Buffer* tangentsOut = nullptr;     // vec4[instances][N]
   };
 
   // Bytes of the triangle-terms scratch for `triangles` x `instances`.
   static VkDeviceSize triangleTermsBytes(uint32_t triangles, uint32_t instances);
+  static constexpr uint32_t kNotOwnTriangle = 0x80000000u;  // SWISH_NOT_OWN_TRIANGLE
+  // The welded (normal) adjacency with kNotOwnTriangle set on the entries that are not in the
+  // vertex's own (tangent) adjacency, which must be a subsequence of it (as buildFrameTopology makes
+  // them; throws Error otherwise); the offsets are the welded adjacency's.
+  static std::vector<uint32_t> frameTriangles(const MeshFrameTopology& topology);
 
   TangentFramesPass() = default;
   explicit TangentFramesPass(Context& ctx);
