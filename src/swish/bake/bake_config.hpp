@@ -19,7 +19,8 @@
 //       "input_joints": ["LowerBack", ...],
 //       "sampling": {"characters", "seconds_per_character", "sample_rate", "mirror_odd_characters",
 //                    "speed_jitter", "seed"},
-//       "thinning": {"tolerance": 0.1} | {"target_poses": 200},
+//       "thinning": {"tolerance": 0.1} | {"target_poses": 200}, plus "include_rest_pose" (default true:
+//                   the rest pose joins the kept poses and is always trained on),
 //       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp)},
@@ -31,7 +32,7 @@
 //       "mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
 //       "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation",
 //       "learning_rate", "batch_size", "max_epochs", "patience", "validation_fraction",
-//       "max_training_seconds", "test_fraction", "temporal_time_constant", "seed", "bc5_baseline"
+//       "normal_code_weight" (the normal code's share of the MLP loss, 1: the mesh's), "max_training_seconds", "test_fraction", "temporal_time_constant", "seed", "bc5_baseline"
 //     }
 //   }
 // Files named in part1 (character, recipe, clips) must exist when the config is loaded.
