@@ -36,8 +36,8 @@ using nlohmann::json;
 
 fs::path defaultModelFile() { return test::sourceDir() / "assets/default/default.swish"; }
 
-// Coarse enough for a unit test (the bake's default model simulates 6568 vertices at 8 substeps,
-// about 1.6 s a pose): about a tenth of that work.
+// Coarse enough for a unit test (the bake's default model simulates 6568 vertices at 12 substeps,
+// about 2.4 s of CPU a pose): about a tenth of that work.
 replay::TruthOptions coarseTruth(uint32_t every) {
   replay::TruthOptions t;
   t.every = every;
@@ -128,8 +128,9 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
         continue;
       }
       ++measured;
-      // The bake measured this model at 9.6 mm mean, 88 mm max on its held-out poses; a coarser
-      // simulation adds a few mm (rest pose) to a few cm (folds a 1500-vertex cloth cannot make).
+      // The bake measured this model at 5.3 mm mean, 52 mm max on its held-out poses, and 16 mm on
+      // the rest pose it trained on; a coarser simulation adds a few mm (rest pose: 21 mm in all) to
+      // a few cm (folds a 3000-vertex cloth at 4 substeps cannot make).
       EXPECT_TRUE(std::isfinite(c.meanMm) && std::isfinite(c.p95Mm) && std::isfinite(c.maxMm));
       EXPECT_GT(c.meanMm, 0.0);
       EXPECT_LT(c.meanMm, 40.0) << "character " << c.character << " frame " << f.frame;
