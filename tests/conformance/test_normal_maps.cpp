@@ -144,10 +144,13 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
   if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
   // 12 .. 4 texels wide: fewer block columns than the pass's smallest exact workgroup (the bounds-checked
   // form); 64 and 72 wide: 16 and 18 block columns, covered exactly.
+  // Both shaders: 32-bit stores, and 64-bit ones where the device has shaderInt64.
+  for (const bool store64 : {false, true})
   for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}}) {
-    SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height));
-    const gpu::NormalMapBlendPass pass(ctx(), width);
+    SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + (store64 ? ", 64-bit stores" : ""));
+    const gpu::NormalMapBlendPass pass(ctx(), width, store64);
     EXPECT_EQ(pass.exact(), width >= 64);
+    EXPECT_EQ(pass.stores64(), store64 && ctx().hasShaderInt64());
     const uint32_t characters = 5, slots = 2;
     const size_t per = size_t(width) * height * 2;
     std::vector<runtime::DecodedNormalMap> decoded(slots, {width, height, std::vector<int8_t>(per)});

@@ -94,6 +94,7 @@ struct Context::Impl {
   VkPhysicalDeviceMemoryProperties memProps{};
   bool normalMaps = false;
   bool timestamps = false;
+  bool shaderInt64 = false;
   bool validation = false;
   VkCommandPool oneTimePool = VK_NULL_HANDLE;
 
@@ -331,6 +332,8 @@ Context Context::create(const ContextOptions& options) {
   f12.bufferDeviceAddress = VK_TRUE;
   VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
   f.features.shaderStorageImageExtendedFormats = supported.shaderStorageImageExtendedFormats;
+  // Optional: the normal-map blend stores through 64-bit words where it can (normal_map_blend_pass.hpp).
+  f.features.shaderInt64 = supported.shaderInt64;
   const float priority = 1.f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = impl->queueFamily;
@@ -343,6 +346,7 @@ Context Context::create(const ContextOptions& options) {
   if (r == VK_ERROR_FEATURE_NOT_PRESENT || r == VK_ERROR_EXTENSION_NOT_PRESENT)
     throw Error(std::string("the Vulkan device refused the features swish needs (") + vkResultName(r) + ")");
   if (r != VK_SUCCESS) throwVkError(r, "vkCreateDevice", __FILE__, __LINE__);
+  impl->shaderInt64 = supported.shaderInt64 == VK_TRUE;
   vkGetDeviceQueue(impl->device, impl->queueFamily, 0, &impl->queue);
   impl->finishSetup();
   return Context(std::move(impl));
@@ -392,6 +396,7 @@ const VkPhysicalDeviceProperties& Context::properties() const { return impl_->pr
 std::string Context::deviceName() const { return impl_->props.deviceName; }
 bool Context::ownsDevice() const { return impl_->ownsDevice; }
 bool Context::supportsNormalMaps() const { return impl_->normalMaps; }
+bool Context::hasShaderInt64() const { return impl_->shaderInt64; }
 bool Context::supportsTimestamps() const { return impl_->timestamps; }
 double Context::timestampPeriodNs() const { return impl_->props.limits.timestampPeriod; }
 bool Context::validationEnabled() const { return impl_->validation; }

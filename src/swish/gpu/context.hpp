@@ -79,6 +79,9 @@ class Context {
   bool ownsDevice() const;
   bool supportsNormalMaps() const;   // storage images of R16G16_SNORM usable
   bool supportsTimestamps() const;
+  // 64-bit integers in shaders (shaderInt64): enabled on swish's own device when supported; never
+  // assumed on an adopted device (a host need not have enabled it, and Vulkan cannot be asked).
+  bool hasShaderInt64() const;
   double timestampPeriodNs() const;
 
   // Index of a memory type allowed by `typeBits` having `required` flags, preferring `preferred` too;

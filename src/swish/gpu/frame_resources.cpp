@@ -36,7 +36,8 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
     // The blend's state starts as the images do: all 0.
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
       vkCmdFillBuffer(cmd, blendedTexels.handle(), 0, VK_WHOLE_SIZE, 0);
-      VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      VkMemoryBarrier mb{};
+      mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
       mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
       mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
       vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0,

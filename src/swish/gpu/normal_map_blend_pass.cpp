@@ -13,8 +13,8 @@ namespace swish::gpu {
 static_assert(sizeof(NormalMapBlendPass::Character) == sizeof(layout::NormalMapBlendCharacter) &&
               offsetof(NormalMapBlendPass::Character, alpha) == offsetof(layout::NormalMapBlendCharacter, alpha));
 
-NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width)
-    : width_(width),
+NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width, bool store64)
+    : width_(width), store64_(store64 && ctx.hasShaderInt64()),
       layout_(ctx, {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER}) {
   if (width == 0 || width % 4) throw Error("normal-map blend: map width " + std::to_string(width) + " is not a multiple of 4");
   const VkPhysicalDeviceLimits& lim = ctx.properties().limits;
@@ -23,8 +23,8 @@ NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width)
   for (uint32_t d = std::min(most, blocksX); d >= kMinRowGroup && !exact_; --d)
     if (blocksX % d == 0) rowGroup_ = d, exact_ = true;
   if (!exact_) rowGroup_ = std::min(kFallbackGroup, most);
-  pipeline_ = ComputePipeline(ctx, "normal_map_blend.comp", {rowGroup_, exact_ ? 1u : 0u}, sizeof(layout::NormalMapBlendParams),
-                              layout_.get());
+  pipeline_ = ComputePipeline(ctx, store64_ ? "normal_map_blend_store64.comp" : "normal_map_blend.comp",
+                              {rowGroup_, exact_ ? 1u : 0u}, sizeof(layout::NormalMapBlendParams), layout_.get());
 }
 
 DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const Buffer& prev, const Buffer& out, const Buffer& decoded) const {
@@ -53,10 +53,12 @@ void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, co
   // TRANSFER_DST_OPTIMAL for the copy (the layout copies ask for) and back to GENERAL; the first barrier
   // also orders the copy's image writes after every earlier access to the images on this queue (all
   // ordered before the dispatch).
-  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  VkMemoryBarrier mb{};
+  mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
   mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-  VkImageMemoryBarrier ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  VkImageMemoryBarrier ib{};
+  ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
   ib.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
   ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   ib.oldLayout = VK_IMAGE_LAYOUT_GENERAL;

@@ -58,11 +58,13 @@ class NormalMapBlendPass {
   };
 
   NormalMapBlendPass() = default;
-  // For maps `width` texels wide (a multiple of 4; the dispatch shape depends on it).
-  NormalMapBlendPass(Context& ctx, uint32_t width);
+  // For maps `width` texels wide (a multiple of 4; the dispatch shape depends on it). The shader stores
+  // 64-bit words where the context has shaderInt64 and store64 is true (normal_map_blend.glsl).
+  NormalMapBlendPass(Context& ctx, uint32_t width, bool store64 = true);
   uint32_t width() const { return width_; }
   uint32_t rowGroup() const { return rowGroup_; }  // block columns per workgroup
   bool exact() const { return exact_; }             // rowGroup() divides width / 4
+  bool stores64() const { return store64_; }        // normal_map_blend_store64.comp
 
   // A descriptor set binding the packed texels `prev` (read), `out` (written) and the decoded slots
   // `decoded` (uint16[slots][height][width], from its start).
@@ -71,7 +73,7 @@ class NormalMapBlendPass {
 
  private:
   uint32_t width_ = 0, rowGroup_ = 0;
-  bool exact_ = false;
+  bool exact_ = false, store64_ = false;
   DescriptorLayout layout_;
   ComputePipeline pipeline_;
 };
