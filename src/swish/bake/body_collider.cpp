@@ -70,6 +70,19 @@ BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& 
   const std::vector<uint32_t> part = connectedParts(triangles_, size_t(restPositions_.rows()));
   triangleComponent_.resize(size_t(triangles_.rows()));
   for (Eigen::Index t = 0; t < triangles_.rows(); ++t) triangleComponent_[size_t(t)] = part[triangles_(t, 0)];
+  partTriangles_.resize(size_t(triangles_.rows()));
+  for (uint32_t t = 0; t < uint32_t(triangles_.rows()); ++t) partTriangles_[t] = t;
+  std::stable_sort(partTriangles_.begin(), partTriangles_.end(),
+                   [&](uint32_t x, uint32_t y) { return triangleComponent_[x] < triangleComponent_[y]; });
+  for (uint32_t i = 0; i < partTriangles_.size();) {
+    const uint32_t id = triangleComponent_[partTriangles_[i]];
+    uint32_t j = i;
+    bool closed = true;
+    for (; j < partTriangles_.size() && triangleComponent_[partTriangles_[j]] == id; ++j)
+      for (int k = 0; k < 3; ++k) closed &= edgeUses[triangleEdges_[size_t(partTriangles_[j]) * 3 + k]] == 2;
+    partRanges_.push_back({id, i, j, closed});
+    i = j;
+  }
   positions_ = restPositions_;
   rebuild();
 }
@@ -104,7 +117,7 @@ void BodyCollider::rebuild() {
     }
     const Vec3f centre = (p[0] + p[1] + p[2]) / 3.f;
     const float r = std::max({(p[0] - centre).norm(), (p[1] - centre).norm(), (p[2] - centre).norm()});
-    triangleSpheres_[t] << centre, r;
+    triangleSpheres_[t] = Vec4f(centre.x(), centre.y(), centre.z(), r);  // not "<< centre, r": GCC 12 warns (-Warray-bounds) on that
   }
   for (auto& n : vertexNormals_) n.normalize();
   for (auto& n : edgeNormals_) n.normalize();
@@ -221,7 +234,9 @@ size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<H
       default: pseudo = edgeNormals_[triangleEdges_[size_t(pb.tri) * 3 + pb.point.index]]; break;
     }
     const Vec3f diff = p - pb.point.point;
-    const float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
+    float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
+    // Deep inside by the pseudo-normal: confirm with the winding number (the header says why).
+    if (sign < 0.f && pb.distance > kWindingCheckDepth && windingNumber(p, int(pb.part)) < 0.5f) sign = 1.f;
     Hit& h = hits[k];
     h.found = true;
     h.signedDistance = sign * pb.distance;
@@ -239,6 +254,23 @@ size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<H
                     });
   std::copy_n(hits.begin(), n, out.begin());
   return n;
+}
+
+float BodyCollider::windingNumber(const Vec3f& p, int part) const {
+  const auto r = std::find_if(partRanges_.begin(), partRanges_.end(), [&](const PartRange& x) { return int(x.part) == part; });
+  if (r == partRanges_.end() || !r->closed) return 1.f;  // nothing to check against: keep the pseudo-normal's answer
+  // Sum of the triangles' solid angles seen from p (Van Oosterom & Strackee), over 4 pi.
+  double omega = 0.0;
+  for (uint32_t i = r->begin; i < r->end; ++i) {
+    const uint32_t t = partTriangles_[i];
+    const Vec3f a = positions_.row(triangles_(t, 0)).transpose() - p, b = positions_.row(triangles_(t, 1)).transpose() - p,
+                c = positions_.row(triangles_(t, 2)).transpose() - p;
+    const float la = a.norm(), lb = b.norm(), lc = c.norm();
+    const float num = a.dot(b.cross(c));
+    const float den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    omega += 2.0 * std::atan2(double(num), double(den));
+  }
+  return float(omega / (4.0 * 3.14159265358979323846));
 }
 
 BodyCollider::Hit BodyCollider::closest(const Vec3f& p, float maxDistance, int onlyPart, int skipPart) const {

@@ -9,6 +9,12 @@
 // part answered by its own closest triangle. Taking the single closest triangle of the whole soup
 // instead would answer, in an armpit, with the arm tube's buried wall inside the torso, whose normal
 // points the wrong way, and push the cloth into the body.
+//
+// Pseudo-normals are exact only for a surface that does not pass through itself. Skinning folds a
+// tube at a sharply bent elbow through itself, and a point well outside the arm then finds its
+// closest feature in the fold, facing away: "inside" by centimetres. So an inside answer deeper than
+// kWindingCheckDepth from a closed part is confirmed by that part's winding number (robust to
+// self-intersection) and turned to outside when the winding number says so.
 #include <span>
 #include <string>
 #include <vector>
@@ -27,6 +33,9 @@ class BodyCollider {
     int triangle = -1;  // the body triangle `point` lies on
     int part = -1;      // the connected part that triangle belongs to
   };
+
+  // Inside answers deeper than this (metres) are confirmed by the winding number (see above).
+  static constexpr float kWindingCheckDepth = 0.002f;
 
   // `body`: rest positions, triangles, skin weights (validated, naming `what`). `cellSize`: grid
   // spacing in metres, best about the usual search distance.
@@ -51,6 +60,10 @@ class BodyCollider {
   // kind whose inside the signed distance tells reliably.
   size_t openEdges() const { return openEdges_; }
 
+  // Generalised winding number of the posed part `part` (a Hit::part) at p: 1 inside a closed part,
+  // 0 outside, whatever folds skinning put in it. O(the part's triangles).
+  float windingNumber(const Vec3f& p, int part) const;
+
   const Points3f& positions() const { return positions_; }
   const Triangles& triangles() const { return triangles_; }
 
@@ -63,6 +76,14 @@ class BodyCollider {
   std::vector<uint32_t> triangleEdges_;  // 3 per triangle: edge index of sides ab, bc, ca
   std::vector<std::array<int32_t, 2>> edgeTriangles_;  // up to two triangles per edge (-1: none)
   std::vector<uint32_t> triangleComponent_;  // connected part (by shared vertices) of each triangle
+  // Each part's triangles (partTriangles_[begin, end)), and whether the part is closed (every edge
+  // shared by two of its triangles): only a closed part has a winding number to trust.
+  struct PartRange {
+    uint32_t part, begin, end;
+    bool closed;
+  };
+  std::vector<PartRange> partRanges_;
+  std::vector<uint32_t> partTriangles_;
   float cellSize_;
   size_t openEdges_ = 0;
 

@@ -193,7 +193,8 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   // 3: band anchored to the trunk only, clear of the limbs and lifted out of them; explosion test by
   //    the share of over-stretched edges.
   // 4: two contact planes per vertex (one per body part), band attachment softened next to the limbs.
-  f.value(uint32_t(4));
+  // 5: the collider confirms deep "inside" answers by the part's winding number (folded elbows).
+  f.value(uint32_t(5));
   f.matrix(mesh_.restPositions);
   f.matrix(mesh_.triangles);
   f.vec(mesh_.skin.joints);
