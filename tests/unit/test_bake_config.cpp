@@ -88,7 +88,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                                     {"joint_map", {{"Hips", "Hips"}}}}}},
                         {"input_joints", {"Spine", "Spine1"}},
                         {"thinning", {{"tolerance", 0.25}, {"include_rest_pose", false}}},
-                        {"simulation", {{"preset", "stiff"}, {"vertices", 4000}, {"threads", 2}, {"substeps", 4}, {"gravity", 0}}},
+                        {"simulation", {{"preset", "stiff"}, {"vertices", 4000}, {"threads", 2}, {"substeps", 4}, {"gravity", 0},
+                                        {"attach_band", 0.03}}},
                         {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
                         {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
       "recipe.json", "/base");
@@ -107,6 +108,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(s.simulationVertices, 4000u);
   EXPECT_EQ(s.threads, 2);
   EXPECT_EQ(s.simulation.substeps, 4);
+  EXPECT_FLOAT_EQ(s.simulation.attachTopFraction, 0.03f);
+  EXPECT_FLOAT_EQ(d.part1->simulation.attachTopFraction, ClothSimSettings{}.attachTopFraction);
   EXPECT_EQ(s.simulation.gravity, Vec3f::Zero());
   EXPECT_FLOAT_EQ(d.part1->simulation.gravity.y(), -9.81f);
   EXPECT_FLOAT_EQ(s.transfer.smoothing.strength, 0.3f);
@@ -121,6 +124,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"simulation", {{"subteps", 3}}}}), "part1.simulation.subteps: unknown key");
   says(part1Error({{"simulation", {{"preset", "silk"}}}}), "part1.simulation.preset");
   says(part1Error({{"simulation", {{"substeps", 0}}}}), "part1.simulation.substeps: 0 is outside");
+  says(part1Error({{"simulation", {{"attach_band", 0.9}}}}), "part1.simulation.attach_band: 0.9 is outside");
   says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
   says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");

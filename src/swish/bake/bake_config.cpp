@@ -133,7 +133,7 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   std::string p = prefix + ".simulation";
   c.onlyKeys(sim, p,
              {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
-              "iterations", "threads", "gravity", "limb_clearance"});
+              "iterations", "threads", "gravity", "limb_clearance", "attach_band"});
   ClothSimSettings& cs = s.simulation;
   if (sim.contains("preset")) {
     try {
@@ -154,6 +154,8 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   cs.gravity = Vec3f(0.f, -float(c.number(sim, p, "gravity", 0, 100, -cs.gravity.y())), 0.f);
   // Metres kept between a limb and the trunk (limb_clearance.hpp); 0 leaves the poses as recorded.
   s.limbClearance.clearance = float(c.number(sim, p, "limb_clearance", 0, 0.1, s.limbClearance.clearance));
+  // The top band of the garment held on the body (share of its rest height; cloth_solver.hpp).
+  cs.attachTopFraction = float(c.number(sim, p, "attach_band", 0, 0.5, cs.attachTopFraction));
   try {
     cs.validate();
   } catch (const Error& e) {

@@ -23,7 +23,8 @@
 //                   the rest pose joins the kept poses and is always trained on),
 //       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
-//                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp)},
+//                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
+//                      "attach_band" (top share of the garment's height held on the body)},
 //       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}

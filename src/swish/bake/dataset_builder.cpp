@@ -135,7 +135,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
        {{"preset", m.material.name}, {"vertices", simulationVertices}, {"thickness", m.thickness},
         {"transition_seconds", m.transitionSeconds}, {"settle_seconds", m.settleSeconds},
         {"frame_rate", m.frameRate}, {"substeps", m.substeps}, {"iterations", m.iterations},
-        {"gravity", -m.gravity.y()}, {"limb_clearance", limbClearance.clearance}}},
+        {"gravity", -m.gravity.y()}, {"limb_clearance", limbClearance.clearance}, {"attach_band", m.attachTopFraction}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength}, {"smoothing_iterations", transfer.smoothing.iterations},
         {"smoothing_weights", transfer.smoothing.weights == LaplacianWeights::Cotangent ? "cotangent" : "uniform"}}},
