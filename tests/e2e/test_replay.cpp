@@ -229,11 +229,12 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
     gpu::FrameRecorder rec(ctx(), g, 3, ro);
     uint64_t model = 0, frame = 0;
     for (const gpu::Buffer* b : {&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets,
-                                 &g.normalTriangles, &g.tangentOffsets, &g.tangentTriangles, &g.codebook, &g.indices})
+                                 &g.normalTriangles, &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook,
+                                 &g.indices})
       model += b->size();
     const auto& f = rec.frame(0);
     for (const gpu::Buffer* b : {&f.meshWeights, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions, &f.normals,
-                                 &f.tangents, &f.decodedMaps})
+                                 &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
       frame += b->size();
     frame += uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4;
     uint64_t plannedModel = 0, plannedFrame = 0;

@@ -45,6 +45,8 @@ std::vector<PlannedAllocation> modelAllocations(const Model& m, const std::strin
   add("normal adjacency", topo.normalAdjacency.triangles.size() * 4);
   add("tangent adjacency offsets", topo.tangentAdjacency.offsets.size() * 4);
   add("tangent adjacency", topo.tangentAdjacency.triangles.size() * 4);
+  // gpu::TangentFramesPass::frameTriangles: the welded adjacency with each vertex's own triangles flagged.
+  add("flagged adjacency", topo.normalAdjacency.triangles.size() * 4);
   if (withMaps && !m.normalMaps.empty()) {
     add("VQ codebook", (m.normalMaps.codebook.size() + 3) / 4 * 4);
     add("VQ indices", (m.normalMaps.indices.size() + 1) / 2 * 2 * 2);
@@ -65,12 +67,17 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
   if (frames) {
     add("normals", c * n * 12);
     add("tangents", c * n * 16);
+    // The two-pass tangent frames' per-triangle terms: 9 floats a triangle, each instance's padded to
+    // a multiple of 4 (SWISH_TERMS_INSTANCE_FLOATS in shaders/swish_triangle_frames_layout.h), 16 B at least.
+    const uint64_t t = uint64_t(m.gameMesh.triangleCount());
+    add("triangle terms", std::max<uint64_t>(16, (t * 9 + 3) / 4 * 4 * 4 * c));
   }
   if (maps) {
     const uint64_t texels = uint64_t(m.normalMaps.width) * m.normalMaps.height;
     add("decode jobs", c * 8);  // map + slot of each map decoded
     add("blend characters", c * 8);
     add("decoded maps", c * texels * 2);
+    add("blended normal maps", c * texels * 4);  // the blend's output (snorm16 x2), copied into the images
     add("normal maps (RG16 snorm array)", c * texels * 4, true);
   }
   return a;
