@@ -19,10 +19,13 @@ TEST_F(GpuContext, ListsTheChosenDeviceAndPrefersRealGpus) {
   ASSERT_GE(picked, 0) << why;
   EXPECT_EQ(devices[size_t(picked)].name, ctx().deviceName());
   std::printf("picked %s of %zu device(s)\n", devices[size_t(picked)].name.c_str(), devices.size());
-  if (!std::getenv("SWISH_DEVICE"))
-    for (const auto& d : devices)  // nothing usable ranks above the pick
-      if (d.usable && d.type == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU)
+  if (!std::getenv("SWISH_DEVICE")) {
+    for (const auto& d : devices) {  // nothing usable ranks above the pick
+      if (d.usable && d.type == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU) {
         EXPECT_EQ(devices[size_t(picked)].type, VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU);
+      }
+    }
+  }
 }
 
 TEST_F(GpuContext, SelectingByIndexAndByNameFindsTheSameDevice) {

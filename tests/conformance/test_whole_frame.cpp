@@ -161,7 +161,9 @@ TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
   const auto gpu = recorder.download(0);
   EXPECT_TRUE(gpu.normalMaps.empty());
   expectFrameMatches(gpu, runtime::referenceFrame(model, in), 0);
-  if (ctx().supportsTimestamps()) EXPECT_TRUE(std::isnan(recorder.stageTimes(0).vqDecodeMs));
+  if (ctx().supportsTimestamps()) {
+    EXPECT_TRUE(std::isnan(recorder.stageTimes(0).vqDecodeMs));
+  }
 }
 
 TEST_F(WholeFrame, BadInputsAreRejectedWithAReason) {
