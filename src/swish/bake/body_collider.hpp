@@ -60,8 +60,9 @@ class BodyCollider {
   // kind whose inside the signed distance tells reliably.
   size_t openEdges() const { return openEdges_; }
 
-  // Generalised winding number of the posed part `part` (a Hit::part) at p: 1 inside a closed part,
-  // 0 outside, whatever folds skinning put in it. O(the part's triangles).
+  // Generalised winding number of the posed part `part` (a Hit::part) at p: 1 inside a closed part
+  // (2 where a fold overlaps itself), 0 outside, whatever folds skinning put in it. An open part or an
+  // unknown id answers 1: its inside cannot be told this way. O(the part's triangles).
   float windingNumber(const Vec3f& p, int part) const;
 
   const Points3f& positions() const { return positions_; }

@@ -47,7 +47,6 @@ Mlp toModelMlp(const MlpNetwork<float>& net) {
 
 }  // namespace
 
-
 IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t> pinned) {
   std::vector<bool> isPinned(n, false);
   for (uint32_t i : pinned)
