@@ -14,6 +14,7 @@
 #include "swish/bake/dataset_preview.hpp"
 #include "swish/bake/pose_simulation.hpp"
 #include "swish/bake/pose_thinning.hpp"
+#include "swish/runtime/theta.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
 #include "swish/io/animation_import.hpp"
@@ -222,7 +223,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   }
   if (s.includeRestPose) {
     const Pose rest = canonicalPose(character.skeleton, character.skeleton.restPose());
-    const float nearest = nearestKeptDistance(samples, thin.kept, thetaOfPose(character.skeleton, rest, s.inputJoints));
+    const float nearest = nearestKeptDistance(samples, thin.kept, runtime::computeTheta(inputJoints, rest.local));
     if (nearest > thin.tolerance) {
       poses.push_back(rest);
       res.restPoseAdded = true;

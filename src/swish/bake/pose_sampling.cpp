@@ -69,19 +69,6 @@ Pose poseOfSample(const Skeleton& skeleton, const std::vector<AnimationClip>& cl
   return origin.mirrored ? mirrorPose(skeleton, p) : p;
 }
 
-std::vector<float> thetaOfPose(const Skeleton& skeleton, const Pose& pose, const std::vector<std::string>& joints) {
-  std::vector<float> out;
-  out.reserve(6 * joints.size());
-  for (const auto& name : joints) {
-    const int j = skeleton.find(name);
-    if (j < 0) throw Error("pose sampling: joint '" + name + "' is not in the skeleton");
-    if (size_t(j) >= pose.local.size()) throw Error("pose sampling: the pose has no rotation for joint '" + name + "'");
-    const Rot6 r = toRot6(Quatf(pose.local[size_t(j)]).normalized());
-    out.insert(out.end(), r.begin(), r.end());
-  }
-  return out;
-}
-
 PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
                         const PoseSamplingOptions& options) {
   if (clips.empty()) throw Error("pose sampling: no clips");

@@ -2,7 +2,8 @@
 // Pose recording: every frame of the given clips, as several "characters" would play them in a game
 // (each with its own clip order, start offset, playback speed and optional left/right mirroring),
 // sampled at a fixed rate into Theta vectors (6D of the chosen joints' local rotations, in the order
-// of the joint list; toRot6 in core/rotation.hpp). The greedy thinning (pose_thinning.hpp) reduces them.
+// of the joint list; toRot6 in core/rotation.hpp): the same vector runtime::computeTheta makes of a
+// pose for those joints. The greedy thinning (pose_thinning.hpp) reduces them.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -45,10 +46,6 @@ struct PoseSamplingOptions {
 // name is not in the skeleton, a clip is empty, or a clip's frames do not fit the skeleton.
 PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
                         const PoseSamplingOptions& options = {});
-
-// The sample (Theta vector, as samplePoses makes them) of one full-skeleton pose. Throws Error when a
-// joint name is not in the skeleton.
-std::vector<float> thetaOfPose(const Skeleton& skeleton, const Pose& pose, const std::vector<std::string>& joints);
 
 // The full-skeleton pose a sample stands for (same interpolation and mirroring as samplePoses).
 Pose poseOfSample(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
