@@ -40,9 +40,10 @@ swish::cli::RunFn setup(CLI::App& sub) {
       std::printf("%s: valid; model -> %s, report -> %s\n", o->config.c_str(), cfg.modelPath().string().c_str(),
                   cfg.reportDir().string().c_str());
       if (cfg.part1)
-        std::printf("part 1: %zu clip(s) -> %s poses -> simulation (%zu vertices, preset '%s') in %s -> dataset %s\n",
+        std::printf("part 1: %zu clip(s) -> %s poses%s -> simulation (%zu vertices, preset '%s') in %s -> dataset %s\n",
                     cfg.part1->clips.size(),
                     cfg.part1->targetPoses ? std::to_string(cfg.part1->targetPoses).c_str() : "thinned",
+                    cfg.part1->includeRestPose ? " (+ the rest pose unless one is near it)" : "",
                     cfg.part1->simulationVertices, cfg.part1->simulation.material.name.c_str(),
                     cfg.simulationDir().string().c_str(), cfg.dataset.string().c_str());
       else
