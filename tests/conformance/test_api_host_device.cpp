@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "support/random_model.hpp"
+#include "support/seeded_test.hpp"
 #include "swish/runtime/frame_evaluator.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "test_api_host_fixture.hpp"
@@ -113,8 +114,7 @@ Model randomModel(uint64_t seed, uint32_t vertices) {
 
 TEST(ApiHostDevice, RecordsIntoHostCommandBuffersAcrossFramesInFlight) {
   SWISH_HOST_DEVICE_OR_SKIP(device);
-  const uint64_t seed = test::testSeed(0xA71);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SWISH_TEST_SEED_SCOPE(seed, 0xA71);
   const Model model = randomModel(seed, 157);
   api::Runtime rt = api::Runtime::adopt(device->handles());
   EXPECT_FALSE(rt.ownsDevice());

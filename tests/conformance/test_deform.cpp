@@ -13,6 +13,7 @@
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
+#include "support/seeded_test.hpp"
 #include "swish/gpu/deform_pass.hpp"
 #include "swish/runtime/reference_pca.hpp"
 #include "swish/runtime/reference_skinning.hpp"
@@ -147,9 +148,7 @@ std::string caseName(const ::testing::TestParamInfo<DeformCase>& info) {
 class DeformConformance : public test::GpuTest, public ::testing::WithParamInterface<DeformCase> {};
 
 TEST_P(DeformConformance, PcaReconstructionMatchesReference) {
-  const uint64_t seed = test::testSeed(0xDEF0 + GetParam().vertices);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0xDEF0 + GetParam().vertices);
   const DeformInputs in = randomInputs(seed, GetParam());
   const auto gpu = runDeform(ctx(), in, false);
   for (const auto& p : gpu.problems) ADD_FAILURE() << p;
@@ -159,9 +158,7 @@ TEST_P(DeformConformance, PcaReconstructionMatchesReference) {
 }
 
 TEST_P(DeformConformance, SkinnedPositionsMatchReference) {
-  const uint64_t seed = test::testSeed(0x5C1 + GetParam().vertices);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0x5C1 + GetParam().vertices);
   const DeformInputs in = randomInputs(seed, GetParam());
   const auto gpu = runDeform(ctx(), in, true);
   for (const auto& p : gpu.problems) ADD_FAILURE() << p;
@@ -182,8 +179,7 @@ class DeformSpecialValues : public test::GpuTest {};
 
 // NaN/Inf placement: each poisoned input must reach exactly the outputs the reference says it reaches.
 TEST_F(DeformSpecialValues, NanAndInfReachExactlyTheReferenceOutputs) {
-  const uint64_t seed = test::testSeed(0xBAD);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SWISH_TEST_SEED_SCOPE(seed, 0xBAD);
   DeformInputs in = randomInputs(seed, {61, 6, 4, 4});
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   in.model.meshPca.basis(3 * 17 + 1, 2) = nan;  // vertex 17 (y), every instance

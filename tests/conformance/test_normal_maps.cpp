@@ -11,6 +11,7 @@
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
+#include "support/seeded_test.hpp"
 #include "swish/gpu/normal_map_blend_pass.hpp"
 #include "swish/gpu/normal_map_images.hpp"
 #include "swish/gpu/vq_decode_pass.hpp"
@@ -98,9 +99,7 @@ void PrintTo(const DecodeCase& c, std::ostream* os) {
 class VqDecodeConformance : public test::GpuTest, public ::testing::WithParamInterface<DecodeCase> {};
 
 TEST_P(VqDecodeConformance, DecodesExactlyLikeReference) {
-  const uint64_t seed = test::testSeed(0x7D + GetParam().size);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0x7D + GetParam().size);
   Rng rng(seed);
   const auto db = randomDatabase(rng, GetParam().size, GetParam().maps, GetParam().codebook);
   expectDecodeExact(ctx(), db, GetParam().slots);
@@ -137,9 +136,7 @@ TEST_F(NormalMapSpecialCases, IndexBeyondCodebookDecodesToZero) {
 // bytes (every snorm8 value), square and not (the kernel walks 4x4 blocks: width and height must not
 // be mixed up), one to several blocks across.
 TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
-  const uint64_t seed = test::testSeed(0xB1E);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0xB1E);
   Rng rng(seed);
   if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
   // 12 .. 4 texels wide: fewer block columns than the pass's smallest exact workgroup (the bounds-checked

@@ -13,6 +13,7 @@
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
+#include "support/seeded_test.hpp"
 #include "swish/core/mesh_frames.hpp"
 #include "swish/core/error.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
@@ -140,9 +141,7 @@ void expectMatch(const Frames& gpu, const Frames& ref, test::CompareReport* nrep
 class TangentFramesConformance : public test::GpuTest, public ::testing::WithParamInterface<FramesCase> {};
 
 TEST_P(TangentFramesConformance, MatchReference) {
-  const uint64_t seed = test::testSeed(0xF4A3 + GetParam().vertices);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0xF4A3 + GetParam().vertices);
   Rng rng(seed);
   test::RandomModelSpec spec;
   spec.vertices = GetParam().vertices;
@@ -186,8 +185,7 @@ TEST_F(TangentFramesSpecialCases, MeshWithoutUvsUsesTheFallbackTangentLikeTheRef
 // A NaN position poisons the frames of the vertices around it exactly as in the reference (whose
 // fallbacks turn a NaN normal into (0,0,1) and a NaN tangent into the fallback perpendicular).
 TEST_F(TangentFramesSpecialCases, NanPositionAffectsExactlyTheReferenceVertices) {
-  const uint64_t seed = test::testSeed(0x4A4);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SWISH_TEST_SEED_SCOPE(seed, 0x4A4);
   Rng rng(seed);
   test::RandomModelSpec spec;
   spec.vertices = 64;

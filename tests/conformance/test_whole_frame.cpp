@@ -12,6 +12,7 @@
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
+#include "support/seeded_test.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/runtime/reference_frame.hpp"
@@ -62,9 +63,7 @@ void expectFrameMatches(const runtime::ReferenceFrameOutputs& gpu, const runtime
 class WholeFrame : public test::GpuTest {};
 
 TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
-  const uint64_t seed = test::testSeed(0xF4A3E);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0xF4A3E);
   Rng rng(seed);
   test::RandomModelSpec spec;
   spec.vertices = 311;
@@ -109,9 +108,7 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
 // into the slots selected longest ago (never one the frame reads), and the normal maps still match the
 // reference frame after frame while slots are given to other maps.
 TEST_F(WholeFrame, DecodedMapsAreKeptAcrossFramesAndTheirSlotsReused) {
-  const uint64_t seed = test::testSeed(0xCAC4E);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
-  SCOPED_TRACE("seed " + std::to_string(seed));
+  SWISH_TEST_SEED_SCOPE(seed, 0xCAC4E);
   Rng rng(seed);
   test::RandomModelSpec spec;
   spec.vertices = 40;
@@ -147,8 +144,7 @@ TEST_F(WholeFrame, DecodedMapsAreKeptAcrossFramesAndTheirSlotsReused) {
 }
 
 TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
-  const uint64_t seed = test::testSeed(0x40AB);
-  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", (unsigned long long)seed);
+  SWISH_TEST_SEED_SCOPE(seed, 0x40AB);
   Rng rng(seed);
   test::RandomModelSpec spec;
   spec.vertices = 53;

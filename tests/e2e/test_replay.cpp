@@ -35,8 +35,7 @@ class ReplayE2E : public test::GpuTest {
     test::GpuTest::SetUp();
     if (IsSkipped()) return;
     dir_ = tmp_.emplace("replay_e2e").path();
-    const uint64_t seed = test::testSeed(11);
-    std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+    const uint64_t seed = test::announcedTestSeed(11);
     Rng rng(seed);
     test::RandomModelSpec spec;
     spec.joints = 8;

@@ -1,6 +1,7 @@
 #include "support/random_model.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -11,6 +12,12 @@ namespace swish::test {
 uint64_t testSeed(uint64_t fallback) {
   if (const char* s = std::getenv("SWISH_TEST_SEED")) return std::strtoull(s, nullptr, 0);
   return fallback;
+}
+
+uint64_t announcedTestSeed(uint64_t fallback) {
+  const uint64_t seed = testSeed(fallback);
+  std::printf("seed %llu (set SWISH_TEST_SEED to override)\n", static_cast<unsigned long long>(seed));
+  return seed;
 }
 
 static Quatf randomRotation(Rng& rng, float maxAngle) {

@@ -27,7 +27,10 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& spec = {});
 // A random pose for the model's skeleton: rotations of up to maxAngle radians per joint.
 Pose makeRandomPose(Rng& rng, const Skeleton& skeleton, float maxAngle = 0.8f);
 
-// The seed a test uses: SWISH_TEST_SEED from the environment if set, else `fallback`. Tests print it.
+// The seed a test uses: SWISH_TEST_SEED from the environment if set, else `fallback`.
 uint64_t testSeed(uint64_t fallback);
+// testSeed(fallback), printed so that a failing run can be replayed (support/seeded_test.hpp also adds
+// it to the failure messages).
+uint64_t announcedTestSeed(uint64_t fallback);
 
 }  // namespace swish::test

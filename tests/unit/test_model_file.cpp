@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "support/random_model.hpp"
+#include "support/seeded_test.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
 #include "swish/model/atomic_write.hpp"
@@ -300,8 +301,7 @@ TEST(Crc32, MatchesTheStandardCheckValueAndContinues) {
 }
 
 TEST(ModelFile, RoundTripIsBitwiseExactForManyShapes) {
-  const uint64_t seed = swish::test::testSeed(2024);
-  std::printf("seed %llu (override with SWISH_TEST_SEED)\n", (unsigned long long)seed);
+  SWISH_TEST_SEED_SCOPE(seed, 2024);
   std::vector<std::pair<const char*, RandomModelSpec>> shapes;
   shapes.push_back({"default", {}});
   RandomModelSpec s;
