@@ -33,7 +33,9 @@ void expectSameMesh(const Mesh& a, const Mesh& b, const std::string& what) {
   ASSERT_EQ(a.triangleCount(), b.triangleCount()) << what;
   EXPECT_LT((a.positions - b.positions).cwiseAbs().maxCoeff(), 1e-6f) << what;
   EXPECT_EQ(a.triangles, b.triangles) << what;
-  if (a.uvs.rows()) EXPECT_LT((a.uvs - b.uvs).cwiseAbs().maxCoeff(), 1e-7f) << what;
+  if (a.uvs.rows()) {
+    EXPECT_LT((a.uvs - b.uvs).cwiseAbs().maxCoeff(), 1e-7f) << what;
+  }
   // Skin: the same (joint, weight) pairs per vertex; the importer drops zero weights, so widths may differ.
   auto pairs = [](const Mesh& m, size_t v) {
     std::map<int, float> w;

@@ -199,7 +199,9 @@ TEST(RuntimeFastExp, WithinTwoUlpOfCorrectlyRoundedExpOverTheNormalRange) {
     if (haveAvx) worstAvx = std::max(worstAvx, ulpDistance(avx[i], ref));
   }
   EXPECT_LE(worstScalar, 2);
-  if (haveAvx) EXPECT_LE(worstAvx, 2);
+  if (haveAvx) {
+    EXPECT_LE(worstAvx, 2);
+  }
   EXPECT_EQ(expApprox(0.f), 1.f);
   EXPECT_EQ(expApprox(-0.f), 1.f);
 }
@@ -357,5 +359,7 @@ TEST(RuntimeMlp, BuildsFromAModelAndRejectsBadShapes) {
   zeroScale.scale[0] = 0.f;
   EXPECT_THROW(MlpEvaluator(model.mlp, model.inputNorm, zeroScale, model.meshComponents()), Error);
   EXPECT_THROW(MlpEvaluator(model.mlp, model.inputNorm, model.outputNorm, model.lambdaSize() + 1), Error);
-  if (!cpuHasAvx2Fma()) EXPECT_THROW(MlpEvaluator(model, CpuKernel::Avx2Fma), Error);
+  if (!cpuHasAvx2Fma()) {
+    EXPECT_THROW(MlpEvaluator(model, CpuKernel::Avx2Fma), Error);
+  }
 }
