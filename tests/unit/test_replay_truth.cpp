@@ -41,7 +41,7 @@ fs::path defaultModelFile() { return test::sourceDir() / "assets/default/default
 // not do: the welded game mesh at 4 substeps cannot hold the jersey's narrow top band (attach_band
 // 0.03) and tears even in the A-pose, and at 6-8 substeps it slides 8-12 cm further down than the
 // bake's cloth, which would measure the coarseness instead of the model.
-replay::TruthOptions coarseTruth(uint32_t every) {
+replay::TruthOptions cheaperTruth(uint32_t every) {
   replay::TruthOptions t;
   t.every = every;
   t.substeps = 6;
@@ -100,7 +100,7 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
   replay::ReplayJobOptions jo;
   jo.quiet = true;
   jo.engine.context = &ctx();
-  jo.engine.truth = coarseTruth(2);
+  jo.engine.truth = cheaperTruth(2);
   uint32_t progressCalls = 0, lastDone = 0, lastTotal = 0;
   jo.engine.truthProgress = [&](uint32_t done, uint32_t total) { ++progressCalls, lastDone = done, lastTotal = total; };
   const replay::ReplayJobResult job = replay::runReplayJob(s, jo);
@@ -124,7 +124,7 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
     }
     ASSERT_EQ(f.truth.size(), 2u) << "frame " << f.frame;
     for (const auto& c : f.truth) {
-      if (!c.ok) {  // a clip pose the coarse solver fails on: the bake leaves such poses out too
+      if (!c.ok) {  // a clip pose the cheaper solve fails on: the bake leaves such poses out too
         EXPECT_EQ(c.character, 0u) << c.failure;
         EXPECT_FALSE(c.failure.empty());
         continue;
@@ -173,7 +173,7 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
 
 TEST_F(ReplayTruth, SameFiguresTwiceAndFarFromTheOrigin) {
   auto figures = [&](std::array<double, 3> at) {
-    const replay::ReplayResult r = run(scene(3, json::array({character("walker", true, at)})), coarseTruth(2));
+    const replay::ReplayResult r = run(scene(3, json::array({character("walker", true, at)})), cheaperTruth(2));
     std::vector<double> v;
     for (const auto& f : r.frames)
       for (const auto& c : f.truth) v.insert(v.end(), {double(c.ok), c.meanMm, c.p95Mm, c.maxMm, c.meanDeg, c.maxDeg});
@@ -189,7 +189,7 @@ TEST_F(ReplayTruth, SameFiguresTwiceAndFarFromTheOrigin) {
 TEST_F(ReplayTruth, FramesOffScreenOrWithoutGpuWorkHaveNoTruth) {
   json c = character("hidden", false);
   c["visible"] = false;
-  const replay::ReplayResult r = run(scene(2, json::array({c})), coarseTruth(1));
+  const replay::ReplayResult r = run(scene(2, json::array({c})), cheaperTruth(1));
   EXPECT_EQ(r.truthFrames, 0u);
   for (const auto& f : r.frames) EXPECT_TRUE(f.truth.empty());
   EXPECT_NE(r.truthNote.find("no GPU work"), std::string::npos) << r.truthNote;
@@ -201,7 +201,7 @@ TEST(ReplayTruthNote, ModelsWithoutARebuildableCharacterSayWhy) {
   replay::ModelEntry e;
   e.key = "random";
   e.model = test::makeRandomModel(rng);
-  const replay::TruthOptions o = coarseTruth(1);
+  const replay::TruthOptions o = cheaperTruth(1);
   {
     const replay::ModelTruth t(e, o);
     EXPECT_FALSE(t.available());
