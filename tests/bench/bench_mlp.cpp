@@ -47,30 +47,36 @@ struct PaperNetwork {
   }
 };
 
-void runMlp(benchmark::State& state, CpuKernel kernel) {
-  static const PaperNetwork net;
-  const MlpEvaluator eval(net.mlp, net.in, net.out, PaperNetwork::kMeshComponents, kernel);
+// Times `eval` on a batch of state.range(0) random Theta vectors (entries in [-1, 1], the range of 6D
+// rotation entries) drawn from `seed`.
+void timeBatches(benchmark::State& state, const MlpEvaluator& eval, uint64_t seed, const std::string& label) {
   const size_t batch = size_t(state.range(0));
-  Rng rng(7);
-  std::vector<float> theta(batch * PaperNetwork::kInputs), lambda(batch * PaperNetwork::kOutputs);
-  for (float& t : theta) t = rng.uniformf(-1.f, 1.f);  // the range of 6D rotation entries
+  Rng rng(seed);
+  std::vector<float> theta(batch * size_t(eval.inputSize())), lambda(batch * size_t(eval.outputSize()));
+  for (float& t : theta) t = rng.uniformf(-1.f, 1.f);
   for (auto _ : state) {
     eval.evaluateBatch(theta, lambda, batch);
     benchmark::DoNotOptimize(lambda.data());
     benchmark::ClobberMemory();
   }
-  state.SetLabel(toString(eval.kernel()));
+  state.SetLabel(label);
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(batch));
   // kIsRate|kInvert turns instances per second into seconds per instance.
   state.counters["time_per_instance"] = benchmark::Counter(double(state.iterations()) * double(batch),
                                                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+void runMlp(benchmark::State& state, CpuKernel kernel) {
+  static const PaperNetwork net;
+  const MlpEvaluator eval(net.mlp, net.in, net.out, PaperNetwork::kMeshComponents, kernel);
+  timeBatches(state, eval, 7, toString(eval.kernel()));
+}
+
 void BM_MlpAuto(benchmark::State& state) { runMlp(state, CpuKernel::Auto); }
 void BM_MlpPortable(benchmark::State& state) { runMlp(state, CpuKernel::Portable); }
 
 // The committed default model's own network (assets/default/bake.json says its shape: its recipe
-// may be wider than the paper's), on Theta of the model's rest pose and random poses.
+// may be wider than the paper's); the label gives the layer widths.
 void BM_MlpDefaultModel(benchmark::State& state) {
   const std::filesystem::path file = test::sourceDir() / "assets/default/default.swish";
   if (!std::filesystem::exists(file)) {
@@ -79,21 +85,9 @@ void BM_MlpDefaultModel(benchmark::State& state) {
   }
   static const Model model = loadModel(file);
   const MlpEvaluator eval(model, CpuKernel::Auto);
-  const size_t batch = size_t(state.range(0));
-  Rng rng(11);
-  std::vector<float> theta(batch * size_t(eval.inputSize())), lambda(batch * size_t(eval.outputSize()));
-  for (float& t : theta) t = rng.uniformf(-1.f, 1.f);
-  for (auto _ : state) {
-    eval.evaluateBatch(theta, lambda, batch);
-    benchmark::DoNotOptimize(lambda.data());
-    benchmark::ClobberMemory();
-  }
   std::string shape = std::to_string(eval.inputSize());
   for (const auto& l : model.mlp.layers) shape.append("-").append(std::to_string(l.weight.rows()));
-  state.SetLabel(std::string(toString(eval.kernel())) + " " + shape);
-  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(batch));
-  state.counters["time_per_instance"] = benchmark::Counter(double(state.iterations()) * double(batch),
-                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  timeBatches(state, eval, 11, std::string(toString(eval.kernel())) + " " + shape);
 }
 
 }  // namespace
