@@ -166,15 +166,15 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
         if (dp.id == p.poseId) pose = &dp;
       if (pose) {
         const std::string stem = "gallery/pose_" + std::to_string(p.poseId);
-        io::writePng(dir / (stem + "_truth.png"),
-                     io::encodeNormalMap(pose->normalMap.width, pose->normalMap.height, pose->normalMap.xy, 8));
+        const std::string truthPng = stem + "_truth.png", runtimePng = stem + "_runtime.png";
+        io::writePng(dir / truthPng, io::encodeNormalMap(pose->normalMap.width, pose->normalMap.height, pose->normalMap.xy, 8));
         const auto dec = runtime::referenceVqDecode(out.model.normalMaps, p.selectedMap);
         std::vector<float> xy(dec.xy.size());
         for (size_t k = 0; k < xy.size(); ++k) xy[k] = runtime::snorm8ToFloat(dec.xy[k]);
-        io::writePng(dir / (stem + "_runtime.png"), io::encodeNormalMap(dec.width, dec.height, xy, 8));
-        galleryFiles.push_back(dir / (stem + "_truth.png"));
-        galleryFiles.push_back(dir / (stem + "_runtime.png"));
-        cell = "![truth](" + stem + "_truth.png) ![runtime](" + stem + "_runtime.png)";
+        io::writePng(dir / runtimePng, io::encodeNormalMap(dec.width, dec.height, xy, 8));
+        galleryFiles.push_back(dir / truthPng);
+        galleryFiles.push_back(dir / runtimePng);
+        cell = "![truth](" + truthPng + ") ![runtime](" + runtimePng + ")";
         ++shown;
       }
     }
