@@ -1,7 +1,9 @@
 #pragma once
 // The skinned body as a collider for the cloth: closest point and signed distance to its triangle
 // surface. Signs come from angle-weighted pseudo-normals (Baerentzen & Aanaes 2005), which are exact
-// for closed manifold meshes whatever feature (face, edge, vertex) is closest. Triangles are binned in
+// for closed manifold meshes whatever feature (face, edge, vertex) is closest. The surface is welded
+// first (vertices at the same position are one): a glTF body is split at its UV seams, and only welded
+// is it closed, its seam edges shared and its pseudo-normals those of both sides. Triangles are binned in
 // a uniform grid rebuilt at every pose; queries visit only the cells that overlap their search ball.
 //
 // A body made of several closed parts that overlap (a mannequin's arm tubes pushed into its torso) is
@@ -56,7 +58,7 @@ class BodyCollider {
   size_t closestParts(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart = -1,
                       int skipPart = -1) const;
 
-  // Edges not shared by exactly two triangles (by vertex index): 0 for a closed surface, the only
+  // Edges not shared by exactly two triangles (seam copies welded): 0 for a closed surface, the only
   // kind whose inside the signed distance tells reliably.
   size_t openEdges() const { return openEdges_; }
 
@@ -66,7 +68,7 @@ class BodyCollider {
   float windingNumber(const Vec3f& p, int part) const;
 
   const Points3f& positions() const { return positions_; }
-  const Triangles& triangles() const { return triangles_; }
+  const Triangles& triangles() const { return triangles_; }  // welded: indices of each position's first vertex
 
  private:
   void rebuild();

@@ -200,7 +200,9 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   f.vec(mesh_.skin.joints);
   f.vec(mesh_.skin.weights);
   f.matrix(ch.body.positions);
-  f.matrix(ch.body.triangles);
+  // The collider's triangles, welded at the seams (body_collider.cpp): a body whose seam copies
+  // weld (a glTF body) gets a new fingerprint, one without seams (the default mannequin) keeps its own.
+  f.matrix(colliderPrototype_.triangles());
   f.vec(ch.body.skin.joints);
   f.vec(ch.body.skin.weights);
   for (const Joint& j : skeleton_.joints) {
