@@ -140,3 +140,36 @@ TEST(BakeNormalMapPca, CodesSeparateDifferentPatterns) {
   EXPECT_LT((normalMapCode(p.pca, maps[3]) - p.codes.col(3)).cwiseAbs().maxCoeff(), 1e-4f);
   EXPECT_GT((p.codes.col(0) - p.codes.col(1)).norm(), 1e-3f);
 }
+
+TEST(BakeBc5AtEqualMemory, SizeFitsTheBytesAndKeepsBlocksWhole) {
+  EXPECT_EQ(bc5SizeWithin(256, 256, bc5Bytes(256, 256)), std::make_pair(256u, 256u));  // all it needs: full size
+  const auto [w, h] = bc5SizeWithin(256, 256, 12288);  // the default model's VQ bytes per map
+  EXPECT_EQ(w % 4, 0u);
+  EXPECT_EQ(h % 4, 0u);
+  EXPECT_LE(bc5Bytes(w, h), 12288u);
+  EXPECT_GT(bc5Bytes(w + 4, h + 4), 12288u);  // the largest that fits
+  EXPECT_EQ(w, 108u);                          // 27 x 27 blocks of 16 bytes = 11664 bytes
+  EXPECT_EQ(bc5SizeWithin(256, 128, 16 * 8 * 4).second * 2, bc5SizeWithin(256, 128, 16 * 8 * 4).first);  // aspect
+  EXPECT_EQ(bc5SizeWithin(64, 64, 15), std::make_pair(0u, 0u));  // not one block
+}
+
+TEST(BakeBc5AtEqualMemory, LowFrequencySurvivesHighFrequencyDoesNot) {
+  // A map that varies slowly loses little at half resolution; one that alternates every texel
+  // averages to flat (box filter), so its error is the whole detail's angle.
+  NormalMapImage slow{64, 64, std::vector<float>(64 * 64 * 2)}, fast = slow;
+  for (uint32_t y = 0; y < 64; ++y)
+    for (uint32_t x = 0; x < 64; ++x) {
+      slow.xy[2 * (y * 64 + x)] = 0.3f * float(std::sin(2 * M_PI * (x + 0.5) / 64.0));
+      fast.xy[2 * (y * 64 + x)] = (x % 2 ? 0.3f : -0.3f);
+    }
+  AngularErrorAccumulator a, b, full;
+  a.addMaps(slow, bc5RoundTripResized(slow, 32, 32));
+  b.addMaps(fast, bc5RoundTripResized(fast, 32, 32));
+  full.addMaps(slow, bc5RoundTrip(slow));
+  EXPECT_LT(a.stats().meanDegrees, 1.5);
+  const double detail = std::asin(0.3) * 180.0 / M_PI;  // 17.5 degrees off the flat normal
+  EXPECT_NEAR(b.stats().meanDegrees, detail, 1.0);
+  EXPECT_LE(full.stats().meanDegrees, a.stats().meanDegrees);  // the full size is no worse
+  EXPECT_THROW(bc5RoundTripResized(slow, 128, 32), Error);     // no upsizing
+  EXPECT_THROW(bc5RoundTripResized(slow, 0, 32), Error);
+}

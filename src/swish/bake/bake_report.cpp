@@ -70,6 +70,9 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
         {"compression", {{"vq_vs_uncompressed", toJson(out.vqVsUncompressed)}, {"bc5_vs_uncompressed", toJson(out.bc5VsUncompressed)},
                          {"vq_bytes", out.vq.totalBytes()}, {"vq_codebook_bytes", out.vq.codebookBytes},
                          {"vq_index_bytes", out.vq.indexBytes}, {"bc5_bytes", out.bc5Bytes},
+                         {"bc5_at_vq_memory", {{"vs_uncompressed", toJson(out.bc5AtVqMemoryVsUncompressed)},
+                                               {"width", out.bc5AtVqMemoryWidth}, {"height", out.bc5AtVqMemoryHeight},
+                                               {"bytes", out.bc5AtVqMemoryBytes}}},
                          {"uncompressed_float_bytes", out.uncompressedBytes}, {"codebook_entries", out.vq.codebookEntries},
                          {"vq_training_seconds", out.vq.trainingSeconds}, {"vq_assignment_seconds", out.vq.assignmentSeconds}}}};
   }
@@ -147,11 +150,20 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
     arow("VQ added (selected map vs its VQ decode)", ev.normalVqAdded);
     arow("all database maps: VQ vs uncompressed", out.vqVsUncompressed);
     arow("all database maps: BC5 vs uncompressed", out.bc5VsUncompressed);
+    if (out.bc5AtVqMemoryWidth > 0) {
+      const std::string name = "all database maps: BC5 at VQ's memory (" + std::to_string(out.bc5AtVqMemoryWidth) + "x" +
+                               std::to_string(out.bc5AtVqMemoryHeight) + ", sampled up) vs uncompressed";
+      arow(name.c_str(), out.bc5AtVqMemoryVsUncompressed);
+    }
     md << "\nPredicted map = ideal map for " << f2(100.0 * ev.selectionAgreement) << "% of held-out poses.\n\n";
     md << "Memory for " << out.model.normalMaps.mapCount() << " maps of " << out.model.normalMaps.width << "x"
        << out.model.normalMaps.height << ": VQ " << f2(double(out.vq.totalBytes()) / 1048576.0) << " MiB ("
        << out.vq.codebookEntries << " codebook entries), BC5 " << f2(double(out.bc5Bytes) / 1048576.0) << " MiB"
-       << (out.vq.totalBytes() ? " (" + f2(double(out.bc5Bytes) / double(out.vq.totalBytes())) + "x)" : "") << ".\n\n";
+       << (out.vq.totalBytes() ? " (" + f2(double(out.bc5Bytes) / double(out.vq.totalBytes())) + "x)" : "") << ".";
+    if (out.bc5AtVqMemoryWidth > 0)
+      md << " BC5 within the VQ's memory affords " << out.bc5AtVqMemoryWidth << "x" << out.bc5AtVqMemoryHeight
+         << " maps (" << f2(double(out.bc5AtVqMemoryBytes) / 1048576.0) << " MiB): the equal-memory row above.";
+    md << "\n\n";
   }
   md << "## Worst held-out poses\n\n| pose | mean mm | max mm | truncation mm | normal deg | gallery |\n|---|---|---|---|---|---|\n";
   std::filesystem::create_directories(dir / "gallery");

@@ -118,6 +118,14 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       for (const NormalMapImage* m : out.databaseMaps) bc5Acc.addMaps(*m, bc5RoundTrip(*m));
       out.bc5VsUncompressed = bc5Acc.stats();
       out.bc5Bytes = uint64_t(db.mapCount()) * bc5Bytes(db.width, db.height);
+      const auto [w, h] = bc5SizeWithin(db.width, db.height, size_t(out.vq.totalBytes() / std::max<size_t>(1, db.mapCount())));
+      if (w > 0) {
+        AngularErrorAccumulator equalAcc;
+        for (const NormalMapImage* m : out.databaseMaps) equalAcc.addMaps(*m, bc5RoundTripResized(*m, w, h));
+        out.bc5AtVqMemoryVsUncompressed = equalAcc.stats();
+        out.bc5AtVqMemoryWidth = w, out.bc5AtVqMemoryHeight = h;
+        out.bc5AtVqMemoryBytes = uint64_t(db.mapCount()) * bc5Bytes(w, h);
+      }
       stage("BC5 baseline");
     }
   }
@@ -188,6 +196,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     out.metadata["errors"]["normal_vq_added"] = toJson(ev.normalVqAdded);
     out.metadata["errors"]["vq_vs_uncompressed"] = toJson(out.vqVsUncompressed);
     out.metadata["errors"]["bc5_vs_uncompressed"] = toJson(out.bc5VsUncompressed);
+    out.metadata["errors"]["bc5_at_vq_memory_vs_uncompressed"] = toJson(out.bc5AtVqMemoryVsUncompressed);
     out.metadata["memory"] = {{"vq_bytes", out.vq.totalBytes()}, {"bc5_bytes", out.bc5Bytes},
                               {"database_maps", db.mapCount()}, {"codebook_entries", db.codebookSize}};
   }

@@ -50,6 +50,11 @@ struct BakeTrainOutput {
   VqReport vq;
   AngularErrorStats vqVsUncompressed, bc5VsUncompressed;
   uint64_t bc5Bytes = 0, uncompressedBytes = 0;
+  // BC5 at equal memory: the maps at the largest size whose BC5 fits in the VQ database's bytes
+  // (bc5RoundTripResized), sampled back up. 0x0 when no database or no baseline.
+  AngularErrorStats bc5AtVqMemoryVsUncompressed;
+  uint32_t bc5AtVqMemoryWidth = 0, bc5AtVqMemoryHeight = 0;
+  uint64_t bc5AtVqMemoryBytes = 0;
   MlpTrainResult regressor;
   BakeEvaluation evaluation;
   std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
