@@ -13,18 +13,22 @@
 // with the former image form) went from 4.4 to 3.5 ms with the buffers, the copy and the exact
 // dispatch below.
 //
-// One invocation per 4x4 block of one character (a VQ block: maps are multiples of 4): the
-// character's slot and alpha are loaded once for 16 texels, and each block row is ONE texel fetch of
-// decoded texels (R32G32_UINT: 4 texels of 2 snorm8 bytes), ONE texel fetch of prev (R32G32B32A32_UINT:
-// 4 packed texels) and ONE uvec4 store. One invocation per texel measured 2.2x slower on lavapipe,
-// which runs invocations 8 at a time on a CPU core and pays per-lane costs for every buffer load and
-// per invocation for the indexing.
+// One invocation per column of ROWS x 4 texels of one character (ROWS block rows of 4 texels, a
+// multiple of 4: maps are multiples of 4; NormalMapBlendPass picks 16, 8 or 4, the largest dividing the
+// map height): the character's slot and alpha are loaded once for 4 * ROWS texels, and each row is ONE
+// texel fetch of decoded texels (R32G32_UINT: 4 texels of 2 snorm8 bytes), ONE texel fetch of prev
+// (R32G32B32A32_UINT: 4 packed texels) and ONE uvec4 store. One invocation per texel measured 2.2x
+// slower on lavapipe, which runs invocations 8 at a time on a CPU core and pays per-lane costs for
+// every buffer load and per invocation for the indexing and the character's (address) load; 16 rows
+// instead of 4 measured 20-25% faster (bench_replay, 22 characters of 256x256, blend stage, 12
+// alternating runs on a busy machine: fastest frame 2.81 -> 2.12 ms, median 3.16 -> 2.53 ms; 8 rows
+// 2.42 / 2.71 ms).
 //
 // Stores: lavapipe stores lane by lane and word by word, so where the device has shaderInt64 the pass
 // uses normal_map_blend_store64.comp, this code storing each row as two 64-bit words instead of four
 // 32-bit ones (same bits; blend stage 14% faster on lavapipe, bench_replay, 22 characters).
 //
-// The dispatch is (block columns, block rows, characters) with workgroups of ROW_GROUP block columns,
+// The dispatch is (block columns, height / ROWS, characters) with workgroups of ROW_GROUP block columns,
 // a divisor of the block columns that NormalMapBlendPass picks (EXACT), so that no invocation falls
 // outside the map and the shader needs no bounds check: on lavapipe a bounds check (an early return)
 // puts every store under an execution mask, a load, select and store per lane and component instead
@@ -35,6 +39,7 @@
 
 layout(local_size_x_id = 0) in;                  // ROW_GROUP
 layout(constant_id = 1) const bool EXACT = true;  // the dispatch covers the block columns exactly
+layout(constant_id = 2) const uint ROWS = 4u;      // texel rows per invocation (4, 8 or 16)
 layout(push_constant) uniform Push { NormalMapBlendParams p; };
 layout(set = 0, binding = 0) uniform usamplerBuffer prevRows;                 // uvec4[layer][height][width / 4]
 #ifdef SWISH_BLEND_STORE64
@@ -55,12 +60,12 @@ float snorm8(uint byteValue) {
 
 void main() {
   const uint blocksX = p.width / 4u;
-  const uint bx = gl_GlobalInvocationID.x, y0 = gl_GlobalInvocationID.y * 4u;
+  const uint bx = gl_GlobalInvocationID.x, y0 = gl_GlobalInvocationID.y * ROWS;
   const uint character = gl_GlobalInvocationID.z;  // the dispatch has characterCount layers
   if (!EXACT && bx >= blocksX) return;
   const NormalMapBlendCharacter ch = Characters(p.characters).c[character];
   const uint rowsPerMap = p.height * blocksX;  // block rows of 4 texels
-  for (uint r = 0u; r < 4u; ++r) {
+  for (uint r = 0u; r < ROWS; ++r) {
     const uint row = (y0 + r) * blocksX + bx;
     const uvec2 words = texelFetch(decodedRows, int(ch.decodedSlot * rowsPerMap + row)).xy;
     const uint at = character * rowsPerMap + row;

@@ -140,10 +140,11 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
   Rng rng(seed);
   if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
   // 12 .. 4 texels wide: fewer block columns than the pass's smallest exact workgroup (the bounds-checked
-  // form); 64 and 72 wide: 16 and 18 block columns, covered exactly.
+  // form); 64 and 72 wide: 16 and 18 block columns, covered exactly. Heights 4, 8 and 12 run 4 or 8
+  // rows per invocation, 48 runs 16 (NormalMapBlendPass::rowsPerInvocation).
   // Both shaders: 32-bit stores, and 64-bit ones where the device has shaderInt64.
   for (const bool store64 : {false, true})
-  for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}}) {
+  for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}, {8, 48}}) {
     SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + (store64 ? ", 64-bit stores" : ""));
     const gpu::NormalMapBlendPass pass(ctx(), width, store64);
     EXPECT_EQ(pass.exact(), width >= 64);

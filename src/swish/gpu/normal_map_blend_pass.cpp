@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <iterator>
 
 #include "shaders/swish_layouts.h"
 #include "swish/core/error.hpp"
@@ -23,8 +24,10 @@ NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width, bool store6
   for (uint32_t d = std::min(most, blocksX); d >= kMinRowGroup && !exact_; --d)
     if (blocksX % d == 0) rowGroup_ = d, exact_ = true;
   if (!exact_) rowGroup_ = std::min(kFallbackGroup, most);
-  pipeline_ = ComputePipeline(ctx, store64_ ? "normal_map_blend_store64.comp" : "normal_map_blend.comp",
-                              {rowGroup_, exact_ ? 1u : 0u}, sizeof(layout::NormalMapBlendParams), layout_.get());
+  for (size_t i = 0; i < std::size(kRowsPerInvocation); ++i)
+    pipelines_[i] = ComputePipeline(ctx, store64_ ? "normal_map_blend_store64.comp" : "normal_map_blend.comp",
+                                    {rowGroup_, exact_ ? 1u : 0u, kRowsPerInvocation[i]}, sizeof(layout::NormalMapBlendParams),
+                                    layout_.get());
 }
 
 DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const Buffer& prev, const Buffer& out, const Buffer& decoded) const {
@@ -46,8 +49,10 @@ void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, co
   p.height = a.height;
   p.characterCount = a.characterCount;
   p.pad0 = 0;
-  pipeline_.bind(cmd, &p, sizeof(p), binding);
-  vkCmdDispatch(cmd, groupCount(a.width / 4, rowGroup_), a.height / 4, a.characterCount);
+  const uint32_t rows = rowsPerInvocation(a.height);
+  const size_t which = size_t(std::find(std::begin(kRowsPerInvocation), std::end(kRowsPerInvocation), rows) - std::begin(kRowsPerInvocation));
+  pipelines_[which].bind(cmd, &p, sizeof(p), binding);
+  vkCmdDispatch(cmd, groupCount(a.width / 4, rowGroup_), a.height / rows, a.characterCount);
 
   // The blended texels, written by the dispatch, are read by the copy. The images' layers go to
   // TRANSFER_DST_OPTIMAL for the copy (the layout copies ask for) and back to GENERAL; the first barrier

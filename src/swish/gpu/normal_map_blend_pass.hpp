@@ -1,7 +1,8 @@
 #pragma once
 // The normal-map blend pass (shaders/normal_map_blend.comp): the temporal filter's blend of each
 // character's newly selected, decoded map into its normal map, out = mix(prev, decoded, alpha), for all
-// characters in one dispatch, one invocation per 4x4 block of a character, then one copy of the result
+// characters in one dispatch, one invocation per 4-texel column of 16, 8 or 4 rows of a character (the
+// most the map height allows), then one copy of the result
 // into the layers of the characters' RG16_SNORM image array (NormalMapImages), which renderers sample.
 //
 // The blend works on buffers of packed texels (uint32[layer][height][width], snorm16 X | Y << 16: the
@@ -42,6 +43,14 @@ class NormalMapBlendPass {
   // largest there is), so that the dispatch covers each map exactly; else kFallbackGroup with a bounds
   // check in the shader.
   static constexpr uint32_t kMinRowGroup = 16, kMaxRowGroup = 256, kFallbackGroup = 64;
+  // Texel rows per invocation (the shader's ROWS): the largest of these dividing the map height
+  // (normal_map_blend.glsl says why); one pipeline each, made by the constructor.
+  static constexpr uint32_t kRowsPerInvocation[3] = {16, 8, 4};
+  static uint32_t rowsPerInvocation(uint32_t height) {
+    for (uint32_t rows : kRowsPerInvocation)
+      if (height % rows == 0) return rows;
+    return 0;  // not a multiple of 4
+  }
 
   // Bytes of `layers` maps of packed texels (the prev and out buffers).
   static VkDeviceSize texelBytes(uint32_t width, uint32_t height, uint32_t layers) {
@@ -75,7 +84,7 @@ class NormalMapBlendPass {
   uint32_t width_ = 0, rowGroup_ = 0;
   bool exact_ = false, store64_ = false;
   DescriptorLayout layout_;
-  ComputePipeline pipeline_;
+  ComputePipeline pipelines_[3];  // one per kRowsPerInvocation
 };
 
 }  // namespace swish::gpu
