@@ -44,7 +44,7 @@ struct Frames {
 };
 
 Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& positions, uint32_t instances, bool hasUvs,
-              bool twoPass) {
+              bool twoPass, bool store64 = true) {
   const Mesh& g = m.gameMesh;
   const uint32_t n = uint32_t(g.vertexCount());
   const MeshFrameTopology topo = buildFrameTopology(g.triangles, g.positions);
@@ -61,7 +61,7 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
   GuardedOutput tangents(ctx, size_t(instances) * n * 4 * 4, "tangents");
   const uint32_t triangles = uint32_t(g.triangles.rows());
   GuardedOutput terms(ctx, std::max<size_t>(16, gpu::TangentFramesPass::triangleTermsBytes(triangles, instances)), "triangle terms");
-  const gpu::TangentFramesPass pass(ctx);
+  const gpu::TangentFramesPass pass(ctx, store64);
   gpu::DescriptorBinding twoPassBinding;
   if (twoPass) {
     gpu::TangentFramesPass::TwoPassBuffers b;
@@ -158,9 +158,15 @@ TEST_P(TangentFramesConformance, MatchReference) {
     std::printf("%s: max |gpu - reference|: normals %.3g over %zu values\n", gpu == &two ? "two passes" : "one pass",
                 rep.maxAbsError, rep.compared);
   }
-  // Same per-triangle values, same sums in the same order: the two paths agree bit for bit.
+  // Same per-triangle values, same sums in the same order: the two paths agree bit for bit, and the
+  // two-pass kernels storing 32-bit floats agree with those storing 64-bit words (two, where the device
+  // has shaderInt64).
   EXPECT_TRUE(test::matchesReference("two-pass normals", two.normals, one.normals, [](size_t) { return 0.0; }));
   EXPECT_TRUE(test::matchesReference("two-pass tangents", two.tangents, one.tangents, [](size_t) { return 0.0; }));
+  const Frames two32 = runGpu(ctx(), m, pos, GetParam().instances, true, true, false);
+  for (const auto& p : two32.problems) ADD_FAILURE() << p;
+  EXPECT_TRUE(test::matchesReference("two-pass normals, 32-bit stores", two32.normals, one.normals, [](size_t) { return 0.0; }));
+  EXPECT_TRUE(test::matchesReference("two-pass tangents, 32-bit stores", two32.tangents, one.tangents, [](size_t) { return 0.0; }));
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, TangentFramesConformance,

@@ -41,12 +41,14 @@ std::vector<VkDescriptorType> twoPassTypes() {
 }
 }  // namespace
 
-TangentFramesPass::TangentFramesPass(Context& ctx)
-    : twoPassLayout_(ctx, twoPassTypes()),
+TangentFramesPass::TangentFramesPass(Context& ctx, bool store64)
+    : store64_(store64 && ctx.hasShaderInt64()),
+      twoPassLayout_(ctx, twoPassTypes()),
       pipeline_(ctx, "tangent_frames.comp", {kWorkgroupSize}, sizeof(layout::TangentFramesParams)),
-      trianglePipeline_(ctx, "triangle_frames.comp", {kWorkgroupSize}, sizeof(layout::TriangleFramesParams), twoPassLayout_.get()),
-      gatherPipeline_(ctx, "vertex_frames_gather.comp", {kWorkgroupSize}, sizeof(layout::VertexFramesGatherParams),
-                      twoPassLayout_.get()) {}
+      trianglePipeline_(ctx, store64_ ? "triangle_frames_store64.comp" : "triangle_frames.comp", {kWorkgroupSize},
+                        sizeof(layout::TriangleFramesParams), twoPassLayout_.get()),
+      gatherPipeline_(ctx, store64_ ? "vertex_frames_gather_store64.comp" : "vertex_frames_gather.comp", {kWorkgroupSize},
+                      sizeof(layout::VertexFramesGatherParams), twoPassLayout_.get()) {}
 
 DescriptorBinding TangentFramesPass::bindTwoPass(Context& ctx, const TwoPassBuffers& b) const {
   for (const Buffer* p : {b.positions, b.triangleTerms, b.normalOffsets, b.frameTriangles, b.normalsOut, b.tangentsOut})

@@ -72,11 +72,15 @@ class TangentFramesPass {
   static std::vector<uint32_t> frameTriangles(const MeshFrameTopology& topology);
 
   TangentFramesPass() = default;
-  explicit TangentFramesPass(Context& ctx);
+  // The two-pass kernels store 64-bit words where the context has shaderInt64 and store64 is true
+  // (triangle_frames_store64.comp, vertex_frames_gather_store64.comp; same results).
+  explicit TangentFramesPass(Context& ctx, bool store64 = true);
+  bool stores64() const { return store64_; }
   DescriptorBinding bindTwoPass(Context& ctx, const TwoPassBuffers& buffers) const;
   void record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
+  bool store64_ = false;
   DescriptorLayout twoPassLayout_;
   ComputePipeline pipeline_;         // single pass: tangent_frames.comp
   ComputePipeline trianglePipeline_; // two passes: triangle_frames.comp ...
