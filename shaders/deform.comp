@@ -11,7 +11,11 @@
 // what ONE scalar load through a buffer address costs (descriptor_binding.hpp): per instance this pass
 // went from 32 + 48 scalar address loads per vertex to 8 + 12 texel fetches, about 3.5x less time per
 // instance in bench_replay's deform stage. Shared-memory staging of the weights measured 2x slower on
-// lavapipe, whose shared-memory loads and barriers are costly.
+// lavapipe, whose shared-memory loads and barriers are costly, and so did a subgroup broadcast: one
+// weight texel fetched per lane, then subgroupBroadcast(texel, q) for q < K4 (with the bounds check
+// below replaced by a clamp, so that every lane is active) made the stage slower, not faster
+// (bench_replay, 12 alternating runs, fastest frame: 22 characters 3.70 -> 4.91 ms, 1 character
+// 0.90 -> 1.02 ms).
 //
 // Conforms to runtime/reference_pca.cpp (x = mean + sum_k basis_k * w_k, k ascending, starting at the
 // mean) and runtime/reference_skinning.cpp (core/skinning.cpp: B = sum over influences with w != 0 of
