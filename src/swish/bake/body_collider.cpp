@@ -48,16 +48,14 @@ ClosestOnTriangle closestOnTriangle(const Vec3f& p, const Vec3f& a, const Vec3f&
 }  // namespace
 
 BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& what)
-    : restPositions_(body.positions), triangles_(body.triangles), skin_(body.skin), cellSize_(cellSize) {
+    : restPositions_(body.positions), skin_(body.skin), cellSize_(cellSize) {
   body.validate(what);
   if (body.triangleCount() == 0) throw Error(what + ": the collider body has no triangles");
   // One surface point per position: a mesh split at its UV seams (as glTF stores it) is closed only
   // once its seam copies are welded. Unwelded, every seam edge would count as open, its pseudo-normal
   // would be that of one side alone, its part would look open (no winding-number check) and, where the
   // seams run (neck, armpits, the sides), points outside would be answered "inside".
-  const std::vector<uint32_t> weld = weldByPosition(restPositions_);
-  for (Eigen::Index t = 0; t < triangles_.rows(); ++t)
-    for (int k = 0; k < 3; ++k) triangles_(t, k) = weld[triangles_(t, k)];
+  triangles_ = trianglesWeldedByPosition(restPositions_, body.triangles);
   if (!(cellSize > 0.f) || !std::isfinite(cellSize)) throw Error(what + ": collider cell size must be positive");
   // Edge numbering: shared sides get one index, so their pseudo-normal sums both faces.
   std::unordered_map<uint64_t, uint32_t> edgeIndex;

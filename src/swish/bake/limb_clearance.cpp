@@ -43,9 +43,7 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
 
   // Parts of the surface, seam copies welded (a glTF body is split at its UV seams, which are not
   // where its limbs begin); the trunk is the part with the most triangles.
-  const std::vector<uint32_t> weld = weldByPosition(body_.positions);
-  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t)
-    for (int k = 0; k < 3; ++k) body_.triangles(t, k) = weld[body_.triangles(t, k)];
+  body_.triangles = trianglesWeldedByPosition(body_.positions, body_.triangles);
   const std::vector<uint32_t> part = connectedParts(body_.triangles, body_.vertexCount());
   std::vector<size_t> triangleCount(body_.vertexCount(), 0);
   for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t) ++triangleCount[part[body_.triangles(t, 0)]];

@@ -67,6 +67,14 @@ std::vector<uint32_t> weldByPosition(const Points3f& p) {
   return weld;
 }
 
+Triangles trianglesWeldedByPosition(const Points3f& positions, const Triangles& triangles) {
+  const std::vector<uint32_t> weld = weldByPosition(positions);
+  Triangles out = triangles;
+  for (Eigen::Index t = 0; t < out.rows(); ++t)
+    for (int k = 0; k < 3; ++k) out(t, k) = weld[out(t, k)];
+  return out;
+}
+
 std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, size_t n,
                                                          const std::vector<uint32_t>* weld) {
   auto rep = [&](uint32_t v) { return weld ? (*weld)[v] : v; };

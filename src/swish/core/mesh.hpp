@@ -36,6 +36,10 @@ struct Mesh {
 // treat seam-split copies as one surface point (normals, simulation).
 std::vector<uint32_t> weldByPosition(const Points3f& positions);
 
+// The triangles with every corner replaced by its weldByPosition representative: the surface with its
+// seam copies joined (closed where only UV seams split it), over the same vertex array.
+Triangles trianglesWeldedByPosition(const Points3f& positions, const Triangles& triangles);
+
 // Vertex -> incident triangles, in compressed sparse rows. Gathered (never scattered), so that the
 // GPU pass needs no float atomics and the CPU reference sums in the same order.
 struct VertexTriangleAdjacency {
