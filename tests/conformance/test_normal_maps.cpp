@@ -141,7 +141,7 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
   if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
   // 12 .. 4 texels wide: fewer block columns than the pass's smallest exact workgroup (the bounds-checked
   // form); 64 and 72 wide: 16 and 18 block columns, covered exactly. Heights 4, 8 and 12 run 4 or 8
-  // rows per invocation, 48 runs 16 (NormalMapBlendPass::rowsPerInvocation).
+  // rows per invocation, 48 runs 16 (NormalMapBlendPass::kRowsPerInvocation).
   // Both shaders: 32-bit stores, and 64-bit ones where the device has shaderInt64.
   for (const bool store64 : {false, true})
   for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}, {8, 48}}) {

@@ -49,10 +49,10 @@ void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, co
   p.height = a.height;
   p.characterCount = a.characterCount;
   p.pad0 = 0;
-  const uint32_t rows = rowsPerInvocation(a.height);
-  const size_t which = size_t(std::find(std::begin(kRowsPerInvocation), std::end(kRowsPerInvocation), rows) - std::begin(kRowsPerInvocation));
+  size_t which = 0;
+  while (a.height % kRowsPerInvocation[which]) ++which;  // stops at 4 at the latest: checked above
   pipelines_[which].bind(cmd, &p, sizeof(p), binding);
-  vkCmdDispatch(cmd, groupCount(a.width / 4, rowGroup_), a.height / rows, a.characterCount);
+  vkCmdDispatch(cmd, groupCount(a.width / 4, rowGroup_), a.height / kRowsPerInvocation[which], a.characterCount);
 
   // The blended texels, written by the dispatch, are read by the copy. The images' layers go to
   // TRANSFER_DST_OPTIMAL for the copy (the layout copies ask for) and back to GENERAL; the first barrier

@@ -43,14 +43,10 @@ class NormalMapBlendPass {
   // largest there is), so that the dispatch covers each map exactly; else kFallbackGroup with a bounds
   // check in the shader.
   static constexpr uint32_t kMinRowGroup = 16, kMaxRowGroup = 256, kFallbackGroup = 64;
-  // Texel rows per invocation (the shader's ROWS): the largest of these dividing the map height
-  // (normal_map_blend.glsl says why); one pipeline each, made by the constructor.
+  // Texel rows per invocation (the shader's ROWS): the first of these dividing the map height, which
+  // record() checks is a multiple of 4 (normal_map_blend.glsl says why); one pipeline each, made by the
+  // constructor.
   static constexpr uint32_t kRowsPerInvocation[3] = {16, 8, 4};
-  static uint32_t rowsPerInvocation(uint32_t height) {
-    for (uint32_t rows : kRowsPerInvocation)
-      if (height % rows == 0) return rows;
-    return 0;  // not a multiple of 4
-  }
 
   // Bytes of `layers` maps of packed texels (the prev and out buffers).
   static VkDeviceSize texelBytes(uint32_t width, uint32_t height, uint32_t layers) {
