@@ -161,7 +161,9 @@ TEST(ClothBodyCollider, ASurfaceSplitAtUvSeamsIsWeldedClosed) {
     ASSERT_TRUE(hit.found) << "point " << p.transpose();
     EXPECT_NEAR(hit.signedDistance, exact, 2.5e-3f) << "point " << p.transpose();  // tessellation, as above
     // Deep inside answers are confirmed by the winding number, which needs the part closed.
-    if (exact < -0.005f) EXPECT_GT(collider.windingNumber(p, hit.part), 0.5f) << "point " << p.transpose();
+    if (exact < -0.005f) {
+      EXPECT_GT(collider.windingNumber(p, hit.part), 0.5f) << "point " << p.transpose();
+    }
   }
   EXPECT_GT(outsideNearSeam, 50);
 }

@@ -28,6 +28,15 @@ void decodeBc4Block(const squish::u8* block, squish::u8 out[16]) {
   for (int b = 0; b < 6; ++b) bits |= uint64_t(block[2 + b]) << (8 * b);
   for (int t = 0; t < 16; ++t) out[t] = squish::u8(palette[(bits >> (3 * t)) & 7]);
 }
+
+// The map's texel count, after checking it holds two values for each.
+size_t checkedTexels(const NormalMapImage& map) {
+  const size_t texels = size_t(map.width) * map.height;
+  if (texels == 0 || map.xy.size() != texels * 2)
+    throw Error("bc5 baseline: map of " + std::to_string(map.width) + "x" + std::to_string(map.height) +
+                " holds " + std::to_string(map.xy.size()) + " values");
+  return texels;
+}
 }  // namespace
 
 size_t bc5Bytes(uint32_t width, uint32_t height) {
@@ -35,10 +44,7 @@ size_t bc5Bytes(uint32_t width, uint32_t height) {
 }
 
 NormalMapImage bc5RoundTrip(const NormalMapImage& map) {
-  const size_t texels = size_t(map.width) * map.height;
-  if (texels == 0 || map.xy.size() != texels * 2)
-    throw Error("bc5 baseline: map of " + std::to_string(map.width) + "x" + std::to_string(map.height) +
-                " holds " + std::to_string(map.xy.size()) + " values");
+  const size_t texels = checkedTexels(map);
   std::vector<squish::u8> rgba(texels * 4, 0);
   for (size_t t = 0; t < texels; ++t) {
     for (int c = 0; c < 2; ++c) {
@@ -68,11 +74,13 @@ NormalMapImage bc5RoundTrip(const NormalMapImage& map) {
 
 std::pair<uint32_t, uint32_t> bc5SizeWithin(uint32_t width, uint32_t height, size_t bytes) {
   if (width == 0 || height == 0) return {0, 0};
-  // Scale both sides by one factor; each side rounded down to whole 4x4 blocks.
+  // Scale both sides by one factor, each rounded down to whole 4x4 blocks: then (w / 4) (h / 4) 16 <=
+  // scale^2 * bc5Bytes(width, height) = bytes, up to the last-place rounding of the square root, which
+  // the one step back corrects.
   const double scale = std::sqrt(double(bytes) / double(bc5Bytes(width, height)));
   auto side = [&](uint32_t n) { return std::min(n, uint32_t(std::floor(double(n) * scale / 4.0)) * 4u); };
   uint32_t w = side(width), h = side(height);
-  while (w >= 4 && h >= 4 && bc5Bytes(w, h) > bytes) w -= 4, h = std::max(4u, h - 4u);
+  if (w >= 4 && h >= 4 && bc5Bytes(w, h) > bytes) w -= 4, h -= 4;
   return (w >= 4 && h >= 4) ? std::pair{w, h} : std::pair{0u, 0u};
 }
 
@@ -96,10 +104,7 @@ void boxDown(uint32_t n, uint32_t m, In in, Out out) {
 }  // namespace
 
 NormalMapImage bc5RoundTripResized(const NormalMapImage& map, uint32_t width, uint32_t height) {
-  const size_t texels = size_t(map.width) * map.height;
-  if (texels == 0 || map.xy.size() != texels * 2)
-    throw Error("bc5 baseline: map of " + std::to_string(map.width) + "x" + std::to_string(map.height) +
-                " holds " + std::to_string(map.xy.size()) + " values");
+  const size_t texels = checkedTexels(map);
   if (width == 0 || height == 0 || width > map.width || height > map.height)
     throw Error("bc5 baseline: cannot resize a " + std::to_string(map.width) + "x" + std::to_string(map.height) +
                 " map to " + std::to_string(width) + "x" + std::to_string(height));
