@@ -271,6 +271,185 @@ TEST(ClothBodyCollider, ClosestPartsGivesEachPartDeepestFirst) {
 
 namespace {
 
+// A hairpin: a tube 4 cm in radius swept up a leg at x = 0 (0.3 m), over a half-circle bend 5 cm in
+// radius and down a second leg at x = 0.1 m, capped at both ends. ONE connected closed surface, as a
+// glTF body is, whose legs face each other across a 2 cm gap like an arm hanging by a torso. The
+// first leg (and its cap) is skinned to joint 1 (the "arm"), the bend and the second leg to joint 0
+// (the "trunk", which has more triangles).
+constexpr float kPinRadius = 0.04f, kPinBend = 0.05f, kPinLeg = 0.3f;
+constexpr int kPinRows = 12, kPinRing = 24;
+
+// The hairpin's centre line, densely sampled (the test's exact distance), or at its rings' stations.
+std::vector<Vec3f> hairpinPath(int rowsPerPiece, std::vector<Vec3f>* tangents = nullptr) {
+  std::vector<Vec3f> path;
+  auto add = [&](const Vec3f& x, const Vec3f& t) {
+    path.push_back(x);
+    if (tangents) tangents->push_back(t);
+  };
+  for (int k = 0; k <= rowsPerPiece; ++k) add({0.f, kPinLeg * float(k) / float(rowsPerPiece), 0.f}, Vec3f::UnitY());
+  for (int k = 1; k < rowsPerPiece; ++k) {
+    const float a = float(M_PI) * float(k) / float(rowsPerPiece);
+    add({kPinBend - kPinBend * std::cos(a), kPinLeg + kPinBend * std::sin(a), 0.f}, Vec3f(std::sin(a), std::cos(a), 0.f));
+  }
+  for (int k = 0; k <= rowsPerPiece; ++k)
+    add({2.f * kPinBend, kPinLeg * (1.f - float(k) / float(rowsPerPiece)), 0.f}, -Vec3f::UnitY());
+  return path;
+}
+
+Mesh armAndTrunkHairpin() {
+  std::vector<Vec3f> tangents;
+  const std::vector<Vec3f> path = hairpinPath(kPinRows, &tangents);
+  const int rows = int(path.size());
+  Mesh m;
+  m.positions.resize(rows * kPinRing + 2, 3);
+  m.skin.influences = 1;
+  for (int k = 0; k < rows; ++k) {
+    const Vec3f n = tangents[size_t(k)].cross(Vec3f::UnitZ());  // in the plane, towards the gap
+    for (int j = 0; j < kPinRing; ++j) {
+      const float ph = 2.f * float(M_PI) * float(j) / kPinRing;
+      m.positions.row(k * kPinRing + j) = path[size_t(k)] + kPinRadius * (std::cos(ph) * n + std::sin(ph) * Vec3f::UnitZ());
+      m.skin.joints.push_back(k <= kPinRows ? 1 : 0);
+      m.skin.weights.push_back(1.f);
+    }
+  }
+  const uint32_t pole0 = uint32_t(rows * kPinRing), pole1 = pole0 + 1;
+  m.positions.row(pole0) = path.front() - 0.5f * kPinRadius * tangents.front();
+  m.positions.row(pole1) = path.back() + 0.5f * kPinRadius * tangents.back();
+  m.skin.joints.push_back(1), m.skin.joints.push_back(0);
+  m.skin.weights.push_back(1.f), m.skin.weights.push_back(1.f);
+  m.triangles.resize(2 * (rows - 1) * kPinRing + 2 * kPinRing, 3);
+  int t = 0;
+  for (int k = 0; k + 1 < rows; ++k)
+    for (int j = 0; j < kPinRing; ++j) {
+      const uint32_t a = uint32_t(k * kPinRing + j), b = a + kPinRing, c = uint32_t(k * kPinRing + (j + 1) % kPinRing),
+                     d = c + kPinRing;
+      m.triangles.row(t++) << a, b, d;  // outward: tangent x ring direction
+      m.triangles.row(t++) << a, d, c;
+    }
+  for (int j = 0; j < kPinRing; ++j) {
+    const uint32_t a = uint32_t(j), b = uint32_t((j + 1) % kPinRing);
+    m.triangles.row(t++) << pole0, a, b;
+    m.triangles.row(t++) << pole1, uint32_t((rows - 1) * kPinRing) + b, uint32_t((rows - 1) * kPinRing) + a;
+  }
+  return m;
+}
+
+float hairpinSignedDistance(const std::vector<Vec3f>& densePath, const Vec3f& p) {
+  float d = std::numeric_limits<float>::max();
+  for (const Vec3f& x : densePath) d = std::min(d, (p - x).norm());
+  return d - kPinRadius;
+}
+
+}  // namespace
+
+TEST(ClothBodyCollider, AOneSurfaceBodyGetsAPlanePerSkinningRegion) {
+  // A point in the gap is 5 mm from the arm's wall and 15 mm from the trunk's: the one closed part
+  // gives it one plane (the arm's), so cloth pinched there is pushed out of the arm into the trunk.
+  // Split by skinning, the part gives a plane per region, each facing the point from its own wall.
+  const Mesh pin = armAndTrunkHairpin();
+  double volume = 0.0;
+  for (Eigen::Index t = 0; t < pin.triangles.rows(); ++t)
+    volume += double(pin.positions.row(pin.triangles(t, 0)).dot(
+                  pin.positions.row(pin.triangles(t, 1)).cross(pin.positions.row(pin.triangles(t, 2))))) / 6.0;
+  ASSERT_GT(volume, 0.0) << "outward triangles";
+  const std::vector<uint8_t> groups = {0, 1};
+  BodyCollider whole(pin, 0.03f), split(pin, 0.03f, "hairpin", groups);
+  EXPECT_EQ(split.openEdges(), 0u);
+  EXPECT_FALSE(whole.splitsParts());
+  ASSERT_TRUE(split.splitsParts());
+  const Vec3f p(0.045f, 0.15f, 0.f);
+  std::array<BodyCollider::Hit, 3> hits;
+  EXPECT_EQ(whole.closestParts(p, 0.03f, std::span(hits)), 1u);
+  EXPECT_EQ(split.closestParts(p, 0.03f, std::span(hits)), 1u);  // parts are parts: one
+  EXPECT_EQ(whole.closestRegions(p, 0.03f, std::span(hits)), 1u);  // nothing split, nothing more
+  ASSERT_EQ(split.closestRegions(p, 0.03f, std::span(hits)), 2u);
+  EXPECT_EQ(hits[0].part, hits[1].part);
+  EXPECT_NE(hits[0].region, hits[1].region);
+  EXPECT_NEAR(hits[0].signedDistance, 0.005f, 5e-4f);  // the arm's wall
+  EXPECT_NEAR(hits[1].signedDistance, 0.015f, 5e-4f);  // the trunk's
+  EXPECT_GT(hits[0].normal.dot(Vec3f::UnitX()), 0.99f);
+  EXPECT_GT(hits[1].normal.dot(-Vec3f::UnitX()), 0.99f);
+  for (size_t k = 0; k < 2; ++k) EXPECT_NEAR((hits[k].point + hits[k].normal * hits[k].signedDistance - p).norm(), 0.f, 1e-4f);
+  // Were joint 1 most of the part (or all of it), the arm would be the part (a mannequin's arm tube
+  // with a few shoulder triangles), not in it: nothing is split.
+  Mesh mostlyArm = pin;
+  for (uint16_t& j : mostlyArm.skin.joints) j = uint16_t(1 - j);
+  EXPECT_FALSE(BodyCollider(mostlyArm, 0.03f, "hairpin", groups).splitsParts());
+  for (uint16_t& j : mostlyArm.skin.joints) j = 1;
+  EXPECT_FALSE(BodyCollider(mostlyArm, 0.03f, "hairpin", groups).splitsParts());
+}
+
+TEST(ClothBodyCollider, RegionsOfAPointOutsideAreAllOutside) {
+  // A region is an open patch: its closest feature (on its border with the other region) need not be
+  // the part's, and its own pseudo-normal can then call a point outside the body "inside", whose
+  // plane would push the cloth into the body. Around the regions' border (where the arm leg meets the
+  // bend) no point outside is answered inside by any region, a point inside gets the part's answer
+  // alone, and the first answer is always the part's.
+  const Mesh pin = armAndTrunkHairpin();
+  const std::vector<Vec3f> dense = hairpinPath(2000);
+  BodyCollider whole(pin, 0.03f), split(pin, 0.03f, "hairpin", {0, 1});
+  Rng rng(test::testSeed(47));
+  int twoRegions = 0, outside = 0;
+  for (int tested = 0; tested < 600;) {
+    const float z = rng.uniformf(-0.07f, 0.07f), y = rng.uniformf(kPinLeg - 0.06f, kPinLeg + 0.1f),
+                x = rng.uniformf(-0.07f, 0.08f);
+    const Vec3f p(x, y, z);
+    const float exact = hairpinSignedDistance(dense, p);
+    if (std::abs(exact) < 3e-3f || std::abs(exact) > 0.03f) continue;  // the tessellation's own error; reach
+    ++tested;
+    std::array<BodyCollider::Hit, 4> hits;
+    const size_t n = split.closestRegions(p, 0.05f, std::span(hits));
+    ASSERT_GE(n, 1u);
+    const BodyCollider::Hit part = whole.closest(p, 0.05f);
+    EXPECT_NEAR(part.signedDistance, exact, 2.5e-3f) << "point " << p.transpose();
+    EXPECT_EQ(hits[0].signedDistance, part.signedDistance) << "point " << p.transpose();
+    EXPECT_EQ(hits[0].triangle, part.triangle) << "point " << p.transpose();
+    EXPECT_EQ(hits[0].normal, part.normal) << "point " << p.transpose();
+    if (exact < 0.f) {
+      // Inside: pushed out the shortest way, by the part's answer alone.
+      EXPECT_EQ(n, 1u) << "point " << p.transpose();
+      continue;
+    }
+    ++outside;
+    twoRegions += n > 1;
+    for (size_t k = 0; k < n; ++k) EXPECT_GT(hits[k].signedDistance, 0.f) << "point " << p.transpose() << " region " << k;
+  }
+  EXPECT_GT(outside, 200);
+  EXPECT_GT(twoRegions, 100) << "the sample must straddle the regions' border";
+}
+
+TEST(ClothBodyCollider, TheDefaultMannequinIsNotSplitIntoRegions) {
+  // The default character's arms are tubes of their own: the arm groups split none of its parts, so
+  // its contact planes (closestRegions = closestParts), its solver fingerprint and the poses cached
+  // under it are what they were.
+  const Character ch = makeDefaultCharacter();
+  const std::vector<uint8_t> groups = colliderJointGroups(ch.skeleton);
+  ASSERT_EQ(groups.size(), ch.skeleton.size());
+  EXPECT_EQ(groups[size_t(ch.skeleton.find("LeftForeArm"))], 1);
+  EXPECT_EQ(groups[size_t(ch.skeleton.find("RightHand"))], 2);
+  EXPECT_EQ(groups[size_t(ch.skeleton.find("LeftShoulder"))], 0);
+  EXPECT_EQ(groups[size_t(ch.skeleton.find("Spine1"))], 0);
+  const BodyCollider collider(ch.body, 0.024f, "default body", groups);
+  EXPECT_FALSE(collider.splitsParts());
+  const BodyCollider plain(ch.body, 0.024f, "default body");
+  EXPECT_EQ(collider.triangleRegions(), plain.triangleRegions());
+  // The same answers, bit for bit, around the shoulders.
+  Rng rng(test::testSeed(53));
+  for (int i = 0; i < 300; ++i) {
+    const Vec3f p(rng.uniformf(-0.3f, 0.3f), rng.uniformf(1.2f, 1.5f), rng.uniformf(-0.15f, 0.15f));
+    std::array<BodyCollider::Hit, 2> a, b;
+    const size_t na = collider.closestRegions(p, 0.024f, std::span(a)), nb = plain.closestParts(p, 0.024f, std::span(b));
+    ASSERT_EQ(na, nb);
+    for (size_t k = 0; k < na; ++k) {
+      EXPECT_EQ(a[k].signedDistance, b[k].signedDistance);
+      EXPECT_EQ(a[k].normal, b[k].normal);
+      EXPECT_EQ(a[k].part, b[k].part);
+    }
+  }
+}
+
+namespace {
+
 // Winding number of a closed triangle mesh at p, by the textbook sum of solid angles in double
 // precision: the test's own reference, written independently of the collider's.
 double referenceWinding(const Points3f& x, const Triangles& t, const Vec3f& p) {

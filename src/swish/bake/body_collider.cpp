@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <unordered_map>
 
 #include "swish/core/error.hpp"
@@ -47,7 +48,8 @@ ClosestOnTriangle closestOnTriangle(const Vec3f& p, const Vec3f& a, const Vec3f&
 
 }  // namespace
 
-BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& what)
+BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& what,
+                           const std::vector<uint8_t>& jointRegion)
     : restPositions_(body.positions), skin_(body.skin), cellSize_(cellSize) {
   body.validate(what);
   if (body.triangleCount() == 0) throw Error(what + ": the collider body has no triangles");
@@ -88,8 +90,52 @@ BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& 
     partRanges_.push_back({id, i, j, closed});
     i = j;
   }
+  splitRegions(jointRegion);
   positions_ = restPositions_;
   rebuild();
+}
+
+void BodyCollider::splitRegions(const std::vector<uint8_t>& jointRegion) {
+  triangleRegion_ = triangleComponent_;
+  const size_t nt = size_t(triangles_.rows());
+  const int k = skin_.influences;
+  if (jointRegion.empty() || skin_.vertexCount() != size_t(restPositions_.rows()) || k <= 0) return;
+  const size_t groups = size_t(*std::max_element(jointRegion.begin(), jointRegion.end())) + 1;
+  if (groups < 2) return;
+  // Each triangle's joint group: the one holding most of its corners' weights (ties: the lower group).
+  std::vector<uint8_t> group(nt, 0);
+  std::vector<float> sum(groups);
+  for (size_t t = 0; t < nt; ++t) {
+    std::fill(sum.begin(), sum.end(), 0.f);
+    for (int c = 0; c < 3; ++c) {
+      const size_t v = triangles_(Eigen::Index(t), c);
+      for (int i = 0; i < k; ++i) {
+        const uint16_t j = skin_.joints[v * size_t(k) + size_t(i)];
+        sum[j < jointRegion.size() ? jointRegion[j] : 0] += skin_.weights[v * size_t(k) + size_t(i)];
+      }
+    }
+    group[t] = uint8_t(std::max_element(sum.begin(), sum.end()) - sum.begin());
+  }
+  // Triangles per (part, group) and per group. A limb group is split off a part that holds most of
+  // the group's triangles and more trunk (group 0) triangles than the group's: the limb is in the part
+  // but is not the part (a mannequin's arm tube is a part of its own and stays whole, and so does its
+  // torso with the few arm-weighted triangles at its shoulders).
+  std::map<std::pair<uint32_t, uint8_t>, uint32_t> count;
+  std::vector<uint32_t> groupTotal(groups, 0);
+  for (size_t t = 0; t < nt; ++t) ++count[{triangleComponent_[t], group[t]}], ++groupTotal[group[t]];
+  uint32_t next = *std::max_element(triangleComponent_.begin(), triangleComponent_.end()) + 1;
+  std::map<std::pair<uint32_t, uint8_t>, uint32_t> regionOf;
+  for (const auto& [key, n] : count) {
+    if (key.second == 0 || 2 * size_t(n) <= groupTotal[key.second]) continue;
+    const auto trunk = count.find({key.first, uint8_t(0)});
+    if (trunk == count.end() || trunk->second <= n) continue;
+    regionOf[key] = next++;
+  }
+  if (regionOf.empty()) return;
+  splitsParts_ = true;
+  for (size_t t = 0; t < nt; ++t)
+    if (const auto r = regionOf.find({triangleComponent_[t], group[t]}); r != regionOf.end())
+      triangleRegion_[t] = r->second;
 }
 
 void BodyCollider::pose(const std::vector<Mat4f>& skinMatrices) {
@@ -171,6 +217,15 @@ void BodyCollider::rebuild() {
 
 size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart,
                                   int skipPart) const {
+  return closestKeyed(p, maxDistance, out, onlyPart, skipPart, false);
+}
+
+size_t BodyCollider::closestRegions(const Vec3f& p, float maxDistance, std::span<Hit> out) const {
+  return closestKeyed(p, maxDistance, out, -1, -1, splitsParts_);
+}
+
+size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart, int skipPart,
+                                  bool byRegion) const {
   if (out.empty() || !p.allFinite() || !(maxDistance > 0.f)) return 0;
   Eigen::Vector3i a, b;
   for (int k = 0; k < 3; ++k) {
@@ -180,8 +235,9 @@ size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<H
     a[k] = std::clamp(int(std::floor(lo)), 0, gridDims_[k] - 1);
     b[k] = std::clamp(int(std::floor(hi)), 0, gridDims_[k] - 1);
   }
-  // The closest triangle of each part met within the ball (a query meets a handful of parts).
+  // The closest triangle of each part (or region) met within the ball (a query meets a handful).
   struct PartBest {
+    uint32_t key;  // the part, or the region when byRegion
     uint32_t part;
     float distance;
     int tri;
@@ -201,8 +257,9 @@ size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<H
           if (lower > maxDistance) continue;
           const uint32_t part = triangleComponent_[t];
           if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
+          const uint32_t key = byRegion ? triangleRegion_[t] : part;
           size_t slot = 0;
-          while (slot < partCount && parts[slot].part != part) ++slot;
+          while (slot < partCount && parts[slot].key != key) ++slot;
           if (slot < partCount && lower > parts[slot].distance) continue;
           const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
                                                         positions_.row(triangles_(t, 1)),
@@ -216,46 +273,83 @@ size_t BodyCollider::closestParts(const Vec3f& p, float maxDistance, std::span<H
               for (size_t k = 1; k < partCount; ++k)
                 if (parts[k].distance > parts[worst].distance) worst = k;
               if (!(d < parts[worst].distance)) continue;
-              parts[worst] = {part, d, int(t), q};
+              parts[worst] = {key, part, d, int(t), q};
               continue;
             }
-            parts[partCount++] = {part, d, int(t), q};
+            parts[partCount++] = {key, part, d, int(t), q};
             continue;
           }
           // Ties (a triangle seen from two cells, or two triangles sharing the closest feature) keep
           // the lowest triangle index, so the answer does not depend on the visiting order.
           PartBest& pb = parts[slot];
-          if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {part, d, int(t), q};
+          if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {key, part, d, int(t), q};
         }
       }
-  // Each part's signed distance from its own closest feature's pseudo-normal.
+  // Each part's signed distance from its own closest feature's pseudo-normal. A region of a split part
+  // is an open patch, its closest feature not always the part's: a point outside the part (by the
+  // part's closest region, confirmed as ever) is outside each of its patches; a point inside it is
+  // answered by the part's closest region alone, pushed out of the body the shortest way as by an
+  // unsplit part (planes of both walls of a pinch that skinning closed, or made pass through each
+  // other, would push it back and forth between them and tear the cloth).
   std::array<Hit, kMaxParts> hits;
+  std::array<float, kMaxParts> signs;
+  std::array<bool, kMaxParts> keep;
+  keep.fill(true);
+  auto pseudoNormal = [&](const PartBest& pb) -> Vec3f {
+    switch (pb.point.feature) {
+      case Feature::Face: return faceNormals_[size_t(pb.tri)];
+      case Feature::Vertex: return vertexNormals_[triangles_(pb.tri, pb.point.index)];
+      default: return edgeNormals_[triangleEdges_[size_t(pb.tri) * 3 + pb.point.index]];
+    }
+  };
+  for (size_t k = 0; k < partCount; ++k) {
+    const Vec3f diff = p - parts[k].point.point, pseudo = pseudoNormal(parts[k]);
+    signs[k] = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
+  }
   for (size_t k = 0; k < partCount; ++k) {
     const PartBest& pb = parts[k];
-    Vec3f pseudo;
-    switch (pb.point.feature) {
-      case Feature::Face: pseudo = faceNormals_[size_t(pb.tri)]; break;
-      case Feature::Vertex: pseudo = vertexNormals_[triangles_(pb.tri, pb.point.index)]; break;
-      default: pseudo = edgeNormals_[triangleEdges_[size_t(pb.tri) * 3 + pb.point.index]]; break;
+    // The part's closest region (the slot itself, unless the part is split): nearest, then lowest
+    // triangle, as closestParts picks the part's closest triangle.
+    size_t nearest = k;
+    for (size_t i = 0; i < partCount; ++i) {
+      const PartBest& q = parts[i];
+      if (q.part == pb.part && (q.distance < parts[nearest].distance ||
+                                (q.distance == parts[nearest].distance && q.tri < parts[nearest].tri)))
+        nearest = i;
     }
-    const Vec3f diff = p - pb.point.point;
-    float sign = diff.dot(pseudo) >= 0.f ? 1.f : -1.f;
+    if (nearest != k) continue;
     // Deep inside by the pseudo-normal: confirm with the winding number (the header says why).
-    if (sign < 0.f && pb.distance > kWindingCheckDepth && windingNumber(p, int(pb.part)) < 0.5f) sign = 1.f;
-    Hit& h = hits[k];
+    if (signs[k] < 0.f && pb.distance > kWindingCheckDepth && windingNumber(p, int(pb.part)) < 0.5f) signs[k] = 1.f;
+    for (size_t i = 0; i < partCount; ++i)
+      if (i != k && parts[i].part == pb.part) {
+        if (signs[k] > 0.f) signs[i] = 1.f;
+        else keep[i] = false;
+      }
+  }
+  size_t kept = 0;
+  for (size_t k = 0; k < partCount; ++k) {
+    if (!keep[k]) continue;
+    const PartBest& pb = parts[k];
+    const Vec3f diff = p - pb.point.point;
+    const float sign = signs[k];
+    Hit& h = hits[kept++];
     h.found = true;
     h.signedDistance = sign * pb.distance;
     h.point = pb.point.point;
     h.triangle = pb.tri;
     h.part = int(pb.part);
-    h.normal = pb.distance > 1e-7f ? Vec3f(sign * diff / pb.distance) : pseudo;
+    h.region = int(pb.key);
+    h.normal = pb.distance > 1e-7f ? Vec3f(sign * diff / pb.distance) : pseudoNormal(pb);
   }
-  // Smallest signed distance first (ties: the lower part id, deterministic).
-  const size_t n = std::min(partCount, out.size());
-  std::partial_sort(hits.begin(), hits.begin() + std::ptrdiff_t(n), hits.begin() + std::ptrdiff_t(partCount),
+  // Smallest signed distance first (ties: the lower part id, then, between regions of a part, the
+  // lower triangle as the part's own closest feature is chosen: deterministic, and the first answer is
+  // the part's).
+  const size_t n = std::min(kept, out.size());
+  std::partial_sort(hits.begin(), hits.begin() + std::ptrdiff_t(n), hits.begin() + std::ptrdiff_t(kept),
                     [](const Hit& x, const Hit& y) {
                       return x.signedDistance < y.signedDistance ||
-                             (x.signedDistance == y.signedDistance && x.part < y.part);
+                             (x.signedDistance == y.signedDistance &&
+                              (x.part < y.part || (x.part == y.part && x.triangle < y.triangle)));
                     });
   std::copy_n(hits.begin(), n, out.begin());
   return n;

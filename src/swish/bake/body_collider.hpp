@@ -17,6 +17,19 @@
 // closest feature in the fold, facing away: "inside" by centimetres. So an inside answer deeper than
 // kWindingCheckDepth from a closed part is confirmed by that part's winding number (robust to
 // self-intersection) and turned to outside when the winding number says so.
+//
+// A body modelled as ONE closed surface (a glTF character: arms and torso one mesh) has one part where
+// a mannequin has an arm tube and a torso: in its armpit the closest surface of the part is the arm or
+// the torso, never both, and cloth trapped between them is pushed out of one into the other. So such a
+// part is split into contact regions by skinning: each triangle goes with the joint group (`jointRegion`,
+// e.g. the left arm chain, the right one, the rest) that holds most of its vertices' weights, and
+// closestRegions answers per region. A part is split only where a joint group's triangles do not make
+// a part of their own (more than half of that group's triangles lie in the part): a mannequin whose
+// arms are separate tubes keeps one region per part, and the very answers of closestParts. A region
+// is an open patch whose own pseudo-normals cannot tell inside from outside: the part's closest
+// region (which holds the part's closest feature, confirmed by the part's winding number) decides. A
+// point outside the part gets every region within reach, all outside; a point inside it gets the
+// part's answer alone, as from an unsplit part.
 #include <span>
 #include <string>
 #include <vector>
@@ -34,14 +47,18 @@ class BodyCollider {
     Vec3f normal = Vec3f::Zero();  // unit, pointing out of the body at `point`
     int triangle = -1;  // the body triangle `point` lies on
     int part = -1;      // the connected part that triangle belongs to
+    int region = -1;    // its contact region (closestRegions): the part's id unless the part is split
   };
 
   // Inside answers deeper than this (metres) are confirmed by the winding number (see above).
   static constexpr float kWindingCheckDepth = 0.002f;
 
   // `body`: rest positions, triangles, skin weights (validated, naming `what`). `cellSize`: grid
-  // spacing in metres, best about the usual search distance.
-  BodyCollider(const Mesh& body, float cellSize, const std::string& what = "body");
+  // spacing in metres, best about the usual search distance. `jointRegion`: a joint group per joint of
+  // the skin (0: the trunk, others: limbs to split off a part that holds them, see above); empty or
+  // all 0 splits nothing.
+  BodyCollider(const Mesh& body, float cellSize, const std::string& what = "body",
+               const std::vector<uint8_t>& jointRegion = {});
 
   // Poses the body by linear blend skinning and rebuilds normals and the grid.
   void pose(const std::vector<Mat4f>& skinMatrices);
@@ -58,6 +75,17 @@ class BodyCollider {
   size_t closestParts(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart = -1,
                       int skipPart = -1) const;
 
+  // As closestParts, per contact region: a part split by skinning (see above) that p is outside of
+  // answers once per region within reach, so a point in an armpit gets the arm and the torso of a
+  // one-surface body. The first answer is always closestParts'; identical to closestParts where no
+  // part is split.
+  size_t closestRegions(const Vec3f& p, float maxDistance, std::span<Hit> out) const;
+
+  // Contact region of each (welded) triangle; the part's id where the part is not split.
+  const std::vector<uint32_t>& triangleRegions() const { return triangleRegion_; }
+  // Whether some part is split into regions (else closestRegions is closestParts).
+  bool splitsParts() const { return splitsParts_; }
+
   // Edges not shared by exactly two triangles (seam copies welded): 0 for a closed surface, the only
   // kind whose inside the signed distance tells reliably.
   size_t openEdges() const { return openEdges_; }
@@ -72,6 +100,9 @@ class BodyCollider {
 
  private:
   void rebuild();
+  void splitRegions(const std::vector<uint8_t>& jointRegion);
+  size_t closestKeyed(const Vec3f& p, float maxDistance, std::span<Hit> out, int onlyPart, int skipPart,
+                      bool byRegion) const;
 
   Points3f restPositions_;
   Triangles triangles_;
@@ -79,6 +110,8 @@ class BodyCollider {
   std::vector<uint32_t> triangleEdges_;  // 3 per triangle: edge index of sides ab, bc, ca
   std::vector<std::array<int32_t, 2>> edgeTriangles_;  // up to two triangles per edge (-1: none)
   std::vector<uint32_t> triangleComponent_;  // connected part (by shared vertices) of each triangle
+  std::vector<uint32_t> triangleRegion_;     // contact region of each triangle (see closestRegions)
+  bool splitsParts_ = false;
   // Each part's triangles (partTriangles_[begin, end)), and whether the part is closed (every edge
   // shared by two of its triangles): only a closed part has a winding number to trust.
   struct PartRange {

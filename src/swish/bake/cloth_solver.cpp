@@ -29,7 +29,8 @@ constexpr float kLimbClearance = 0.05f;
 constexpr float kBandSoftening = 0.05f;
 // An edge this many times failStrain stretched is a runaway solve on its own, however few share it.
 constexpr float kRunawayFactor = 5.f;
-// Contact planes kept per cloth vertex: one per body part, the deepest first (see closestParts).
+// Contact planes kept per cloth vertex: one per body part (or contact region of a one-surface body),
+// the deepest first (see closestParts, closestRegions).
 constexpr size_t kContactPlanes = 2;
 using V3 = Eigen::Map<Vec3f>;
 
@@ -59,6 +60,21 @@ Mesh shiftedBody(const Character& ch, const Vec3f& origin) {
 }
 
 }  // namespace
+
+std::vector<uint8_t> colliderJointGroups(const Skeleton& sk) {
+  std::vector<uint8_t> group(sk.size(), 0);
+  auto endsWith = [](const std::string& s, const char* tail) {
+    const size_t n = std::strlen(tail);
+    return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
+  };
+  for (size_t j = 0; j < sk.size(); ++j)
+    for (int a = int(j), guard = 0; a >= 0 && guard <= int(sk.size()); a = sk.joints[size_t(a)].parent, ++guard) {
+      const std::string& name = sk.joints[size_t(a)].name;
+      if (endsWith(name, "LeftArm")) { group[j] = 1; break; }
+      if (endsWith(name, "RightArm")) { group[j] = 2; break; }
+    }
+  return group;
+}
 
 void ClothSimSettings::validate() const {
   validateClothMaterial(material);
@@ -91,7 +107,7 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
       settings_((settings.validate(), std::move(settings))),
       origin_(garmentCentre(mesh_)),
       colliderPrototype_(shiftedBody(ch, origin_), settings_.thickness + settings_.contactMargin,
-                         "body of character '" + ch.name + "'") {
+                         "body of character '" + ch.name + "'", colliderJointGroups(ch.skeleton)) {
   skeleton_.validate("skeleton of character '" + ch.name + "'");
   if (skeleton_.inverseBind.empty()) skeleton_.computeInverseBindFromRest();
   const std::string what = "simulation mesh of character '" + ch.name + "'";
@@ -194,6 +210,7 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   //    the share of over-stretched edges.
   // 4: two contact planes per vertex (one per body part), band attachment softened next to the limbs.
   // 5: the collider confirms deep "inside" answers by the part's winding number (folded elbows).
+  // (6, hashed below only for a body split into contact regions: contact planes per region.)
   f.value(uint32_t(5));
   f.matrix(mesh_.restPositions);
   f.matrix(mesh_.triangles);
@@ -203,6 +220,12 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   // The collider's triangles, welded at the seams (body_collider.cpp): a body whose seam copies
   // weld (a glTF body) gets a new fingerprint, one without seams (the default mannequin) keeps its own.
   f.matrix(colliderPrototype_.triangles());
+  // Contact regions (a body split by skinning): hashed only where some part is split, so that a body
+  // that is not (the default mannequin) keeps its fingerprint and its cached poses.
+  if (colliderPrototype_.splitsParts()) {
+    f.value(uint32_t(6));
+    f.vec(colliderPrototype_.triangleRegions());
+  }
   f.vec(ch.body.skin.joints);
   f.vec(ch.body.skin.weights);
   for (const Joint& j : skeleton_.joints) {
@@ -335,8 +358,11 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     // vertex settles in the crease. Measured on the 70 poses of the 201-pose default bake that failed
     // with one plane and 8 substeps: with two planes and 12 substeps, 40 of the 44 "ends inside the
     // body" failures go.
+    // A body that is one closed surface (a glTF character) is split into arm and trunk regions
+    // (colliderJointGroups) so that its armpit gets the same two planes; on a mannequin of separate
+    // tubes the regions are its parts.
     for (size_t v = 0; v < nv; ++v)
-      contactCount[v] = uint8_t(body.closestParts(x.row(Eigen::Index(v)), reach, std::span(contacts[v])));
+      contactCount[v] = uint8_t(body.closestRegions(x.row(Eigen::Index(v)), reach, std::span(contacts[v])));
     for (size_t a = 0; a < attached_.size(); ++a) {
       const uint32_t v = attached_[a];
       if (!anchorTarget(anchors_[a], body, attachTarget[a]))  // no body near, or skinning collapsed it

@@ -63,6 +63,12 @@ struct PoseSimulation {
   SimResiduals residuals;
 };
 
+// The collider's joint groups (BodyCollider's jointRegion) for a skeleton: 1 for the left arm chain
+// (the joint whose name ends in "LeftArm", the upper arm in CMU and Mixamo naming, and every joint
+// under it), 2 for the right one, 0 for the rest. A body that is one closed surface is split by them
+// into arm and trunk contact regions, so that cloth in its armpit gets a plane of each.
+std::vector<uint8_t> colliderJointGroups(const Skeleton& skeleton);
+
 class ClothSolver {
  public:
   // Validates the character's body and skeleton against the mesh and prepares constraints, masses,
