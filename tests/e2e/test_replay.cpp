@@ -102,7 +102,12 @@ TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
   EXPECT_EQ(rep["summary"]["frames"], 5);
   EXPECT_EQ(rep["summary"]["checkedFrames"], 3);  // frames 0, 2, 4
   EXPECT_EQ(rep["characters"].size(), 3u);
-  EXPECT_EQ(rep["plan"]["gpuDispatchesPerFrame"], 4);
+  EXPECT_EQ(rep["plan"]["gpuDispatchesPerFrame"], 5);
+  // The plan's count is what the recorder records: all of it on frame 0 (every selected map is new),
+  // never more on a later frame (no VQ decode where the selected maps were decoded before).
+  ASSERT_EQ(rep["frames"].size(), 5u);
+  EXPECT_EQ(rep["frames"][0]["gpuDispatches"], 5);
+  for (const auto& f : rep["frames"]) EXPECT_LE(f["gpuDispatches"].get<int>(), 5) << f["frame"];
   EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxPositionErrorMm"].get<double>(), replay::kPositionToleranceMm);
   EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxMapErrorSteps"].get<int>(), replay::kMapToleranceSteps);
   EXPECT_TRUE(rep["frames"][0]["times"]["gpuDeform"].is_number());
@@ -204,13 +209,16 @@ TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
     o.onCharacterOutput = [&](uint32_t, uint32_t, const runtime::ReferenceFrameOutputs& r, uint32_t i) { out.push_back(r.positions[i]); };
     replay::ReplayEngine engine(s, lib, o);
     *plan = engine.plan();
-    engine.run();
+    const replay::ReplayResult r = engine.run();
+    // What was recorded is what was planned: all of it on frame 0, never more later.
+    EXPECT_EQ(r.frames.front().gpuDispatches, plan->gpuDispatchesPerFrame());
+    for (const auto& f : r.frames) EXPECT_LE(f.gpuDispatches, plan->gpuDispatchesPerFrame()) << f.frame;
     return out;
   };
   runtime::ReplayPlan pFull, pLean;
   const auto a = positions(scene(full), &pFull);
   const auto b = positions(scene(lean), &pLean);
-  EXPECT_EQ(pFull.gpuDispatchesPerFrame(), 4u);
+  EXPECT_EQ(pFull.gpuDispatchesPerFrame(), 5u);
   EXPECT_EQ(pLean.gpuDispatchesPerFrame(), 1u);
   EXPECT_LT(pLean.gpuBytes(), pFull.gpuBytes());
   ASSERT_EQ(a.size(), b.size());

@@ -62,15 +62,15 @@ TEST(Planner, CharactersSharingAModelAreOneBatch) {
   const ReplayPlan shared = planReplay(sceneOf({"a.swish", "a.swish", "a.swish", "a.swish"}), f.models);
   ASSERT_EQ(shared.batches.size(), 1u);
   EXPECT_EQ(shared.batches[0].characters, (std::vector<uint32_t>{0, 1, 2, 3}));
-  // deform, tangents, decode, blend: one dispatch each for all four characters.
-  EXPECT_EQ(shared.gpuDispatchesPerFrame(), 4u);
+  // deform, tangents (triangle terms + gather), decode, blend: the same dispatches for all four characters.
+  EXPECT_EQ(shared.gpuDispatchesPerFrame(), 5u);
   EXPECT_TRUE(mentions(shared, "3 of 4 per-character dispatches"));
   // Two models: two batches, the model without a database has no normal-map passes.
   const ReplayPlan two = planReplay(sceneOf({"a.swish", "b.swish", "a.swish"}), f.models);
   ASSERT_EQ(two.batches.size(), 2u);
   EXPECT_EQ(two.batches[0].characters, (std::vector<uint32_t>{0, 2}));
   EXPECT_FALSE(two.batches[1].normalMaps);
-  EXPECT_EQ(two.gpuDispatchesPerFrame(), 4u + 2u);
+  EXPECT_EQ(two.gpuDispatchesPerFrame(), 5u + 3u);
   EXPECT_TRUE(mentions(two, "the model has no normal-map database"));
 }
 
@@ -81,7 +81,7 @@ TEST(Planner, NoNormalMapOutputDropsLookupDecodeBlendAndTangents) {
   meshesOnly.outputs.render = false;
   meshesOnly.outputs.meshes = true;
   const ReplayPlan a = planReplay(full, f.models), b = planReplay(meshesOnly, f.models);
-  EXPECT_EQ(a.gpuDispatchesPerFrame(), 4u);
+  EXPECT_EQ(a.gpuDispatchesPerFrame(), 5u);
   EXPECT_EQ(b.gpuDispatchesPerFrame(), 1u);
   EXPECT_FALSE(b.batches[0].normalMaps);
   EXPECT_FALSE(b.batches[0].tangentFrames);
@@ -105,7 +105,7 @@ TEST(Planner, NoNormalMapOutputDropsLookupDecodeBlendAndTangents) {
   PlannerOptions naive;
   naive.leaveOut = false;
   const ReplayPlan c = planReplay(meshesOnly, f.models, naive);
-  EXPECT_EQ(c.gpuDispatchesPerFrame(), 4u);
+  EXPECT_EQ(c.gpuDispatchesPerFrame(), 5u);
   EXPECT_EQ(c.gpuBytes(), a.gpuBytes());
   EXPECT_TRUE(c.leftOut.empty());
 }

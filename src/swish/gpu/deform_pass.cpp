@@ -40,8 +40,8 @@ DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& wei
                             BoundResource::texels(skinMatrices, VK_FORMAT_R32G32B32A32_SFLOAT, matricesOffset)});
 }
 
-void DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
-  if (a.vertexCount == 0 || a.instanceCount == 0) return;
+uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
+  if (a.vertexCount == 0 || a.instanceCount == 0) return 0;
   if (!a.instanceInputs) throw Error("deform pass: no instance inputs bound (bindInstanceInputs)");
   layout::DeformParams p;
   p.mean = layout::Address::of(a.mean);
@@ -55,6 +55,7 @@ void DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.pad0 = 0;
   pipeline_.bind(cmd, &p, sizeof(p), a.instanceInputs);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
+  return 1;
 }
 
 }  // namespace swish::gpu

@@ -54,7 +54,8 @@ class DeformPass {
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance).
   DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
                                        VkDeviceSize weightsOffset = 0, VkDeviceSize matricesOffset = 0) const;
-  void record(VkCommandBuffer cmd, const Args& args) const;
+  // Returns the dispatches recorded (1; 0 for an empty input).
+  uint32_t record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
   DescriptorLayout inputsLayout_;

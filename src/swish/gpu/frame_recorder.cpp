@@ -53,7 +53,7 @@ void FrameRecorder::forgetDecodedMaps() {
   for (FrameResources& f : frames_) std::fill(f.slotMap.begin(), f.slotMap.end(), FrameResources::kNoMap);
 }
 
-void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& in) {
+uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& in) {
   const GpuModel& m = *model_;
   if (in.instanceCount > capacity_)
     throw Error("frame recorder: " + std::to_string(in.instanceCount) + " instances, capacity " + std::to_string(capacity_));
@@ -102,7 +102,7 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
   d.vertexCount = m.vertexCount();
   d.instanceCount = in.instanceCount;
   d.jointCount = m.jointCount();
-  deform_.record(cmd, d);
+  uint32_t dispatches = deform_.record(cmd, d);
   f.timestamps.mark(cmd, kAfterDeform);
 
   if (tangentFrames_) {
@@ -115,7 +115,7 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
     t.hasUvs = m.hasUvs();
     t.twoPass = f.tangentFrames.get();
     t.triangleCount = m.triangleCount();
-    tangentFramesPass_.record(cmd, t);
+    dispatches += tangentFramesPass_.record(cmd, t);
     f.timestamps.mark(cmd, kAfterTangentFrames);
   }
 
@@ -157,7 +157,7 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
     v.height = m.mapHeight();
     v.jobCount = f.decodeJobCount;
     v.codebookSize = m.codebookSize();
-    decode_.record(cmd, v);
+    dispatches += decode_.record(cmd, v);
     f.timestamps.mark(cmd, kAfterDecode);
     computeToComputeBarrier(cmd);  // decoded slots written -> read
     NormalMapBlendPass::Args b;
@@ -167,9 +167,10 @@ void FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runti
     b.characterCount = in.instanceCount;
     b.outTexels = f.blendedTexels.handle();
     b.outMaps = f.normalMaps.image();
-    blend_.record(cmd, f.blendBinding.get(), b);
+    dispatches += blend_.record(cmd, f.blendBinding.get(), b);
     f.timestamps.mark(cmd, kAfterBlend);
   }
+  return dispatches;
 }
 
 StageTimes FrameRecorder::stageTimes(uint32_t slot) const {

@@ -52,10 +52,12 @@ class FrameRecorder {
   uint32_t slotOf(uint64_t frameIndex) const { return uint32_t(frameIndex % frames_.size()); }
   const FrameResources& frame(uint32_t slot) const { return frames_.at(slot); }
 
-  // Writes `inputs` into frame frameIndex's slot and records its passes into `cmd` (begun by the caller).
+  // Writes `inputs` into frame frameIndex's slot and records its passes into `cmd` (begun by the caller);
+  // returns the compute dispatches recorded (what the replay planner counts per batch: its "dispatches
+  // per frame" are these, at most; the VQ decode has none on a frame whose maps are all decoded already).
   // The slot's decoded maps are kept for later frames: a caller that throws a recorded command buffer
   // away instead of submitting it calls forgetDecodedMaps() before the next record().
-  void record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& inputs);
+  uint32_t record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& inputs);
   // Every slot's decoded maps are decoded again when next selected.
   void forgetDecodedMaps();
 

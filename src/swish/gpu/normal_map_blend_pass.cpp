@@ -36,8 +36,8 @@ DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const Buffer& pr
                             BoundResource::texels(decoded, VK_FORMAT_R32G32_UINT)});
 }
 
-void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& a) const {
-  if (a.characterCount == 0 || a.width == 0 || a.height == 0) return;
+uint32_t NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& a) const {
+  if (a.characterCount == 0 || a.width == 0 || a.height == 0) return 0;
   if (a.width != width_ || a.height % 4)
     throw Error("normal-map blend: map size " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                 " is not a multiple of 4 or not the pass's width " + std::to_string(width_));
@@ -84,6 +84,7 @@ void NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding, co
   ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   ib.newLayout = VK_IMAGE_LAYOUT_GENERAL;
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &ib);
+  return 1;
 }
 
 }  // namespace swish::gpu

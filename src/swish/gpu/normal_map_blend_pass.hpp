@@ -74,7 +74,8 @@ class NormalMapBlendPass {
   // A descriptor set binding the packed texels `prev` (read), `out` (written) and the decoded slots
   // `decoded` (uint16[slots][height][width], from its start).
   DescriptorBinding makeBinding(Context& ctx, const Buffer& prev, const Buffer& out, const Buffer& decoded) const;
-  void record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& args) const;
+  // Returns the dispatches recorded (1, and the copy; 0 for an empty input).
+  uint32_t record(VkCommandBuffer cmd, VkDescriptorSet binding, const Args& args) const;
 
  private:
   uint32_t width_ = 0, rowGroup_ = 0;

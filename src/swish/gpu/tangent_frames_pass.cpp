@@ -65,8 +65,8 @@ DescriptorBinding TangentFramesPass::bindTwoPass(Context& ctx, const TwoPassBuff
   return DescriptorBinding(ctx, twoPassLayout_, r);
 }
 
-void TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
-  if (a.vertexCount == 0 || a.instanceCount == 0) return;
+uint32_t TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
+  if (a.vertexCount == 0 || a.instanceCount == 0) return 0;
   if (a.twoPass != VK_NULL_HANDLE) {
     if (a.triangleCount > 0) {
       layout::TriangleFramesParams tp;
@@ -87,7 +87,7 @@ void TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
     gp.hasUvs = a.hasUvs ? 1u : 0u;
     gatherPipeline_.bind(cmd, &gp, sizeof(gp), a.twoPass);
     vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), a.instanceCount, 1);
-    return;
+    return a.triangleCount > 0 ? 2 : 1;
   }
   layout::TangentFramesParams p;
   p.positions = layout::Address::of(a.positions);
@@ -105,6 +105,7 @@ void TangentFramesPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.pad0 = 0;
   pipeline_.bind(cmd, &p, sizeof(p));
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), a.instanceCount, 1);
+  return 1;
 }
 
 }  // namespace swish::gpu

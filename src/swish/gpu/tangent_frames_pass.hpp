@@ -77,7 +77,9 @@ class TangentFramesPass {
   explicit TangentFramesPass(Context& ctx, bool store64 = true);
   bool stores64() const { return store64_; }
   DescriptorBinding bindTwoPass(Context& ctx, const TwoPassBuffers& buffers) const;
-  void record(VkCommandBuffer cmd, const Args& args) const;
+  // Returns the dispatches recorded: two-pass, 2 (triangle terms, then the per-vertex gather; 1 for a
+  // mesh without triangles); single-pass, 1; 0 for an empty input.
+  uint32_t record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
   bool store64_ = false;

@@ -32,7 +32,8 @@ class VqDecodePass {
 
   VqDecodePass() = default;
   explicit VqDecodePass(Context& ctx);
-  void record(VkCommandBuffer cmd, const Args& args) const;
+  // Returns the dispatches recorded (1; 0 when there is no job).
+  uint32_t record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
   ComputePipeline pipeline_;

@@ -239,7 +239,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
     auto t0 = Clock::now();
     VkCommandBuffer cmd = ctx->beginOneTime();
     try {
-      for (Batch& B : batches) B.recorder->record(cmd, index, B.inputs);
+      for (Batch& B : batches) rec.gpuDispatches += B.recorder->record(cmd, index, B.inputs);
     } catch (...) {
       ctx->abandonOneTime(cmd);
       throw;

@@ -67,6 +67,7 @@ struct CharacterCheck {
 struct FrameRecord {
   uint32_t frame = 0;
   FrameTimes times;
+  uint32_t gpuDispatches = 0;  // compute dispatches recorded (the plan's gpuDispatchesPerFrame at most)
   bool checked = false;
   std::vector<CharacterCheck> checks;  // when checked
   uint32_t poseIssues = 0;

@@ -1,6 +1,7 @@
 #include "swish/replay/report_writer.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -110,7 +111,7 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
     json t;
     for (const auto& s : stageColumns()) t[s.key] = f.times.*s.field;
     t["cpuTotal"] = f.times.cpuTotal();
-    json fj{{"frame", f.frame}, {"times", t}, {"checked", f.checked}, {"poseIssues", f.poseIssues}};
+    json fj{{"frame", f.frame}, {"times", t}, {"gpuDispatches", f.gpuDispatches}, {"checked", f.checked}, {"poseIssues", f.poseIssues}};
     if (f.truthFrame) {
       fj["truth"] = json::array();
       for (const auto& c : f.truth) {
@@ -199,7 +200,10 @@ std::string reportMarkdown(const json& j) {
         << fmt(num(e["normal_total"]["p95_deg"])) << " deg";
     s << "\n";
   }
-  s << "\n## Plan\n\n" << j["plan"]["gpuDispatchesPerFrame"] << " GPU dispatches per frame, "
+  int fewest = INT_MAX, most = 0;  // dispatches recorded per frame (the VQ decode only for new maps)
+  for (const auto& f : j["frames"]) fewest = std::min(fewest, f["gpuDispatches"].get<int>()), most = std::max(most, f["gpuDispatches"].get<int>());
+  s << "\n## Plan\n\nAt most " << j["plan"]["gpuDispatchesPerFrame"] << " GPU dispatches per frame (recorded: "
+    << (j["frames"].empty() ? std::string("no frames") : std::to_string(fewest) + " to " + std::to_string(most)) << "), "
     << fmt(num(j["plan"]["gpuBytes"]) / 1048576.0, "%.2f") << " MiB of GPU memory, " << j["plan"]["rot6JointsPerFrame"]
     << " joints converted to 6D per frame.\n\nLeft out:\n\n";
   for (const auto& l : j["plan"]["leftOut"]) s << "- " << l["what"].get<std::string>() << " -- because " << l["why"].get<std::string>() << "\n";

@@ -134,12 +134,14 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
                              std::to_string(inst) + " instances x " + std::to_string(n) + " vertices, K = " +
                                  std::to_string(m.meshComponents())});
       if (b.tangentFrames)
-        plan.stages.push_back({"normals + tangents", "GPU", key, 1, inst * n, std::to_string(inst) + " instances"});
+        plan.stages.push_back({"normals + tangents", "GPU", key, 2, inst * n,
+                               "triangle terms, then a per-vertex gather: " + std::to_string(inst) + " instances"});
       if (b.normalMaps) {
         const uint64_t texels = uint64_t(m.normalMaps.width) * m.normalMaps.height;
         plan.stages.push_back({"VQ decode", "GPU", key, 1, b.maxDecodedMaps * texels,
                                "each selected map once: at most " + std::to_string(b.maxDecodedMaps) + " maps of " +
-                                   std::to_string(m.normalMaps.width) + "x" + std::to_string(m.normalMaps.height)});
+                                   std::to_string(m.normalMaps.width) + "x" + std::to_string(m.normalMaps.height) +
+                                   ", none on a frame whose maps earlier frames decoded"});
         plan.stages.push_back({"normal-map blend", "GPU", key, 1, inst * texels, std::to_string(inst) + " maps"});
       }
       for (const auto& a : modelAllocations(m, key, b.normalMaps)) plan.allocations.push_back(a);
@@ -221,12 +223,12 @@ const PlannedBatch* ReplayPlan::batchOf(const std::string& model) const {
 
 std::string ReplayPlan::describe() const {
   std::ostringstream s;
-  s << "Stages per frame (" << gpuDispatchesPerFrame() << " GPU dispatches, " << rot6JointsPerFrame()
+  s << "Stages per frame (at most " << gpuDispatchesPerFrame() << " GPU dispatches, " << rot6JointsPerFrame()
     << " joints to 6D):\n";
   for (const auto& st : stages) {
     s << "  [" << st.device << "] " << st.name;
     if (!st.batch.empty()) s << " <" << st.batch << ">";
-    if (st.device == "GPU") s << ": " << st.dispatchesPerFrame << " dispatch";
+    if (st.device == "GPU") s << ": " << st.dispatchesPerFrame << (st.dispatchesPerFrame == 1 ? " dispatch" : " dispatches");
     s << " -- " << st.detail << "\n";
   }
   if (stages.empty()) s << "  (none)\n";

@@ -47,7 +47,7 @@ struct PlannedStage {
   std::string name;
   std::string device;           // "CPU" or "GPU"
   std::string batch;            // model of the batch ("" for all)
-  uint32_t dispatchesPerFrame = 0;  // GPU dispatches (0 for CPU stages)
+  uint32_t dispatchesPerFrame = 0;  // GPU dispatches at most (0 for CPU stages)
   uint64_t itemsPerFrame = 0;   // characters, joints, vertices or texels processed per frame
   std::string detail;
 };
