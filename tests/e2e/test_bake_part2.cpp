@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "support/error_message.hpp"
 #include "support/random_model.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/bake/bake_pipeline.hpp"
@@ -129,6 +130,44 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     err += (frame.positions[0].row(v) - p.gameMeshWorld.row(v)).norm();
   err = 1000.0 * err / double(frame.positions[0].rows());
   EXPECT_NEAR(err, out.evaluation.perPose[0].meanMm, 1e-3);  // same path, same answer
+}
+
+// train.input_joints: the network reads the joints it names, in that order, instead of the dataset's.
+// The synthetic shape follows Theta of all three dataset joints, so a network given only the third
+// cannot learn it, and one given all three (named in another order) can; unknown or repeated names are
+// errors that say so.
+TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
+  const uint64_t seed = test::testSeed(502);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const Dataset ds = syntheticDataset(seed, 160, 32);
+  BakeTrainSettings st;
+  st.meshComponents = 6;
+  st.normalCodeDims = 0;
+  st.mlp.hiddenLayers = 3;
+  st.mlp.maxEpochs = 400;
+  st.mlp.patience = 80;
+  st.testFraction = 0.1;
+  const auto& joints = ds.character.skeleton.joints;
+  const std::string j0 = joints[ds.inputJoints[0]].name, j1 = joints[ds.inputJoints[1]].name, j2 = joints[ds.inputJoints[2]].name;
+
+  st.inputJoints = {j2, j0, j1};
+  const BakeTrainOutput all = trainBake(ds, st);
+  EXPECT_EQ(all.model.inputJoints, (std::vector<uint32_t>{ds.inputJoints[2], ds.inputJoints[0], ds.inputJoints[1]}));
+  EXPECT_EQ(all.model.thetaSize(), 18);
+  EXPECT_EQ(nlohmann::json::parse(all.model.metadata)["settings"]["input_joints"], nlohmann::json({j2, j0, j1}));
+
+  // The third joint alone drives only the smallest of the three fields (a third of the first's size).
+  st.inputJoints = {j2};
+  const BakeTrainOutput third = trainBake(ds, st);
+  EXPECT_EQ(third.model.inputJoints, (std::vector<uint32_t>{ds.inputJoints[2]}));
+  EXPECT_LT(all.evaluation.regressionMm.mean, 0.5 * third.evaluation.regressionMm.mean)
+      << all.evaluation.regressionMm.mean << " vs " << third.evaluation.regressionMm.mean;
+
+  st.inputJoints = {j0, "NoSuchJoint"};
+  EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("train.input_joints: the character 'synthetic' has no joint 'NoSuchJoint'"),
+            std::string::npos);
+  st.inputJoints = {j0, j1, j0};
+  EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("joint '" + j0 + "' is named twice"), std::string::npos);
 }
 
 TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {

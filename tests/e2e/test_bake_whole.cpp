@@ -15,6 +15,7 @@
 #include <fstream>
 #include <memory>
 
+#include "support/error_message.hpp"
 #include "support/gpu_test.hpp"
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
@@ -164,6 +165,20 @@ TEST(BakeWhole, ReRunRedoesNothing) {
   EXPECT_EQ(again.part1["failed"], w.first.part1["failed"]);
   EXPECT_TRUE(again.part2Skipped);
   EXPECT_EQ(fs::last_write_time(w.first.model), stamp);
+}
+
+// train.input_joints is part 2's, but a joint the character lacks stops the bake before part 1
+// simulates anything: the error names the key and the joint, and no simulation file is written.
+TEST(BakeWhole, AnUnknownNetworkJointStopsTheBakeBeforeAnySimulation) {
+  if (!requireClip()) GTEST_SKIP() << kClip << " is missing (Debian package assimp-testmodels)";
+  const test::TempDir tmp("bake_whole_joints");
+  nlohmann::json j = smallConfig();
+  j["train"]["input_joints"] = {"Spine", "LeftForeArm", "LeftTentacle"};
+  const BakeConfig cfg = parseBakeConfig(j, "whole.json", tmp / "bake");
+  const std::string error = test::errorOf([&] { runBake(cfg); });
+  EXPECT_NE(error.find("train.input_joints: joint 'LeftTentacle' is not in character"), std::string::npos) << error;
+  EXPECT_TRUE(!fs::exists(cfg.simulationDir()) || fs::is_empty(cfg.simulationDir()));
+  EXPECT_FALSE(fs::exists(cfg.modelPath()));
 }
 
 // The baked model on the GPU path (gpu::FrameRecorder) against the CPU reference frame.

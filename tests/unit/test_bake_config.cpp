@@ -31,6 +31,11 @@ TEST(BakeConfig, DefaultsAndPaths) {
   const BakeConfig w = parseBakeConfig({{"output", "out"}, {"train", {{"normal_code_weight", 0.1}}}}, "recipe.json", "/base");
   EXPECT_DOUBLE_EQ(w.train.normalCodeWeight, 0.1);
   EXPECT_DOUBLE_EQ(w.train.toJson()["normal_code_weight"].get<double>(), 0.1);  // what the model's metadata records
+  EXPECT_TRUE(w.train.inputJoints.empty());  // the dataset's (part 1's) joints
+  EXPECT_FALSE(w.train.toJson().contains("input_joints"));
+  const BakeConfig j = parseBakeConfig({{"output", "out"}, {"train", {{"input_joints", {"Spine", "LeftForeArm"}}}}}, "recipe.json", "/base");
+  EXPECT_EQ(j.train.inputJoints, (std::vector<std::string>{"Spine", "LeftForeArm"}));
+  EXPECT_EQ(j.train.toJson()["input_joints"], nlohmann::json({"Spine", "LeftForeArm"}));
 }
 
 TEST(BakeConfig, ErrorsNameTheKey) {
@@ -45,6 +50,8 @@ TEST(BakeConfig, ErrorsNameTheKey) {
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"learning_rate", "fast"}}}}).find("train.learning_rate: must be a number"),
             std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"normal_code_weight", 0}}}}).find("train.normal_code_weight: 0 is outside"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"input_joints", "Spine"}}}}).find("train.input_joints: must be a non-empty array"),
             std::string::npos);
   EXPECT_NE(errorOf({{"name", "../x"}, {"output", "o"}}).find("name"), std::string::npos);
   EXPECT_NE(errorOf({{"name", "x"}}).find("output: is required"), std::string::npos);

@@ -257,7 +257,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
              {"mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
               "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation", "learning_rate",
               "batch_size", "max_epochs", "patience", "validation_fraction", "normal_code_weight", "max_training_seconds", "test_fraction",
-              "temporal_time_constant", "seed", "bc5_baseline"});
+              "temporal_time_constant", "seed", "bc5_baseline", "input_joints"});
   BakeTrainSettings& t = cfg.train;
   const std::string p = "train";
   t.meshComponents = int(c.number(train, p, "mesh_components", 1, 4096, t.meshComponents, true));
@@ -290,6 +290,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   t.testFraction = c.number(train, p, "test_fraction", 0, 0.49, t.testFraction);
   t.temporalTimeConstant = float(c.number(train, p, "temporal_time_constant", 0, 10, t.temporalTimeConstant));
   t.seed = uint64_t(c.number(train, p, "seed", 0, 9.007199254740992e15, double(t.seed), true));
+  t.inputJoints = c.strings(train, p, "input_joints", t.inputJoints);
   if (train.contains("bc5_baseline")) {
     if (!train.at("bc5_baseline").is_boolean()) c.fail("train.bc5_baseline", "must be true or false");
     t.bc5Baseline = train.at("bc5_baseline").get<bool>();

@@ -47,7 +47,9 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   if (cfg.part1) {
     const auto t1 = Clock::now();
     log("part 1: building the dataset " + cfg.dataset.string());
-    const DatasetBuildResult part1 = buildDataset(*cfg.part1, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
+    DatasetBuildSettings part1Settings = *cfg.part1;
+    part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
+    const DatasetBuildResult part1 = buildDataset(part1Settings, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
     res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
     res.part1 = part1.toJson();
     res.part1["seconds"] = res.part1Seconds;

@@ -13,7 +13,7 @@
 namespace swish::bake {
 
 nlohmann::json BakeTrainSettings::toJson() const {
-  return {{"mesh_components", meshComponents},
+  nlohmann::json j = {{"mesh_components", meshComponents},
           {"mesh_variance", meshVariance},
           {"normal_code_dims", normalCodeDims},
           {"database_size", databaseSize},
@@ -33,11 +33,26 @@ nlohmann::json BakeTrainSettings::toJson() const {
           {"test_fraction", testFraction},
           {"temporal_time_constant", temporalTimeConstant},
           {"seed", seed}};
+  if (!inputJoints.empty()) j["input_joints"] = inputJoints;  // absent: the dataset's (older fingerprints stay)
+  return j;
 }
 
 namespace {
 using Clock = std::chrono::steady_clock;
 }  // namespace
+
+std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSettings& st) {
+  if (st.inputJoints.empty()) return ds.inputJoints;
+  std::vector<uint32_t> out;
+  for (const std::string& name : st.inputJoints) {
+    const int j = ds.character.skeleton.find(name);
+    if (j < 0) throw Error("bake: train.input_joints: the character '" + ds.character.name + "' has no joint '" + name + "'");
+    if (std::find(out.begin(), out.end(), uint32_t(j)) != out.end())
+      throw Error("bake: train.input_joints: joint '" + name + "' is named twice");
+    out.push_back(uint32_t(j));
+  }
+  return out;
+}
 
 BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress) {
   auto report = [&](const std::string& s, double f) {
@@ -46,6 +61,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   const size_t poses = ds.poses.size();
   if (poses < 3) throw Error("bake: the dataset has " + std::to_string(poses) + " poses; training needs at least 3");
   if (ds.inputJoints.empty()) throw Error("bake: the dataset names no input joints (Theta)");
+  const std::vector<uint32_t> thetaJoints = networkInputJoints(ds, st);
   const size_t n = ds.character.garment.vertexCount();
   for (const auto& p : ds.poses)
     if (size_t(p.gameMeshPreSkin.rows()) != n || size_t(p.gameMeshWorld.rows()) != n)
@@ -133,9 +149,9 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   // 3. MLP Theta -> Lambda = [mesh weights, normal code].
   report("MLP training", 0.5);
   const int K = out.meshPca.components(), C = maps ? int(normalCodes.rows()) : 0;
-  MatXf theta(Eigen::Index(6 * ds.inputJoints.size()), Eigen::Index(nTrain)), lambda(K + C, Eigen::Index(nTrain));
+  MatXf theta(Eigen::Index(6 * thetaJoints.size()), Eigen::Index(nTrain)), lambda(K + C, Eigen::Index(nTrain));
   for (size_t i = 0; i < nTrain; ++i) {
-    const std::vector<float> th = runtime::computeTheta(ds.inputJoints, ds.poses[out.trainingPoses[i]].pose.local);
+    const std::vector<float> th = runtime::computeTheta(thetaJoints, ds.poses[out.trainingPoses[i]].pose.local);
     theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
   }
   lambda.topRows(K) = meshCodes;
@@ -166,7 +182,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
                   {"poses", {{"training", nTrain}, {"held_out", out.testPoses.size()}}}};
   ModelParts parts;
   parts.character = &ds.character;
-  parts.inputJoints = ds.inputJoints;
+  parts.inputJoints = thetaJoints;
   parts.regressor = &out.regressor;
   parts.meshPca = &out.meshPca;
   parts.normalMaps = db;

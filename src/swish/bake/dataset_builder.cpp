@@ -183,6 +183,9 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     if (j < 0) throw Error("bake part 1: input joint '" + name + "' is not in character '" + character.name + "'");
     inputJoints.push_back(uint32_t(j));
   }
+  for (const std::string& name : s.alsoRequiredJoints)
+    if (character.skeleton.find(name) < 0)
+      throw Error("bake: train.input_joints: joint '" + name + "' is not in character '" + character.name + "'");
   log("part 1: character '" + character.name + "': " + std::to_string(character.skeleton.size()) + " joints, body " +
       std::to_string(character.body.vertexCount()) + " vertices, game mesh " +
       std::to_string(character.garment.vertexCount()) + " vertices");

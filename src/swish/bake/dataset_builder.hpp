@@ -51,6 +51,9 @@ struct DatasetBuildSettings {
 
   std::vector<ClipSource> clips;
   std::vector<std::string> inputJoints = defaultInputJointNames();
+  // Joints a later step reads (part 2's train.input_joints), checked against the character with
+  // inputJoints before any simulation; they do not enter the dataset or its fingerprint.
+  std::vector<std::string> alsoRequiredJoints;
   PoseSamplingOptions sampling;   // .joints is replaced by inputJoints
 
   // Thinning: exactly one of the two is > 0.
