@@ -69,21 +69,27 @@ Dataset syntheticDataset(uint64_t seed, int poses, uint32_t mapSize) {
   }
   return ds;
 }
+
+// Part 2 settings small enough for the synthetic dataset (3 displacement fields, 160 poses).
+BakeTrainSettings smallTraining() {
+  BakeTrainSettings st;
+  st.meshComponents = 6;
+  st.mlp.hiddenLayers = 3;
+  st.mlp.maxEpochs = 400;
+  st.mlp.patience = 80;
+  st.testFraction = 0.1;
+  return st;
+}
 }  // namespace
 
 TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   const uint64_t seed = test::testSeed(501);
   SCOPED_TRACE("seed " + std::to_string(seed));
   const Dataset ds = syntheticDataset(seed, 160, 32);
-  BakeTrainSettings st;
-  st.meshComponents = 6;
+  BakeTrainSettings st = smallTraining();
   st.normalCodeDims = 4;
   st.databaseSize = 24;
   st.vq.codebookSize = 128;
-  st.mlp.hiddenLayers = 3;
-  st.mlp.maxEpochs = 400;
-  st.mlp.patience = 80;
-  st.testFraction = 0.1;
   const BakeTrainOutput out = trainBake(ds, st);
 
   EXPECT_EQ(out.testPoses.size(), 16u);
@@ -140,13 +146,8 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
   const uint64_t seed = test::testSeed(502);
   SCOPED_TRACE("seed " + std::to_string(seed));
   const Dataset ds = syntheticDataset(seed, 160, 32);
-  BakeTrainSettings st;
-  st.meshComponents = 6;
+  BakeTrainSettings st = smallTraining();
   st.normalCodeDims = 0;
-  st.mlp.hiddenLayers = 3;
-  st.mlp.maxEpochs = 400;
-  st.mlp.patience = 80;
-  st.testFraction = 0.1;
   const auto& joints = ds.character.skeleton.joints;
   const std::string j0 = joints[ds.inputJoints[0]].name, j1 = joints[ds.inputJoints[1]].name, j2 = joints[ds.inputJoints[2]].name;
 
