@@ -8,6 +8,7 @@
 #include "swish/bake/default_character.hpp"
 #include "swish/bake/limb_clearance.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/rotation.hpp"
 #include "swish/core/skinning.hpp"
 #include "test_cloth_fixture.hpp"
 
@@ -119,6 +120,7 @@ TEST(LimbClearance, OnePartBodiesAndBadPosesAreLeftAlone) {
   const Character capsule = test::capsuleCharacter();
   const LimbClearance lc(capsule);
   EXPECT_EQ(lc.limbCount(), 0u);
+  EXPECT_FALSE(lc.checksHead());  // no joint named Head
   EXPECT_NE(lc.skipped().find("one connected mesh"), std::string::npos) << lc.skipped();
   // A trunk with a hole has no inside: nothing is checked.
   Character open = mannequin();
@@ -140,4 +142,108 @@ TEST(LimbClearance, OnePartBodiesAndBadPosesAreLeftAlone) {
   LimbClearanceSettings wrong;
   wrong.clearance = -1.f;
   EXPECT_THROW(LimbClearance(mannequin(), wrong), Error);
+}
+
+namespace {
+
+// A one-surface body with a head: the capsule stretched to 1.2 m, its joints renamed Hips, LowerBack,
+// Neck, Head (0.75 m): the top 0.45 m of the tube and its cap are the head, the rest the body.
+struct HeadedCapsule {
+  test::CapsuleSpec spec;
+  Character character;
+  HeadedCapsule() {
+    spec.axisHigh = 1.2f;
+    spec.rows = 48;
+    spec.garmentHigh = 0.6f;
+    character = test::capsuleCharacter(spec);
+    character.skeleton.joints[2].name = "Neck";
+    character.skeleton.joints[3].name = "Head";
+  }
+};
+
+Pose headBowed(const Skeleton& s, float degrees) {
+  Pose p = s.restPose();
+  p.local[3] = Quatf(Eigen::AngleAxisf(degrees * float(M_PI) / 180.f, Vec3f::UnitX()));
+  return p;
+}
+
+// Deepest a head vertex (rest height above 0.81 m: off the blended neck) is inside the body's
+// unblended lower tube (below 0.69 m), analytically.
+float headInsideBody(const HeadedCapsule& h, const Pose& pose) {
+  const Mesh& b = h.character.body;
+  const auto m = h.character.skeleton.skinningMatrices(pose);
+  float worst = 0.f;
+  for (uint32_t v = 0; v < b.vertexCount(); ++v) {
+    const Vec3f x0 = b.positions.row(v);
+    if (x0.y() < 0.81f) continue;
+    const Mat4f k = blendedSkinMatrix(b.skin, v, m);
+    const Vec3f x = k.topLeftCorner<3, 3>() * x0 + k.topRightCorner<3, 1>();
+    if (x.y() > 0.69f || x.y() < 0.f) continue;
+    worst = std::max(worst, h.spec.radius - Vec3f(x.x(), 0.f, x.z()).norm());
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(LimbClearance, OneSurfaceHeadBowedIntoTheBodyIsTurnedBackTowardsRest) {
+  const HeadedCapsule h;
+  const Skeleton& s = h.character.skeleton;
+  const LimbClearance lc(h.character);
+  ASSERT_TRUE(lc.checksHead()) << lc.skipped();
+  EXPECT_TRUE(lc.skipped().empty()) << lc.skipped();
+  EXPECT_EQ(lc.limbCount(), 0u);
+  EXPECT_GT(lc.headVertexCount(), 100u);
+
+  // At rest and slightly bowed the head is clear: untouched.
+  for (float deg : {0.f, 8.f}) {
+    Pose p = headBowed(s, deg);
+    const Pose before = p;
+    EXPECT_TRUE(lc.apply(p).empty()) << deg;
+    for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(p.local[j].coeffs(), before.local[j].coeffs());
+  }
+
+  // Folded down along the body the head is centimetres inside it.
+  const Pose recorded = headBowed(s, 170.f);
+  ASSERT_GT(headInsideBody(h, recorded), 0.03f);
+  Pose p = recorded;
+  const std::vector<LimbCorrection> fixes = lc.apply(p);
+  ASSERT_EQ(fixes.size(), 1u);
+  const LimbCorrection& f = fixes[0];
+  EXPECT_EQ(f.joint, "Head");
+  EXPECT_GT(f.depthBefore, 0.03f);
+  EXPECT_EQ(f.depthAfter, 0.f);
+  EXPECT_GT(f.towardsRest, 0.f);
+  EXPECT_LT(f.towardsRest, 1.f);
+  // The head turned back by that fraction of its 170 degrees, about the same axis.
+  EXPECT_NEAR(f.degrees, 170.f * f.towardsRest, 0.5f);
+  const Eigen::AngleAxisf turned(p.local[3]);
+  EXPECT_NEAR(turned.angle() * 180.f / float(M_PI), 170.f - f.degrees, 0.5f);
+  EXPECT_GT(turned.axis().x(), 0.999f);
+  // Out of the body (measured analytically, 1 mm tolerance), and only the head chain moved.
+  EXPECT_LT(headInsideBody(h, p), 0.0011f);
+  for (size_t j = 0; j < 3; ++j) EXPECT_EQ(p.local[j].coeffs(), recorded.local[j].coeffs()) << s.joints[j].name;
+  // The smallest correction: a percent less leaves the head inside.
+  Pose less = recorded;
+  less.local[3] = slerpShortest(recorded.local[3], s.joints[3].rest.rotation, f.towardsRest - 0.01f);
+  EXPECT_FALSE(lc.apply(less).empty());
+  // Corrected poses need no more; deterministic.
+  Pose again = p;
+  EXPECT_TRUE(lc.apply(again).empty());
+  Pose twice = recorded;
+  lc.apply(twice);
+  for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(twice.local[j].coeffs(), p.local[j].coeffs());
+}
+
+TEST(LimbClearance, BodiesOfPartsNeverGetTheHeadStep) {
+  // The mannequin's head is a part of its own, kept out of the torso by limb clearance: the one-surface
+  // head step (which would change the default bake's simulated poses) is not set up.
+  const LimbClearance lc(mannequin());
+  EXPECT_FALSE(lc.checksHead());
+  EXPECT_EQ(lc.headVertexCount(), 0u);
+  Pose p = mannequin().skeleton.restPose();
+  const int neck = mannequin().skeleton.find("Neck");
+  ASSERT_GE(neck, 0);
+  p.local[size_t(neck)] = Quatf(Eigen::AngleAxisf(1.4f, Vec3f::UnitX()));
+  for (const LimbCorrection& f : lc.apply(p)) EXPECT_EQ(f.towardsRest, 0.f) << f.joint;
 }

@@ -155,6 +155,7 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"kept_poses", keptPoses},       {"rest_pose_added", restPoseAdded},
           {"tolerance", tolerance},
           {"poses_corrected", posesCorrected}, {"max_correction_degrees", maxCorrectionDegrees},
+          {"max_correction_towards_rest", maxTowardsRest},
           {"simulation_vertices", simulationVertices},
           {"simulated", simulated},        {"simulations_reused", simulationsReused},
           {"transferred", transferred},    {"transfers_reused", transfersReused},
@@ -269,6 +270,26 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
                   1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
                   double(res.maxCorrectionDegrees), stillInside, since(t));
     if (clearance.limbCount() > 0) log(line);
+    if (clearance.checksHead()) {
+      for (const auto& c : corrections)
+        for (const LimbCorrection& x : c) res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);
+      std::snprintf(line, sizeof line,
+                    "part 1: head clearance (one-surface body, %zu head vertices checked): %zu of %zu poses had the "
+                    "head inside the body; neck turned back towards rest by up to %.0f %% (%.0f degrees), %zu still "
+                    "inside, in %.2f s",
+                    clearance.headVertexCount(), res.posesCorrected, poses.size(), 100.0 * res.maxTowardsRest,
+                    double(res.maxCorrectionDegrees), stillInside, since(t));
+      log(line);
+      for (size_t i = 0; i < corrections.size(); ++i)
+        for (const LimbCorrection& x : corrections[i]) {
+          std::snprintf(line, sizeof line,
+                        "part 1: head clearance: pose %zu: head %.1f mm inside, neck turned %.0f %% back to rest "
+                        "(%s %.1f degrees), %.1f mm after",
+                        i, 1000.0 * x.depthBefore, 100.0 * x.towardsRest, x.joint.c_str(), double(x.degrees),
+                        1000.0 * x.depthAfter);
+          log(line);
+        }
+    }
     step("limb clearance", t);
   }
 

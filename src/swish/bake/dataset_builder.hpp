@@ -99,8 +99,9 @@ struct DatasetBuildResult {
   size_t samples = 0;              // Theta samples before thinning
   size_t keptPoses = 0;            // after thinning (the rest pose included when it was added)
   bool restPoseAdded = false;      // the rest pose was appended to the thinned poses (its id: keptPoses - 1)
-  size_t posesCorrected = 0;       // poses whose limbs were turned out of the trunk
+  size_t posesCorrected = 0;       // poses whose limbs (or one-surface head) were turned out of the body
   float maxCorrectionDegrees = 0.f;
+  float maxTowardsRest = 0.f;      // head clearance: the largest fraction of the neck turned back to rest
   float tolerance = 0.f;           // the thinning tolerance used
   size_t simulationVertices = 0;
   size_t simulated = 0, simulationsReused = 0;

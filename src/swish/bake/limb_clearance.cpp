@@ -1,11 +1,13 @@
 #include "swish/bake/limb_clearance.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 
 #include "swish/bake/body_collider.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/rotation.hpp"
 #include "swish/core/skinning.hpp"
 
 namespace swish::bake {
@@ -17,6 +19,43 @@ constexpr float kSearch = 0.25f;
 constexpr float kCell = 0.05f;
 // A limb this little inside its clearance is left alone (m).
 constexpr float kTolerance = 0.001f;
+
+// The smallest whole number of steps in [1, most] after which depthAt(steps) <= kTolerance, `before`
+// being the depth at 0: 5-step strides, then bisection; `most` when none clears. `after` gets the depth
+// at the answer, and p (which depthAt sets) is left holding the answer's pose. Shared by the limbs
+// (steps: degrees) and the head (steps: percent of the way back to rest).
+template <class DepthAt>
+int smallestClearing(int most, float before, DepthAt&& depthAt, float& after) {
+  int tried = 0;  // the steps the pose holds
+  auto at = [&](int steps) {
+    tried = steps;
+    return depthAt(steps);
+  };
+  int lo = 0, hi = 0;
+  after = before;
+  while (after > kTolerance && hi < most) {
+    lo = hi;
+    hi = std::min(most, hi + 5);
+    after = at(hi);
+  }
+  while (after <= kTolerance && hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    const float d = at(mid);
+    if (d <= kTolerance) hi = mid, after = d;
+    else lo = mid;
+  }
+  if (tried != hi) after = at(hi);
+  return hi;
+}
+
+bool endsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
 
 int depthOf(const Skeleton& s, int j) {
   int d = 0;
@@ -56,6 +95,7 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   for (size_t i = 0; i < keep.size(); ++i) trunkMesh.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
   if (keep.size() == size_t(body_.triangles.rows())) {
     skipped_ = "the body is one connected mesh: no limbs to keep apart";
+    setUpHead();
     return;
   }
   // Inside and outside need a closed trunk: near the openings of an open one (a torso whose head and
@@ -110,6 +150,10 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
 
 std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   std::vector<LimbCorrection> out;
+  if (head_) {
+    if (std::optional<LimbCorrection> c = applyHead(pose)) out.push_back(*c);
+    return out;
+  }
   if (limbs_.empty() || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return out;
   for (const Quatf& q : pose.local)
     if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
@@ -161,36 +205,155 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
     }
     axis.normalize();
     const Quatf global = g[size_t(j)].rotation, parentInv = g[size_t(parent)].rotation.conjugate();
-    // The smallest whole number of degrees that clears the limb: 5-degree steps, then bisection.
-    int tried = 0;  // the turn p holds
+    // The smallest whole number of degrees that clears the limb.
     auto depthAt = [&](int degrees) {
-      tried = degrees;
       const Quatf turn(Eigen::AngleAxisf(float(degrees) * float(M_PI) / 180.f, axis));
       p.local[size_t(j)] = (parentInv * turn * global).normalized();
       return measure();
     };
-    const int most = int(settings_.maxDegrees);
-    int lo = 0, hi = 0;
     float after = before;
-    while (after > kTolerance && hi < most) {
-      lo = hi;
-      hi = std::min(most, hi + 5);
-      after = depthAt(hi);
-    }
-    while (after <= kTolerance && hi - lo > 1) {
-      const int mid = (lo + hi) / 2;
-      const float d = depthAt(mid);
-      if (d <= kTolerance) hi = mid, after = d;
-      else lo = mid;
-    }
-    const int degrees = hi;
-    if (tried != degrees) after = depthAt(degrees);
+    const int degrees = smallestClearing(int(settings_.maxDegrees), before, depthAt, after);
     pose.local[size_t(j)] = p.local[size_t(j)];
     c.degrees = float(degrees);
     c.depthAfter = after > kTolerance ? after : 0.f;
     out.push_back(c);
   }
   return out;
+}
+
+void LimbClearance::setUpHead() {
+  const std::string what = "body";
+  // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
+  int headJoint = -1;
+  for (int j = 1; j < int(skeleton_.size()); ++j)
+    if (endsWith(lower(skeleton_.joints[size_t(j)].name), "head") &&
+        (headJoint < 0 || depthOf(skeleton_, j) < depthOf(skeleton_, headJoint)))
+      headJoint = j;
+  if (headJoint < 0) {
+    skipped_ += "; no joint named 'Head': the head is not checked either";
+    return;
+  }
+  Head h;
+  h.joint = headJoint;
+  h.chain.push_back(headJoint);
+  for (int a = skeleton_.joints[size_t(headJoint)].parent; a > 0 && lower(skeleton_.joints[size_t(a)].name).find("neck") != std::string::npos;
+       a = skeleton_.joints[size_t(a)].parent)
+    h.chain.push_back(a);
+  std::vector<char> inHead(skeleton_.size(), 0);
+  for (size_t j = 0; j < skeleton_.size(); ++j)
+    for (int a = int(j); a >= 0; a = skeleton_.joints[size_t(a)].parent)
+      if (a == headJoint) {
+        inHead[j] = 1;
+        break;
+      }
+  // Head vertices: dominant skin joint in the head joint's subtree.
+  const int n = body_.skin.influences;
+  std::vector<char> isHead(body_.vertexCount(), 0);
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+    int best = 0;
+    for (int k = 1; k < n; ++k)
+      if (body_.skin.weights[size_t(v) * n + k] > body_.skin.weights[size_t(v) * n + best]) best = k;
+    isHead[v] = inHead[body_.skin.joints[size_t(v) * n + best]];
+  }
+  // The rest of the body: the triangles with fewer than two head vertices.
+  Mesh others = body_;
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t) {
+    const int heads = isHead[body_.triangles(t, 0)] + isHead[body_.triangles(t, 1)] + isHead[body_.triangles(t, 2)];
+    if (heads < 2) keep.push_back(t);
+  }
+  if (keep.size() == size_t(body_.triangles.rows()) || keep.empty()) {
+    skipped_ += "; the head has no triangles of its own: it is not checked";
+    return;
+  }
+  others.triangles.resize(Eigen::Index(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) others.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
+  h.whole.emplace(body_, kCell, what);
+  if (h.whole->openEdges() > 0) {
+    skipped_ += "; the body is not a closed surface (" + std::to_string(h.whole->openEdges()) +
+                " open edges): the head is not checked";
+    return;
+  }
+  h.rest.emplace(others, kCell, what + " (without the head)");
+  const Pose rest = skeleton_.restPose();
+  const std::vector<Mat4f> m = skeleton_.skinningMatrices(rest);
+  BodyCollider restPosed = *h.rest, wholePosed = *h.whole;
+  restPosed.pose(m);
+  wholePosed.pose(m);
+  std::vector<char> used(body_.vertexCount(), 0);
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t)
+    for (int c = 0; c < 3; ++c) used[body_.triangles(t, c)] = 1;
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+    if (!isHead[v] || !used[v]) continue;
+    const Vec3f x = body_.positions.row(v);
+    if (h.vertices.empty()) h.wholePart = wholePosed.closest(x, kCell).part;
+    if (restPosed.closest(x, settings_.headBorder).found) continue;  // near the neck seam or the jaw
+    h.vertices.push_back(v);
+  }
+  if (h.vertices.empty()) {
+    skipped_ += "; no head vertex lies " + std::to_string(settings_.headBorder) + " m from the rest of the body";
+    return;
+  }
+  skipped_.clear();
+  head_ = std::move(h);
+}
+
+std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose) const {
+  const Head& h = *head_;
+  if (pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return std::nullopt;
+  for (const Quatf& q : pose.local)
+    if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return std::nullopt;
+  Pose p = pose;
+  p.local[0] = skeleton_.joints[0].rest.rotation;
+  p.rootTranslation = skeleton_.joints[0].rest.translation;
+  // How far the deepest checked head vertex is inside the rest of the body: the closest of the other
+  // triangles (an open surface: its sign is trusted only where the whole body's winding number
+  // confirms the vertex lies inside another layer of it, 1.5 against 0.5 on the surface alone).
+  auto measure = [&] {
+    const std::vector<Mat4f> m = skeleton_.skinningMatrices(p);
+    BodyCollider others = *h.rest;
+    others.pose(m);
+    std::optional<BodyCollider> whole;
+    float worst = 0.f;
+    for (const uint32_t v : h.vertices) {
+      const Mat4f b = blendedSkinMatrix(body_.skin, v, m);
+      const Vec3f x = b.topLeftCorner<3, 3>() * body_.positions.row(v).transpose() + b.topRightCorner<3, 1>();
+      const BodyCollider::Hit hit = others.closest(x, kSearch);
+      if (!hit.found || !(-hit.signedDistance > std::max(worst, kTolerance))) continue;
+      if (!whole) {
+        whole.emplace(*h.whole);
+        whole->pose(m);
+      }
+      if (whole->windingNumber(x, h.wholePart) < 1.f) continue;
+      worst = -hit.signedDistance;
+    }
+    return worst;
+  };
+  const float before = measure();
+  if (before <= kTolerance) return std::nullopt;
+  const Pose recorded = p;
+  // The head joint in the frame of its chain's parent, to tell how far the head turned.
+  const int top = skeleton_.joints[size_t(h.chain.back())].parent;
+  auto headInChain = [&](const Pose& q) {
+    const std::vector<RigidTransform> g = skeleton_.globalTransforms(q);
+    return Quatf(g[size_t(top)].rotation.conjugate() * g[size_t(h.joint)].rotation);
+  };
+  // The smallest whole percentage of the way back to rest that clears the head.
+  auto depthAt = [&](int percent) {
+    for (int j : h.chain)
+      p.local[size_t(j)] = slerpShortest(recorded.local[size_t(j)], skeleton_.joints[size_t(j)].rest.rotation,
+                                         float(percent) / 100.f)
+                               .normalized();
+    return measure();
+  };
+  float after = before;
+  const int percent = smallestClearing(100, before, depthAt, after);
+  for (int j : h.chain) pose.local[size_t(j)] = p.local[size_t(j)];
+  LimbCorrection c{skeleton_.joints[size_t(h.joint)].name, 0.f, before, after > kTolerance ? after : 0.f,
+                   float(percent) / 100.f};
+  const float dot = std::min(1.f, std::abs(headInChain(recorded).dot(headInChain(p))));
+  c.degrees = 2.f * std::acos(dot) * 180.f / float(M_PI);
+  return c;
 }
 
 }  // namespace swish::bake

@@ -14,8 +14,21 @@
 // root joint is the shallowest joint carrying a tenth of its skin weight. Only limb vertices that lie
 // outside the trunk in the rest pose and farther than rootRadius from the root joint are checked:
 // the root of a tube starts inside the trunk by construction. A body that is one connected mesh has
-// no parts to separate, and a trunk that is not a closed surface has no inside; the poses of either
+// no parts to separate, and a trunk that is not a closed surface has no inside; the limbs of either
 // are left unchanged (skipped() says why).
+//
+// Head clearance. A body that is ONE closed surface (a glTF character) has no limb parts, but its head
+// can still pass into its own chest: a clip that bows the head further than the body's skinning
+// allows puts the skinned chin centimetres inside the chest, and the collar between them has nowhere
+// to be (the shared T-shirt's runaway at the neckline, docs/baking.md). So for such a body the head
+// (vertices whose dominant skin joint is the joint named "Head", or ending in "Head", or below it) is
+// checked against the rest of the body (the other triangles, posed with it): a pose that puts a head
+// vertex inside it by more than the tolerance has its neck chain (that joint and the ancestors named
+// "...Neck...") turned back towards rest, every joint by the same smallest whole percentage of the
+// way (slerp) that leaves no head vertex inside. Head vertices within headBorder of the rest of the
+// body at rest (under the jaw, the neck seam) are not checked: skinning creases them into the neck in
+// ordinary bends. A body of separate parts never gets this step: its head is a part that limb
+// clearance already keeps out of the trunk (the embedded mannequin's is).
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +42,7 @@ struct LimbClearanceSettings {
   float clearance = 0.015f;   // m between a limb and the trunk: room for two layers of cloth
   float rootRadius = 0.10f;   // m: limb vertices this close to their root joint are not checked
   float maxDegrees = 60.f;    // the largest correction; a limb still inside after it is reported
+  float headBorder = 0.03f;   // m: one-surface bodies' head vertices this close to the rest of the body at rest are not checked
 };
 
 struct LimbCorrection {
@@ -36,6 +50,9 @@ struct LimbCorrection {
   float degrees = 0.f;     // by how much
   float depthBefore = 0.f;  // m: how far the limb was inside the clearance before
   float depthAfter = 0.f;   // after (0 when cleared)
+  // Head clearance only (joint: the head joint): the fraction of the way back to rest the neck chain
+  // was turned (0.2: 20 %); `degrees` is then how far that turned the head joint in its chain's frame.
+  float towardsRest = 0.f;
 };
 
 class LimbClearance {
@@ -50,6 +67,9 @@ class LimbClearance {
   size_t limbCount() const { return limbs_.size(); }
   // Why no limb is checked (empty when some are).
   const std::string& skipped() const { return skipped_; }
+  // Whether the head of a one-surface body is checked (see above), and how many of its vertices.
+  bool checksHead() const { return head_.has_value(); }
+  size_t headVertexCount() const { return head_ ? head_->vertices.size() : 0; }
 
  private:
   struct Limb {
@@ -63,6 +83,18 @@ class LimbClearance {
   LimbClearanceSettings settings_;
   std::vector<Limb> limbs_;
   std::string skipped_;
+
+  struct Head {
+    int joint = -1;               // the head joint
+    std::vector<int> chain;       // the joints turned back to rest: the head joint and its neck ancestors
+    std::vector<uint32_t> vertices;  // checked head vertices
+    std::optional<BodyCollider> rest;   // the body without the head's triangles, unposed
+    std::optional<BodyCollider> whole;  // the whole closed body, unposed: its winding number confirms inside
+    int wholePart = 0;
+  };
+  std::optional<Head> head_;
+  void setUpHead();
+  std::optional<LimbCorrection> applyHead(Pose& pose) const;
 };
 
 }  // namespace swish::bake
