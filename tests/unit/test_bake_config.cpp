@@ -2,9 +2,13 @@
 // name the key; defaults fill what is absent; paths resolve against the config's folder.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "support/error_message.hpp"
+#include "support/paths.hpp"
 #include "swish/bake/bake_config.hpp"
 #include "swish/core/error.hpp"
+#include "swish/model/model_file.hpp"
 
 using namespace swish;
 using namespace swish::bake;
@@ -153,4 +157,25 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
 
 TEST(BakeConfig, MissingFileIsAClearError) {
   EXPECT_THROW(loadBakeConfig("/nonexistent/recipe.json"), Error);
+}
+
+// The committed default model is what its committed recipe makes: the part 2 settings the model's
+// metadata records (and its input joints) are the recipe's. Editing assets/default/bake.json without
+// re-baking fails here, not silently at the next `swish bake` (which would re-train).
+TEST(BakeConfig, CommittedDefaultModelMatchesItsRecipe) {
+  const std::filesystem::path recipe = test::sourceDir() / "assets/default/bake.json";
+  BakeConfig cfg;
+  try {
+    cfg = loadBakeConfig(recipe);
+  } catch (const Error& e) {
+    // The recipe names the Debian CMU clips, which must exist for it to load.
+    GTEST_SKIP() << "the default recipe does not load here (" << e.what() << "); assimp-testmodels missing?";
+  }
+  const Model m = loadModel(cfg.modelPath());
+  const nlohmann::json meta = nlohmann::json::parse(m.metadata);
+  EXPECT_EQ(meta.at("settings"), cfg.train.toJson());
+  std::vector<std::string> names;
+  for (uint32_t j : m.inputJoints) names.push_back(m.skeleton.joints.at(j).name);
+  EXPECT_EQ(names, cfg.train.inputJoints.empty() ? cfg.part1->inputJoints : cfg.train.inputJoints);
+  EXPECT_EQ(m.mlp.inputSize(), 6 * int(names.size()));
 }
