@@ -63,15 +63,11 @@ Mesh shiftedBody(const Character& ch, const Vec3f& origin) {
 
 std::vector<uint8_t> colliderJointGroups(const Skeleton& sk) {
   std::vector<uint8_t> group(sk.size(), 0);
-  auto endsWith = [](const std::string& s, const char* tail) {
-    const size_t n = std::strlen(tail);
-    return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
-  };
   for (size_t j = 0; j < sk.size(); ++j)
     for (int a = int(j), guard = 0; a >= 0 && guard <= int(sk.size()); a = sk.joints[size_t(a)].parent, ++guard) {
       const std::string& name = sk.joints[size_t(a)].name;
-      if (endsWith(name, "LeftArm")) { group[j] = 1; break; }
-      if (endsWith(name, "RightArm")) { group[j] = 2; break; }
+      if (name.ends_with("LeftArm")) { group[j] = 1; break; }
+      if (name.ends_with("RightArm")) { group[j] = 2; break; }
     }
   return group;
 }

@@ -1,7 +1,6 @@
 #include "swish/bake/limb_clearance.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <limits>
 
@@ -9,6 +8,7 @@
 #include "swish/core/error.hpp"
 #include "swish/core/rotation.hpp"
 #include "swish/core/skinning.hpp"
+#include "swish/io/joint_map.hpp"
 
 namespace swish::bake {
 namespace {
@@ -46,15 +46,6 @@ int smallestClearing(int most, float before, DepthAt&& depthAt, float& after) {
   }
   if (tried != hi) after = at(hi);
   return hi;
-}
-
-bool endsWith(const std::string& s, const std::string& tail) {
-  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 int depthOf(const Skeleton& s, int j) {
@@ -226,7 +217,7 @@ void LimbClearance::setUpHead() {
   // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
   int headJoint = -1;
   for (int j = 1; j < int(skeleton_.size()); ++j)
-    if (endsWith(lower(skeleton_.joints[size_t(j)].name), "head") &&
+    if (io::normaliseJointName(skeleton_.joints[size_t(j)].name).ends_with("head") &&
         (headJoint < 0 || depthOf(skeleton_, j) < depthOf(skeleton_, headJoint)))
       headJoint = j;
   if (headJoint < 0) {
@@ -236,7 +227,8 @@ void LimbClearance::setUpHead() {
   Head h;
   h.joint = headJoint;
   h.chain.push_back(headJoint);
-  for (int a = skeleton_.joints[size_t(headJoint)].parent; a > 0 && lower(skeleton_.joints[size_t(a)].name).find("neck") != std::string::npos;
+  for (int a = skeleton_.joints[size_t(headJoint)].parent;
+       a > 0 && io::normaliseJointName(skeleton_.joints[size_t(a)].name).find("neck") != std::string::npos;
        a = skeleton_.joints[size_t(a)].parent)
     h.chain.push_back(a);
   std::vector<char> inHead(skeleton_.size(), 0);

@@ -21,7 +21,8 @@
 // can still pass into its own chest: a clip that bows the head further than the body's skinning
 // allows puts the skinned chin centimetres inside the chest, and the collar between them has nowhere
 // to be (the shared T-shirt's runaway at the neckline, docs/baking.md). So for such a body the head
-// (vertices whose dominant skin joint is the joint named "Head", or ending in "Head", or below it) is
+// (vertices whose dominant skin joint is the joint named "Head", or ending in "Head", or below it;
+// names compared as the importer compares them, io::normaliseJointName) is
 // checked against the rest of the body (the other triangles, posed with it): a pose that puts a head
 // vertex inside it by more than the tolerance has its neck chain (that joint and the ancestors named
 // "...Neck...") turned back towards rest, every joint by the same smallest whole percentage of the
