@@ -141,17 +141,17 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
 
 std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   std::vector<LimbCorrection> out;
-  if (head_) {
-    if (std::optional<LimbCorrection> c = applyHead(pose)) out.push_back(*c);
-    return out;
-  }
-  if (limbs_.empty() || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return out;
+  if ((limbs_.empty() && !head_) || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return out;
   for (const Quatf& q : pose.local)
     if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
   // Measured with the root at rest, as the solver simulates it (the shape ignores the root).
   Pose p = pose;
   p.local[0] = skeleton_.joints[0].rest.rotation;
   p.rootTranslation = skeleton_.joints[0].rest.translation;
+  if (head_) {
+    if (std::optional<LimbCorrection> c = applyHead(pose, std::move(p))) out.push_back(*c);
+    return out;
+  }
 
   // The trunk is posed once: turning a limb moves only the few trunk vertices its blends reach, near
   // its root, where nothing is checked.
@@ -290,14 +290,8 @@ void LimbClearance::setUpHead() {
   head_ = std::move(h);
 }
 
-std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose) const {
+std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const {
   const Head& h = *head_;
-  if (pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return std::nullopt;
-  for (const Quatf& q : pose.local)
-    if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return std::nullopt;
-  Pose p = pose;
-  p.local[0] = skeleton_.joints[0].rest.rotation;
-  p.rootTranslation = skeleton_.joints[0].rest.translation;
   // How far the deepest checked head vertex is inside the rest of the body: the closest of the other
   // triangles (an open surface: its sign is trusted only where the whole body's winding number
   // confirms the vertex lies inside another layer of it, 1.5 against 0.5 on the surface alone).

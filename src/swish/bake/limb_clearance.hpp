@@ -95,7 +95,8 @@ class LimbClearance {
   };
   std::optional<Head> head_;
   void setUpHead();
-  std::optional<LimbCorrection> applyHead(Pose& pose) const;
+  // `p`: `pose` checked and with its root at rest (as apply measures it).
+  std::optional<LimbCorrection> applyHead(Pose& pose, Pose p) const;
 };
 
 }  // namespace swish::bake
