@@ -64,7 +64,7 @@ class WholeFrame : public test::GpuTest {};
 
 TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
   SWISH_TEST_SEED_SCOPE(seed, 0xF4A3E);
-  Rng rng(seed);
+  Rng modelRng(seed);
   test::RandomModelSpec spec;
   spec.vertices = 311;
   spec.meshComponents = 30;
@@ -72,12 +72,21 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
   spec.normalMaps = 6;
   spec.mapSize = 24;
   spec.codebookSize = 40;
-  const Model model = test::makeRandomModel(rng, spec);
+  const Model model = test::makeRandomModel(modelRng, spec);
   const uint32_t instances = 22;
   gpu::GpuModel gpuModel(ctx(), model, "random model");
+  // The normal maps written straight into images that share the blend's output (where the device
+  // allows it: lavapipe does), and copied into images of their own.
+  for (const bool share : {true, false}) {
+  SCOPED_TRACE(share ? "shared texels" : "copied texels");
+  Rng rng(seed + 1);  // the same frames for both
   gpu::FrameRecorderOptions options;
   options.framesInFlight = 2;
+  options.shareNormalMapTexels = share;
   gpu::FrameRecorder recorder(ctx(), gpuModel, instances, options);
+  if (!share) {
+    EXPECT_FALSE(recorder.frame(0).normalMaps.sharesTexels());
+  }
 
   std::vector<runtime::BlendedNormalMap> prevMaps;  // reference state; starts at zeros like the GPU images
   for (int frame = 0; frame < 3; ++frame) {
@@ -101,6 +110,7 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
       EXPECT_GE(t.totalMs, t.deformMs);
     }
     prevMaps = ref.normalMaps;
+  }
   }
 }
 

@@ -24,6 +24,14 @@ class Buffer {
   Buffer() = default;
   // size 0 is rounded up to 4 bytes so every buffer has an address. `name` appears in errors.
   Buffer(Context& ctx, VkDeviceSize size, MemoryKind kind, const std::string& name);
+  // A buffer over memory another object allocated and owns (at offset 0; mapped when host visible),
+  // which must outlive it: NormalMapImages shares its image's memory this way. The memory must have
+  // been allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT, of a type in requirements(ctx, size),
+  // and at least requirements(ctx, size).size bytes (checked).
+  Buffer(Context& ctx, VkDeviceSize size, VkDeviceMemory sharedMemory, uint32_t memoryType, VkDeviceSize memoryBytes,
+         const std::string& name);
+  // The memory requirements of a Buffer of `size` bytes (its usage flags), without creating one.
+  static VkMemoryRequirements requirements(Context& ctx, VkDeviceSize size);
 
   VkBuffer handle() const { return buffer_.get(); }
   VkDeviceSize size() const { return size_; }
@@ -42,8 +50,10 @@ class Buffer {
   void download(Context& ctx, void* dst, VkDeviceSize bytes, VkDeviceSize offset = 0) const;
 
  private:
+  void createHandle(Context& ctx);
+  void finish(Context& ctx, VkDeviceMemory memory, uint32_t memoryType);  // binds, maps when host visible, gets the address
   VkUnique<VkBuffer> buffer_;
-  VkUnique<VkDeviceMemory> memory_;
+  VkUnique<VkDeviceMemory> memory_;  // empty for a buffer over shared memory
   VkDeviceSize size_ = 0;
   VkDeviceAddress address_ = 0;
   void* mapped_ = nullptr;

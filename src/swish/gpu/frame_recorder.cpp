@@ -28,7 +28,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
     decode_ = VqDecodePass(ctx);
     blend_ = NormalMapBlendPass(ctx, model.mapWidth());
   }
-  for (uint32_t s = 0; s < o.framesInFlight; ++s) frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s);
+  for (uint32_t s = 0; s < o.framesInFlight; ++s) frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s, o.shareNormalMapTexels);
   for (uint32_t s = 0; s < o.framesInFlight; ++s) {
     FrameResources& f = frames_[s];
     f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices);
@@ -44,7 +44,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
     }
     if (normalMaps_) {
       const uint32_t prev = (s + o.framesInFlight - 1) % o.framesInFlight;
-      f.blendBinding = blend_.makeBinding(ctx, frames_[prev].blendedTexels, f.blendedTexels, f.decodedMaps);
+      f.blendBinding = blend_.makeBinding(ctx, frames_[prev].blendOutput(), f.blendOutput(), f.decodedMaps);
     }
   }
 }
@@ -165,8 +165,9 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
     b.width = m.mapWidth();
     b.height = m.mapHeight();
     b.characterCount = in.instanceCount;
-    b.outTexels = f.blendedTexels.handle();
+    b.outTexels = f.blendOutput().handle();
     b.outMaps = f.normalMaps.image();
+    b.outMapsShareTexels = f.normalMaps.sharesTexels();
     dispatches += blend_.record(cmd, f.blendBinding.get(), b);
     f.timestamps.mark(cmd, kAfterBlend);
   }
@@ -225,7 +226,8 @@ void FrameRecorder::uploadNormalMaps(uint32_t slot, const std::vector<runtime::B
     std::copy(maps[i].xy.begin(), maps[i].xy.end(), all.begin() + i * per);
   }
   f.normalMaps.upload(*ctx_, all);
-  f.blendedTexels.upload(*ctx_, all.data(), all.size() * sizeof(int16_t));  // what the next frame's blend reads
+  if (!f.normalMaps.sharesTexels())  // else the upload wrote them
+    f.blendedTexels.upload(*ctx_, all.data(), all.size() * sizeof(int16_t));  // what the next frame's blend reads
 }
 
 }  // namespace swish::gpu

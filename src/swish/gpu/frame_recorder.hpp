@@ -3,10 +3,10 @@
 // the caller owns (the caller submits; nothing here submits frame work):
 //   deform (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
 //   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch,
-//   then a copy into the normal-map images)
+//   into the normal-map images' own memory where they share it, else then a copy into them)
 // with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
-// uses slot f % framesInFlight and its blend reads the previous slot's blended maps (blendedTexels, the
-// buffer its normal-map images are a copy of).
+// uses slot f % framesInFlight and its blend reads the previous slot's blended maps
+// (FrameResources::blendOutput()).
 //
 // Caller contract: before record(f), wait for the fence of the submission that used slot
 // f % framesInFlight last (frame f - framesInFlight); submit frames in order on one queue. After
@@ -34,6 +34,9 @@ struct FrameRecorderOptions {
   uint32_t framesInFlight = 2;
   bool tangentFrames = true;  // normals + tangents pass
   bool normalMaps = true;     // VQ decode + blend (ignored for a model without a database)
+  // Lay the normal-map images over the blend's output where the device allows it (NormalMapImages::
+  // sharesTexels): no copy per frame. false: always the copy (tests compare the two).
+  bool shareNormalMapTexels = true;
 };
 
 // GPU time of each pass of one frame, in milliseconds (NaN: not run, or no timestamps on the device).

@@ -12,7 +12,8 @@
 
 namespace swish::gpu {
 
-FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bool withFrames, bool withMaps, uint32_t slot) {
+FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bool withFrames, bool withMaps, uint32_t slot,
+                               bool shareTexels) {
   const std::string tag = m.name() + " frame " + std::to_string(slot) + ": ";
   const VkDeviceSize n = m.vertexCount(), c = std::max(1u, cap);
   meshWeights = Buffer(ctx, DeformPass::weightsBytes(uint32_t(c), m.kernelMeshComponents()), MemoryKind::HostVisible,
@@ -30,12 +31,13 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
     decodeSlotMaps = Buffer(ctx, 2 * c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode jobs");
     blendCharacters = Buffer(ctx, c * sizeof(layout::NormalMapBlendCharacter), MemoryKind::HostVisible, tag + "blend characters");
     decodedMaps = Buffer(ctx, c * m.mapWidth() * m.mapHeight() * 2, MemoryKind::DeviceLocal, tag + "decoded maps");
-    blendedTexels = Buffer(ctx, NormalMapBlendPass::texelBytes(m.mapWidth(), m.mapHeight(), uint32_t(c)), MemoryKind::DeviceLocal,
-                           tag + "blended normal maps");
-    normalMaps = NormalMapImages(ctx, m.mapWidth(), m.mapHeight(), uint32_t(c));
+    normalMaps = NormalMapImages(ctx, m.mapWidth(), m.mapHeight(), uint32_t(c), shareTexels);
+    if (!normalMaps.sharesTexels())
+      blendedTexels = Buffer(ctx, NormalMapBlendPass::texelBytes(m.mapWidth(), m.mapHeight(), uint32_t(c)), MemoryKind::DeviceLocal,
+                             tag + "blended normal maps");
     // The blend's state starts as the images do: all 0.
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
-      vkCmdFillBuffer(cmd, blendedTexels.handle(), 0, VK_WHOLE_SIZE, 0);
+      vkCmdFillBuffer(cmd, blendOutput().handle(), 0, VK_WHOLE_SIZE, 0);
       VkMemoryBarrier mb{};
       mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
       mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;

@@ -27,9 +27,10 @@ class GpuModel;
 
 struct FrameResources {
   FrameResources() = default;
-  // withNormalMaps: allocate the decode slots and per-character images (the model must have a database).
+  // withNormalMaps: allocate the decode slots and per-character images (the model must have a database);
+  // shareTexels: lay the images over the blend's output where the device allows it (NormalMapImages).
   FrameResources(Context& ctx, const GpuModel& model, uint32_t instanceCapacity, bool withTangentFrames, bool withNormalMaps,
-                 uint32_t slot);
+                 uint32_t slot, bool shareTexels = true);
 
   // Inputs, written by FrameRecorder::record.
   Buffer meshWeights;      // float[instances][K4] (DeformPass::packWeights)
@@ -42,11 +43,15 @@ struct FrameResources {
   Buffer tangents;         // float[instances][N][4]
   Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8): decoded database maps, one slot per instance
   Buffer triangleTerms;    // vec4[instances][T][3], scratch of the two-pass tangent frames
-  Buffer blendedTexels;    // uint32[instances][H][W] (snorm16 X | Y << 16): the blend's output, copied into normalMaps
   NormalMapImages normalMaps;  // one layer per instance
+  // uint32[instances][H][W] (snorm16 X | Y << 16): the blend's output, copied into normalMaps; empty
+  // where normalMaps.sharesTexels() (the blend writes normalMaps.texels(), the images' own memory).
+  Buffer blendedTexels;
+  // Where the blend writes (and the next frame's blend reads): normalMaps.texels() or blendedTexels.
+  const Buffer& blendOutput() const { return normalMaps.sharesTexels() ? normalMaps.texels() : blendedTexels; }
   DescriptorBinding deformInputs;   // meshWeights, skinMatrices
   DescriptorBinding tangentFrames;  // positions, triangleTerms, the model's adjacency, normals, tangents
-  DescriptorBinding blendBinding;   // prev frame's blendedTexels -> this frame's blendedTexels, decodedMaps
+  DescriptorBinding blendBinding;   // prev frame's blendOutput() -> this frame's blendOutput(), decodedMaps
 
   // Which database map each slot of decodedMaps holds (kNoMap: none yet) and the last frame that
   // selected it. Database maps never change, so a decoded slot stays valid until it is given to another

@@ -54,6 +54,10 @@ uint32_t NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding
   pipelines_[which].bind(cmd, &p, sizeof(p), binding);
   vkCmdDispatch(cmd, groupCount(a.width / 4, rowGroup_), a.height / kRowsPerInvocation[which], a.characterCount);
 
+  if (a.outMapsShareTexels) {  // the dispatch wrote the images' memory: make it available (see the header)
+    computeToComputeBarrier(cmd);
+    return 1;
+  }
   // The blended texels, written by the dispatch, are read by the copy. The images' layers go to
   // TRANSFER_DST_OPTIMAL for the copy (the layout copies ask for) and back to GENERAL; the first barrier
   // also orders the copy's image writes after every earlier access to the images on this queue (all

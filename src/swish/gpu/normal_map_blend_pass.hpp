@@ -2,23 +2,32 @@
 // The normal-map blend pass (shaders/normal_map_blend.comp): the temporal filter's blend of each
 // character's newly selected, decoded map into its normal map, out = mix(prev, decoded, alpha), for all
 // characters in one dispatch, one invocation per 4-texel column of 16, 8 or 4 rows of a character (the
-// most the map height allows), then one copy of the result
-// into the layers of the characters' RG16_SNORM image array (NormalMapImages), which renderers sample.
+// most the map height allows), into the characters' RG16_SNORM image array (NormalMapImages), which
+// renderers sample: written directly where the images share the out buffer's memory
+// (NormalMapImages::sharesTexels: linear images laid out as the packed texels), else by one copy of
+// the out buffer into the image layers.
 //
 // The blend works on buffers of packed texels (uint32[layer][height][width], snorm16 X | Y << 16: the
 // memory layout of R16G16_SNORM), not on the images: prev is the previous frame's buffer, out this
 // frame's. On lavapipe a storage-image load or store of RG16_SNORM converts the format lane by lane;
 // the buffer form reads and writes 4 texels per texel fetch or store, and the copy into the images is
-// a memcpy (22 characters of 256x256: see normal_map_blend.comp for the figures).
+// a memcpy (22 characters of 256x256: see normal_map_blend.comp for the figures). With shared texels
+// there is no copy at all: bench_replay's BM_ReplayRatio, lavapipe on 2 cores, 6 runs alternating with
+// the copy (a scratch switch): 22 characters against 1, blend stage 12.7x -> 10.3x, whole frame
+// (wall) 6.25x -> 5.66x (medians; lower in each of the 6 pairs).
 //
 // prev, out and the decoded slots (VqDecodePass output) are bound through a descriptor set made by
-// makeBinding(); prev and out may be the same buffer (one frame in flight). Records one dispatch and
-// one copy (never submits). The caller places computeToComputeBarrier after the VQ decode pass and
+// makeBinding(); prev and out may be the same buffer (one frame in flight). Records one dispatch and,
+// unless the images share out's memory, one copy (never submits). The caller places computeToComputeBarrier after the VQ decode pass and
 // before this one (which also orders this frame's read of `prev` after the previous frame's write of it
 // on the same queue). The images are written by a transfer, after which record() places a barrier
 // TRANSFER/TRANSFER_WRITE -> COMPUTE_SHADER/SHADER_READ|WRITE, so that the documented contract for a
 // renderer holds unchanged: a barrier COMPUTE_SHADER/SHADER_WRITE -> its own stage/SHADER_READ
-// before sampling `out` (the two form a dependency chain).
+// before sampling `out` (the two form a dependency chain). With shared texels the dispatch writes the
+// images' memory through the buffer, and record() places a global memory barrier COMPUTE_SHADER/
+// SHADER_WRITE -> COMPUTE_SHADER/SHADER_READ|WRITE after it: it makes those writes available (a
+// renderer's image barrier alone covers only accesses through the image), and the renderer's barrier
+// from the compute stage chains to it as above.
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
@@ -60,6 +69,7 @@ class NormalMapBlendPass {
     uint32_t characterCount = 0;     // <= layers of the bound buffers and of outMaps
     VkBuffer outTexels = VK_NULL_HANDLE;  // the `out` buffer of the binding, copied into outMaps
     VkImage outMaps = VK_NULL_HANDLE;     // a NormalMapImages::image() (layout GENERAL): layers 0..characterCount-1 written
+    bool outMapsShareTexels = false;      // outMaps lies over outTexels' memory (NormalMapImages::sharesTexels): no copy
   };
 
   NormalMapBlendPass() = default;

@@ -152,6 +152,17 @@ void ReplayEngine::Impl::setUp() {
     // Ground truth needs the run time's outputs, hence GPU work.
     if (options.truth.every > 0) B.truth = std::make_unique<ModelTruth>(models.at(B.planned->model), options.truth);
   }
+  // The memory the device really takes: where it lays the normal-map images over the blend's output
+  // (the same for every recorder on one device), no separate blended-maps buffer.
+  for (const Batch& B : batches)
+    if (B.planned->normalMaps) {
+      if (B.recorder->frame(0).normalMaps.sharesTexels()) {
+        runtime::PlannerOptions po;
+        po.normalMapsShareTexels = true;
+        plan.allocations = runtime::planReplay(scene, models.modelMap(), po).allocations;
+      }
+      break;
+    }
 }
 
 bool ReplayEngine::Impl::truthFrame(uint32_t index) const {

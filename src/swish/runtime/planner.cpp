@@ -55,7 +55,7 @@ std::vector<PlannedAllocation> modelAllocations(const Model& m, const std::strin
 }
 
 std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::string& owner, uint32_t instances,
-                                                bool frames, bool maps) {
+                                                bool frames, bool maps, bool sharedTexels) {
   const uint64_t n = m.gameMesh.vertexCount(), c = std::max(1u, instances);
   // The deform kernel reads the mesh weights as vec4 texels: K (at least 1) padded to a multiple of 4.
   const uint64_t kk = (std::max<uint64_t>(uint64_t(m.meshComponents()), 1) + 3) / 4 * 4, j = m.skeleton.size();
@@ -77,8 +77,12 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
     add("decode jobs", c * 8);  // map + slot of each map decoded
     add("blend characters", c * 8);
     add("decoded maps", c * texels * 2);
-    add("blended normal maps", c * texels * 4);  // the blend's output (snorm16 x2), copied into the images
-    add("normal maps (RG16 snorm array)", c * texels * 4, true);
+    if (sharedTexels) {
+      add("normal maps (RG16 snorm array, linear: the blend's output)", c * texels * 4, true);
+    } else {
+      add("blended normal maps", c * texels * 4);  // the blend's output (snorm16 x2), copied into the images
+      add("normal maps (RG16 snorm array)", c * texels * 4, true);
+    }
   }
   return a;
 }
@@ -146,7 +150,8 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
       }
       for (const auto& a : modelAllocations(m, key, b.normalMaps)) plan.allocations.push_back(a);
       for (uint32_t s = 0; s < o.framesInFlight; ++s)
-        for (const auto& a : frameAllocations(m, key + " frame " + std::to_string(s), uint32_t(inst), b.tangentFrames, b.normalMaps))
+        for (const auto& a : frameAllocations(m, key + " frame " + std::to_string(s), uint32_t(inst), b.tangentFrames, b.normalMaps,
+                                               o.normalMapsShareTexels))
           plan.allocations.push_back(a);
     }
 

@@ -30,6 +30,10 @@ namespace swish::runtime {
 struct PlannerOptions {
   uint32_t framesInFlight = 1;  // the replay reads every frame back, so a second frame buys nothing
   bool leaveOut = true;         // false: the naive plan (every stage, every character), for comparison
+  // The device lays the normal-map images over the blend's output (gpu::NormalMapImages::sharesTexels:
+  // lavapipe does): no separate blended-maps buffer and no copy. Unknown without a device (`--plan`),
+  // hence false by default: the plan's memory is then an upper bound.
+  bool normalMapsShareTexels = false;
 };
 
 // One model's batch: its on-screen characters, in instance order.
@@ -90,6 +94,6 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
 std::vector<PlannedAllocation> modelAllocations(const Model& model, const std::string& owner, bool withNormalMaps);
 // The bytes of one gpu::FrameResources for `instances` instances.
 std::vector<PlannedAllocation> frameAllocations(const Model& model, const std::string& owner, uint32_t instances,
-                                                bool tangentFrames, bool normalMaps);
+                                                bool tangentFrames, bool normalMaps, bool normalMapsShareTexels = false);
 
 }  // namespace swish::runtime
