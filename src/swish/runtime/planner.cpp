@@ -80,7 +80,9 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
     if (sharedTexels) {
       add("normal maps (RG16 snorm array, linear: the blend's output)", c * texels * 4, true);
     } else {
-      add("blended normal maps", c * texels * 4);  // the blend's output (snorm16 x2), copied into the images
+      // The blend's output (snorm16 x2), copied into the images; not allocated where the device lays
+      // the images over it (PlannerOptions::normalMapsShareTexels).
+      add("blended normal maps (none where the images share them)", c * texels * 4);
       add("normal maps (RG16 snorm array)", c * texels * 4, true);
     }
   }
