@@ -7,16 +7,20 @@
 
 namespace swish::gpu {
 
+namespace {
+// The usage the header and docs/integration.md promise: storage, sampled, transfer src/dst.
+constexpr VkImageUsageFlags kUsage =
+    VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+}  // namespace
+
 bool NormalMapImages::deviceSupportsLinear(Context& ctx, uint32_t width, uint32_t height, uint32_t layers) {
-  constexpr VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                                      VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   constexpr VkFormatFeatureFlags features = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT |
                                             VK_FORMAT_FEATURE_TRANSFER_SRC_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT;
   VkFormatProperties fp;
   vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), kFormat, &fp);
   if ((fp.linearTilingFeatures & features) != features) return false;
   VkImageFormatProperties ip;
-  if (vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), kFormat, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_LINEAR, usage, 0,
+  if (vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), kFormat, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_LINEAR, kUsage, 0,
                                                &ip) != VK_SUCCESS)
     return false;
   return ip.maxArrayLayers >= layers && ip.maxExtent.width >= width && ip.maxExtent.height >= height &&
@@ -40,8 +44,7 @@ NormalMapImages::NormalMapImages(Context& ctx, uint32_t width, uint32_t height, 
     ici.arrayLayers = layers;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
     ici.tiling = tiling;
-    ici.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    ici.usage = kUsage;
     ici.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     VkImage img;
