@@ -32,6 +32,10 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_EQ(c.train.mlp.hiddenWidth, 32);
   EXPECT_EQ(c.train.databaseSize, 128);
   EXPECT_EQ(c.train.normalCodeWeight, 1.0);
+  EXPECT_EQ(c.train.meshWeightFloor, 0.0);
+  const BakeConfig f = parseBakeConfig({{"output", "out"}, {"train", {{"mesh_weight_floor", 0.5}}}}, "recipe.json", "/base");
+  EXPECT_DOUBLE_EQ(f.train.meshWeightFloor, 0.5);
+  EXPECT_DOUBLE_EQ(f.train.toJson()["mesh_weight_floor"].get<double>(), 0.5);
   const BakeConfig w = parseBakeConfig({{"output", "out"}, {"train", {{"normal_code_weight", 0.1}}}}, "recipe.json", "/base");
   EXPECT_DOUBLE_EQ(w.train.normalCodeWeight, 0.1);
   EXPECT_DOUBLE_EQ(w.train.toJson()["normal_code_weight"].get<double>(), 0.1);  // what the model's metadata records
@@ -54,6 +58,8 @@ TEST(BakeConfig, ErrorsNameTheKey) {
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"learning_rate", "fast"}}}}).find("train.learning_rate: must be a number"),
             std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"normal_code_weight", 0}}}}).find("train.normal_code_weight: 0 is outside"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"mesh_weight_floor", 1.5}}}}).find("train.mesh_weight_floor: 1.5 is outside"),
             std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"input_joints", "Spine"}}}}).find("train.input_joints: must be a non-empty array"),
             std::string::npos);

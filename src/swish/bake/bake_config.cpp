@@ -256,7 +256,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   c.onlyKeys(train, "train",
              {"mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
               "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation", "learning_rate",
-              "batch_size", "max_epochs", "patience", "validation_fraction", "normal_code_weight", "max_training_seconds", "test_fraction",
+              "batch_size", "max_epochs", "patience", "validation_fraction", "normal_code_weight", "mesh_weight_floor", "max_training_seconds", "test_fraction",
               "temporal_time_constant", "seed", "bc5_baseline", "input_joints"});
   BakeTrainSettings& t = cfg.train;
   const std::string p = "train";
@@ -286,6 +286,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   t.mlp.patience = int(c.number(train, p, "patience", 1, 1e7, t.mlp.patience, true));
   t.mlp.validationFraction = c.number(train, p, "validation_fraction", 0.01, 0.5, t.mlp.validationFraction);
   t.normalCodeWeight = c.number(train, p, "normal_code_weight", 0.001, 100, t.normalCodeWeight);
+  t.meshWeightFloor = c.number(train, p, "mesh_weight_floor", 0, 1, t.meshWeightFloor);
   t.mlp.maxSeconds = c.number(train, p, "max_training_seconds", 0, 1e6, t.mlp.maxSeconds);
   t.testFraction = c.number(train, p, "test_fraction", 0, 0.49, t.testFraction);
   t.temporalTimeConstant = float(c.number(train, p, "temporal_time_constant", 0, 10, t.temporalTimeConstant));

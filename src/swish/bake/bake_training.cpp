@@ -29,6 +29,7 @@ nlohmann::json BakeTrainSettings::toJson() const {
           {"patience", mlp.patience},
           {"validation_fraction", mlp.validationFraction},
           {"normal_code_weight", normalCodeWeight},
+          {"mesh_weight_floor", meshWeightFloor},
           {"max_training_seconds", mlp.maxSeconds},
           {"test_fraction", testFraction},
           {"temporal_time_constant", temporalTimeConstant},
@@ -163,11 +164,11 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
         uint32_t(std::lower_bound(out.trainingPoses.begin(), out.trainingPoses.end(), p) - out.trainingPoses.begin()));
   if (mo.outputWeights.empty()) {
     // Mesh weights by their share of the shape variance (the loss then follows the vertex error),
-    // mixed with a uniform floor so that small components still train; the normal code as one block
-    // of normalCodeWeight times the mesh's total weight.
+    // mixed with st.meshWeightFloor of a uniform weight; the normal code as one block of
+    // normalCodeWeight times the mesh's total weight.
     const VecXd var = out.meshPca.singularValues.head(K).cwiseAbs2();
-    const double sum = std::max(var.sum(), 1e-300);
-    for (int k = 0; k < K; ++k) mo.outputWeights.push_back(0.5 * var[k] / sum + 0.5 / K);
+    const double sum = std::max(var.sum(), 1e-300), uniform = st.meshWeightFloor;
+    for (int k = 0; k < K; ++k) mo.outputWeights.push_back((1.0 - uniform) * var[k] / sum + uniform / K);
     for (int c = 0; c < C; ++c) mo.outputWeights.push_back(st.normalCodeWeight / C);
   }
   out.regressor = trainMlp(theta, lambda, mo);
