@@ -64,7 +64,9 @@ struct GpuDeformResult {
   std::vector<std::string> problems;  // guard or input violations
 };
 
-GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinning) {
+// basisTexels: the pass reads the basis as texels (deform_basis_texels.comp) where the device's
+// maxTexelBufferElements allows, else through its address (deform.comp).
+GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinning, bool basisTexels) {
   const Model& m = in.model;
   const uint32_t n = uint32_t(m.gameMesh.vertexCount()), k = uint32_t(m.meshComponents());
   const std::vector<uint32_t> joints(m.gameMesh.skin.joints.begin(), m.gameMesh.skin.joints.end());
@@ -80,11 +82,13 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   CheckedInput skinWeights(ctx, std::span<const float>(m.gameMesh.skin.weights), "skin weights");
   GuardedOutput out(ctx, size_t(in.instances) * n * 3 * sizeof(float), "deformed positions");
 
-  const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), skinning);
+  const uint64_t basisFloats = uint64_t(m.meshPca.basis.size());
+  const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), skinning, basisTexels ? basisFloats : 0);
+  EXPECT_EQ(pass.basisTexels(), basisTexels && basisFloats <= ctx.properties().limits.maxTexelBufferElements);
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
-  const gpu::DescriptorBinding instanceInputs = pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer());
+  const gpu::DescriptorBinding instanceInputs = pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
   a.instanceInputs = instanceInputs.get();
   a.skinJoints = skinJoints.address();
   a.skinWeights = skinWeights.address();
@@ -150,22 +154,28 @@ class DeformConformance : public test::GpuTest, public ::testing::WithParamInter
 TEST_P(DeformConformance, PcaReconstructionMatchesReference) {
   SWISH_TEST_SEED_SCOPE(seed, 0xDEF0 + GetParam().vertices);
   const DeformInputs in = randomInputs(seed, GetParam());
-  const auto gpu = runDeform(ctx(), in, false);
-  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-  test::CompareReport rep;
-  EXPECT_TRUE(test::matchesReference("pre-skinning positions", gpu.positions, referencePositions(in, false), pcaTolerance(in), &rep));
-  std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
+  for (const bool basisTexels : {false, true}) {
+    SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
+    const auto gpu = runDeform(ctx(), in, false, basisTexels);
+    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+    test::CompareReport rep;
+    EXPECT_TRUE(test::matchesReference("pre-skinning positions", gpu.positions, referencePositions(in, false), pcaTolerance(in), &rep));
+    std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
+  }
 }
 
 TEST_P(DeformConformance, SkinnedPositionsMatchReference) {
   SWISH_TEST_SEED_SCOPE(seed, 0x5C1 + GetParam().vertices);
   const DeformInputs in = randomInputs(seed, GetParam());
-  const auto gpu = runDeform(ctx(), in, true);
-  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
   const auto ref = referencePositions(in, true);
-  test::CompareReport rep;
-  EXPECT_TRUE(test::matchesReference("skinned positions", gpu.positions, ref, [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
-  std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
+  for (const bool basisTexels : {false, true}) {
+    SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
+    const auto gpu = runDeform(ctx(), in, true, basisTexels);
+    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+    test::CompareReport rep;
+    EXPECT_TRUE(test::matchesReference("skinned positions", gpu.positions, ref, [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
+    std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
+  }
 }
 
 // Odd sizes: 1 vertex, a prime count, a large prime count; 1, 3 and 22 instances; K = 1, 5, 30;
@@ -188,15 +198,18 @@ TEST_F(DeformSpecialValues, NanAndInfReachExactlyTheReferenceOutputs) {
   in.matrices[3 * in.model.skeleton.size() + joint](0, 3) = inf;  // instance 3's translation x of that joint
   in.model.gameMesh.skin.weights[9 * 4 + 1] = 0.f;                // a zero weight: skipped, so...
   in.matrices[1 * in.model.skeleton.size() + in.model.gameMesh.skin.joints[9 * 4 + 1]](1, 1) = nan;  // ...no NaN unless used
-  const auto gpu = runDeform(ctx(), in, true);
-  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
   const auto ref = referencePositions(in, true);
-  test::CompareReport rep;
-  EXPECT_TRUE(test::matchesReference("skinned positions with NaN/Inf inputs", gpu.positions, ref,
-                                     [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
-  // The poison must be neither absent nor everywhere, or the test would prove nothing.
-  EXPECT_GT(rep.nonFinite, 61u * 3);
-  EXPECT_LT(rep.nonFinite, ref.size());
+  for (const bool basisTexels : {false, true}) {
+    SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
+    const auto gpu = runDeform(ctx(), in, true, basisTexels);
+    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+    test::CompareReport rep;
+    EXPECT_TRUE(test::matchesReference("skinned positions with NaN/Inf inputs", gpu.positions, ref,
+                                       [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
+    // The poison must be neither absent nor everywhere, or the test would prove nothing.
+    EXPECT_GT(rep.nonFinite, 61u * 3);
+    EXPECT_LT(rep.nonFinite, ref.size());
+  }
 }
 
 // Small integers and binary fractions: every sum and product is exact in float, so GPU and reference
@@ -219,8 +232,10 @@ TEST_F(DeformSpecialValues, ExactlyRepresentableInputsGiveExactResults) {
     mat(3, 3) = 1.f;
     for (int r = 0; r < 3; ++r) mat(r, 3) = float(int(rng.below(20)) - 10);
   }
-  for (bool skinning : {false, true}) {
-    const auto gpu = runDeform(ctx(), in, skinning);
+  for (bool skinning : {false, true})
+  for (const bool basisTexels : {false, true}) {
+    SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
+    const auto gpu = runDeform(ctx(), in, skinning, basisTexels);
     for (const auto& p : gpu.problems) ADD_FAILURE() << p;
     EXPECT_TRUE(test::matchesReference(skinning ? "skinned positions" : "PCA positions", gpu.positions,
                                        referencePositions(in, skinning), [](size_t) { return 0.0; }));

@@ -1,10 +1,12 @@
 #include "swish/gpu/deform_pass.hpp"
 
 #include <algorithm>
+#include <vector>
 
 #include "shaders/swish_layouts.h"
 #include "swish/core/error.hpp"
 #include "swish/core/mesh.hpp"
+#include "swish/gpu/context.hpp"
 
 namespace swish::gpu {
 
@@ -22,22 +24,28 @@ void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
       for (int c = 0; c < 4; ++c) out[12 * i + 4 * r + c] = m[i](r, c);
 }
 
-DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning) {
+DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats)
+    : basisTexels_(basisFloats > 0 && basisFloats <= ctx.properties().limits.maxTexelBufferElements) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
     throw Error("deform pass: " + std::to_string(k) + " mesh components; the kernel supports 1.." +
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
   if (influences < 1 || influences > uint32_t(kMaxInfluences))
     throw Error("deform pass: " + std::to_string(influences) + " skin influences; supported: 1..8");
-  inputsLayout_ = DescriptorLayout(ctx, {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER});
-  pipeline_ = ComputePipeline(ctx, "deform.comp", {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u},
-                              sizeof(layout::DeformParams), inputsLayout_.get());
+  inputsLayout_ = DescriptorLayout(ctx, std::vector<VkDescriptorType>(basisTexels_ ? 3 : 2, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
+  pipeline_ = ComputePipeline(ctx, basisTexels_ ? "deform_basis_texels.comp" : "deform.comp",
+                              {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u}, sizeof(layout::DeformParams),
+                              inputsLayout_.get());
 }
 
-DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
+DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices, const Buffer* basis,
                                                  VkDeviceSize weightsOffset, VkDeviceSize matricesOffset) const {
-  return DescriptorBinding(ctx, inputsLayout_,
-                           {BoundResource::texels(weights, VK_FORMAT_R32G32B32A32_SFLOAT, weightsOffset),
-                            BoundResource::texels(skinMatrices, VK_FORMAT_R32G32B32A32_SFLOAT, matricesOffset)});
+  std::vector<BoundResource> r = {BoundResource::texels(weights, VK_FORMAT_R32G32B32A32_SFLOAT, weightsOffset),
+                                  BoundResource::texels(skinMatrices, VK_FORMAT_R32G32B32A32_SFLOAT, matricesOffset)};
+  if (basisTexels_) {
+    if (!basis) throw Error("deform pass: reads the basis as texels, but no basis buffer was bound");
+    r.push_back(BoundResource::texels(*basis, VK_FORMAT_R32_SFLOAT));
+  }
+  return DescriptorBinding(ctx, inputsLayout_, r);
 }
 
 uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {

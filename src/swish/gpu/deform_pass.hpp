@@ -2,7 +2,9 @@
 // The deform pass (shaders/deform.comp): PCA reconstruction + linear blend skinning of every instance
 // of one model in ONE dispatch; each vertex's basis values are read once per frame for all instances.
 // The per-instance inputs (mesh weights, skin matrix rows) are bound as texel buffers through a
-// descriptor set made once per pair of buffers by bindInstanceInputs (descriptor_binding.hpp says why).
+// descriptor set made once per pair of buffers by bindInstanceInputs (descriptor_binding.hpp says why),
+// and with them the model's basis as R32 texels where it fits in the device's maxTexelBufferElements
+// (shaders/deform_basis_texels.comp; else shaders/deform.comp reads it through its address).
 //
 // Records one dispatch into the caller's command buffer (never submits). Synchronisation the caller
 // provides: inputs written by the host before the submission (mapped memory; the submission makes them
@@ -25,7 +27,7 @@ class DeformPass {
 
   struct Args {
     VkDeviceAddress mean = 0;          // float[3N]
-    VkDeviceAddress basis = 0;         // float[K][3N]
+    VkDeviceAddress basis = 0;         // float[K][3N] (read here unless basisTexels())
     VkDeviceAddress skinJoints = 0;    // uint[N][influences]
     VkDeviceAddress skinWeights = 0;   // float[N][influences]
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
@@ -48,16 +50,21 @@ class DeformPass {
 
   DeformPass() = default;
   // meshComponents (K) in 1..SWISH_MAX_MESH_COMPONENTS; influences in 1..8. applySkinning = false writes
-  // the pre-skinning shape (used to check the PCA reconstruction on its own).
-  DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true);
+  // the pre-skinning shape (used to check the PCA reconstruction on its own). basisFloats: 3N x K, the
+  // basis read as texels when it is > 0 and within the device's maxTexelBufferElements; 0: through
+  // Args::basis.
+  DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true, uint64_t basisFloats = 0);
+  bool basisTexels() const { return basisTexels_; }
 
-  // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance).
-  DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
+  // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
+  // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise).
+  DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices, const Buffer* basis,
                                        VkDeviceSize weightsOffset = 0, VkDeviceSize matricesOffset = 0) const;
   // Returns the dispatches recorded (1; 0 for an empty input).
   uint32_t record(VkCommandBuffer cmd, const Args& args) const;
 
  private:
+  bool basisTexels_ = false;
   DescriptorLayout inputsLayout_;
   ComputePipeline pipeline_;
 };

@@ -19,7 +19,7 @@ enum Mark : uint32_t { kBegin = 0, kAfterDeform, kAfterTangentFrames, kAfterDeco
 FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capacity, const FrameRecorderOptions& o)
     : ctx_(&ctx), model_(&model), capacity_(capacity), tangentFrames_(o.tangentFrames),
       normalMaps_(o.normalMaps && model.hasNormalMaps()),
-      deform_(ctx, model.kernelMeshComponents(), model.influences()) {
+      deform_(ctx, model.kernelMeshComponents(), model.influences(), true, model.basis.size() / sizeof(float)) {
   if (o.framesInFlight < 1 || o.framesInFlight > 8)
     throw Error("frame recorder: " + std::to_string(o.framesInFlight) + " frames in flight; supported: 1..8");
   if (capacity == 0) throw Error("frame recorder: the instance capacity must be at least 1");
@@ -31,7 +31,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
   for (uint32_t s = 0; s < o.framesInFlight; ++s) frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s, o.shareNormalMapTexels);
   for (uint32_t s = 0; s < o.framesInFlight; ++s) {
     FrameResources& f = frames_[s];
-    f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices);
+    f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices, &model.basis);
     if (tangentFrames_) {
       TangentFramesPass::TwoPassBuffers b;
       b.positions = &f.positions;

@@ -1,0 +1,110 @@
+// deform.comp and deform_basis_texels.comp (the shader code of both).
+// PCA reconstruction (pre-skinning space) + linear blend skinning for ALL instances of one model in one
+// dispatch. One thread per vertex: it loads its 3K basis values and its skin influences ONCE into
+// registers, then loops over the instances. The basis, the largest input (3N x K floats), is
+// therefore read once per frame, not once per instance.
+//
+// The per-instance inputs, read N times per instance, come through texel buffers (set 0), a whole vec4
+// per fetch: the mesh weights as vec4[instance][K4 / 4] (K4 = K rounded up to 4, zero padded; every
+// thread fetches the same texels) and the skin matrices as vec4[instance][joint][3], the top three
+// rows of each affine matrix (the bottom row is 0 0 0 1). On lavapipe a vec4 texel fetch costs about
+// what ONE scalar load through a buffer address costs (descriptor_binding.hpp): per instance this pass
+// went from 32 + 48 scalar address loads per vertex to 8 + 12 texel fetches, about 3.5x less time per
+// instance in bench_replay's deform stage. Shared-memory staging of the weights measured 2x slower on
+// lavapipe, whose shared-memory loads and barriers are costly, and so did a subgroup broadcast: one
+// weight texel fetched per lane, then subgroupBroadcast(texel, q) for q < K4 (with the bounds check
+// below replaced by a clamp, so that every lane is active) made the stage slower, not faster
+// (bench_replay, 12 alternating runs, fastest frame: 22 characters 3.70 -> 4.91 ms, 1 character
+// 0.90 -> 1.02 ms).
+//
+// Conforms to runtime/reference_pca.cpp (x = mean + sum_k basis_k * w_k, k ascending, starting at the
+// mean) and runtime/reference_skinning.cpp (core/skinning.cpp: B = sum over influences with w != 0 of
+// w * M, then B * x). `precise` forbids fused multiply-add contraction so that the sums round like
+// the CPU reference (which is compiled without FMA); devices may still differ within the documented
+// tolerance.
+//
+// The basis: deform.comp reads it through its buffer address, deform_basis_texels.comp as R32 texels
+// (binding 2), where it fits in the device's maxTexelBufferElements (DeformPass decides). Lavapipe loads
+// through an address lane by lane, and the basis is 3K loads per vertex per frame, whatever the
+// instance count: with K = 64 (the default model) bench_replay's 1-character frame went from 2.92 to
+// 2.44 ms with the texels (5 alternating runs, medians), 22 characters the same.
+//
+// Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
+// that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
+#include "swish_buffers.glsl"
+#include "swish_layouts.h"
+
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint K = 1;               // mesh PCA components
+layout(constant_id = 2) const uint INFLUENCES = 4;      // skin influences per vertex
+layout(constant_id = 3) const bool APPLY_SKINNING = true;  // false: write the pre-skinning shape
+
+layout(push_constant) uniform Push { DeformParams p; };
+layout(set = 0, binding = 0) uniform samplerBuffer weightTexels;  // vec4[instance][K4 / 4]
+layout(set = 0, binding = 1) uniform samplerBuffer matrixRows;  // vec4[instance][joint][3] (rows 0..2)
+#ifdef SWISH_DEFORM_BASIS_TEXELS
+layout(set = 0, binding = 2) uniform samplerBuffer basisTexels;  // float[K][3N]
+#endif
+const uint K4 = (K + 3u) / 4u;
+
+void main() {
+  const uint v = gl_GlobalInvocationID.x;
+  if (v >= p.vertexCount) return;
+  const uint n3 = p.vertexCount * 3u;
+
+  float basis[3 * K];
+  uint joints[INFLUENCES];
+  float skinW[INFLUENCES];
+  FloatsIn meanBuf = FloatsIn(p.mean);
+  const vec3 mean = vec3(meanBuf.v[3u * v], meanBuf.v[3u * v + 1u], meanBuf.v[3u * v + 2u]);
+#ifdef SWISH_DEFORM_BASIS_TEXELS
+  [[unroll]] for (uint k = 0u; k < K; ++k)
+    [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = texelFetch(basisTexels, int(k * n3 + 3u * v + a)).x;
+#else
+  FloatsIn basisBuf = FloatsIn(p.basis);
+  [[unroll]] for (uint k = 0u; k < K; ++k)
+    [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = basisBuf.v[k * n3 + 3u * v + a];
+#endif
+  UintsIn jointBuf = UintsIn(p.skinJoints);
+  FloatsIn skinWeightBuf = FloatsIn(p.skinWeights);
+  [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
+    joints[i] = jointBuf.v[v * INFLUENCES + i];
+    skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
+  }
+
+  FloatsOut outBuf = FloatsOut(p.positionsOut);
+  for (uint instance = 0u; instance < p.instanceCount; ++instance) {
+    precise vec3 x = mean;
+    [[unroll]] for (uint q = 0u; q < K4; ++q) {
+      const vec4 w4 = texelFetch(weightTexels, int(instance * K4 + q));  // the same texel in every thread
+      [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+        const uint k = 4u * q + j;
+        if (k < K) x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w4[j];
+      }
+    }
+    precise vec3 y = x;
+    if (APPLY_SKINNING) {
+      // Each matrix comes as its top three rows (3 fetches); the columns summed below are their
+      // components. The zero-weight skip is a select, not a branch: every lane runs the same fetches
+      // (lavapipe gathers per lane, masked branches do not save that), and a skipped matrix still
+      // cannot bring its NaN/Inf in.
+      precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
+      [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
+        const int m = int((instance * p.jointCount + joints[i]) * 3u);
+        const float w = skinW[i];
+        const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2);
+        const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w);
+        const bool use = w != 0.0;
+        b0 = use ? b0 + w * c0 : b0;
+        b1 = use ? b1 + w * c1 : b1;
+        b2 = use ? b2 + w * c2 : b2;
+        b3 = use ? b3 + w * c3 : b3;
+      }
+      y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
+    }
+    const uint o = (instance * p.vertexCount + v) * 3u;
+    outBuf.v[o] = y.x;
+    outBuf.v[o + 1u] = y.y;
+    outBuf.v[o + 2u] = y.z;
+  }
+}
