@@ -11,8 +11,8 @@
 // weights, skin matrices, deformed positions, triangle terms, the adjacency walked per instance,
 // decoded maps) are therefore read as texel buffers and the vec4 outputs written through storage
 // buffers; model data read once per frame keeps its address, except the deform's PCA basis, the
-// largest (3K loads per vertex), which it fetches as texels where the device's limits allow. On GPUs texel buffers are an ordinary,
-// cached path, so nothing is lost there.
+// largest (3K loads per vertex), which it fetches as texels where the device's limits allow. On GPUs
+// texel buffers are an ordinary, cached path, so nothing is lost there.
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
