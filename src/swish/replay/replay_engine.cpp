@@ -154,15 +154,12 @@ void ReplayEngine::Impl::setUp() {
   }
   // The memory the device really takes: where it lays the normal-map images over the blend's output
   // (the same for every recorder on one device), no separate blended-maps buffer.
-  for (const Batch& B : batches)
-    if (B.planned->normalMaps) {
-      if (B.recorder->frame(0).normalMaps.sharesTexels()) {
-        runtime::PlannerOptions po;
-        po.normalMapsShareTexels = true;
-        plan.allocations = runtime::planReplay(scene, models.modelMap(), po).allocations;
-      }
-      break;
-    }
+  const auto withMaps = std::find_if(batches.begin(), batches.end(), [](const Batch& B) { return B.planned->normalMaps; });
+  if (withMaps != batches.end() && withMaps->recorder->frame(0).normalMaps.sharesTexels()) {
+    runtime::PlannerOptions po;
+    po.normalMapsShareTexels = true;
+    plan.allocations = runtime::planReplay(scene, models.modelMap(), po).allocations;
+  }
 }
 
 bool ReplayEngine::Impl::truthFrame(uint32_t index) const {

@@ -55,7 +55,7 @@ std::vector<PlannedAllocation> modelAllocations(const Model& m, const std::strin
 }
 
 std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::string& owner, uint32_t instances,
-                                                bool frames, bool maps, bool sharedTexels) {
+                                                bool frames, bool maps, bool normalMapsShareTexels) {
   const uint64_t n = m.gameMesh.vertexCount(), c = std::max(1u, instances);
   // The deform kernel reads the mesh weights as vec4 texels: K (at least 1) padded to a multiple of 4.
   const uint64_t kk = (std::max<uint64_t>(uint64_t(m.meshComponents()), 1) + 3) / 4 * 4, j = m.skeleton.size();
@@ -77,7 +77,7 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
     add("decode jobs", c * 8);  // map + slot of each map decoded
     add("blend characters", c * 8);
     add("decoded maps", c * texels * 2);
-    if (sharedTexels) {
+    if (normalMapsShareTexels) {
       add("normal maps (RG16 snorm array, linear: the blend's output)", c * texels * 4, true);
     } else {
       // The blend's output (snorm16 x2), copied into the images; not allocated where the device lays
