@@ -26,7 +26,7 @@
 // The basis: deform.comp reads it through its buffer address, deform_basis_texels.comp as R32 texels
 // (binding 2), where it fits in the device's maxTexelBufferElements (DeformPass decides). Lavapipe loads
 // through an address lane by lane, and the basis is 3K loads per vertex per frame, whatever the
-// instance count: with K = 64 (the default model) bench_replay's 1-character frame went from 2.92 to
+// instance count: with K = 64 (the default model then) bench_replay's 1-character frame went from 2.92 to
 // 2.44 ms with the texels (5 alternating runs, medians), 22 characters the same.
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
