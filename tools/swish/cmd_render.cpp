@@ -1,9 +1,9 @@
-// swish render MODEL --pose JOINT=RX,RY,RZ ... [--character default|FILE|none] [--out FILE]
+// swish render MODEL --pose JOINT=RX,RY,RZ ... [--character auto|default|FILE|none] [--out FILE]
 // Draws one pose of a model with the headless preview renderer (a host of swish's public API on its
 // own Vulkan device): the jersey with swish's normal map (left) and without it (right), side by side
-// from the same deformation, so that a person sees what the maps add. The body is drawn as a plain
-// mannequin when one can be had: the embedded default character (made by code) when the model's
-// skeleton has its joints, or a character file (glTF/FBX); otherwise the jersey alone, and it says so.
+// from the same deformation, so that a person sees what the maps add. The body drawn is, by default, the
+// one the model was baked on (named by its metadata: the embedded default character, a recipe, or a
+// glTF/FBX file); --character picks another or none. The output line names the body it drew.
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "swish/bake/character/default_character.hpp"
+#include "swish/bake/pipeline/baked_character.hpp"
+#include "swish/model/model_file.hpp"
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
-#include "swish/io/character_import.hpp"
 #include "swish/render/body_from_character.hpp"
 #include "swish/render/preview_renderer.hpp"
 #include "swish/swish.hpp"
@@ -26,7 +26,7 @@ namespace {
 struct RenderOptions {
   std::string model;
   std::vector<std::string> pose;
-  std::string character = "default";
+  std::string character = "auto";
   std::string out = "render.png";
   std::string device;
   uint32_t width = 480, height = 640;
@@ -60,12 +60,16 @@ void applyPoseSpec(const std::string& spec, const api::ModelInfo& info, std::vec
   rotations[j] = multiply(rotations[j], q);
 }
 
-std::optional<render::BodyMesh> loadBody(const RenderOptions& o, const api::ModelInfo& info, std::string& why) {
+// The body to draw and the words that name it. 'auto' draws the body the model was baked on (its metadata
+// names the character), and refuses when that character's file is not at hand rather than drawing the
+// garment on another body at the wrong place.
+std::optional<render::BodyMesh> loadBody(const RenderOptions& o, const api::ModelInfo& info, std::string& label, std::string& why) {
   if (o.character == "none") {
     why = "--character none";
     return std::nullopt;
   }
-  const Character c = o.character == "default" ? bake::makeDefaultCharacter() : io::importCharacter(o.character);
+  const Character c = bake::characterToDraw(o.character, o.character == "auto" ? loadModel(o.model).metadata : std::string(),
+                                            o.model, label);
   return render::bodyFromCharacter(c, info, why);
 }
 
@@ -81,8 +85,8 @@ int run(const RenderOptions& o) {
   render::PreviewOptions popts;
   popts.width = o.width;
   popts.height = o.height;
-  std::string why;
-  popts.body = loadBody(o, info, why);
+  std::string why, bodyLabel;
+  popts.body = loadBody(o, info, bodyLabel, why);
   if (!popts.body) std::printf("swish render: drawing the jersey only: %s\n", why.c_str());
   if (!info.hasNormalMaps) std::printf("swish render: the model has no normal maps; both halves will look the same\n");
 
@@ -95,8 +99,8 @@ int run(const RenderOptions& o) {
   const render::PreviewImage img = preview.render(pose, {{true, true}, {false, true}});
   for (const auto& w : preview.lastReport().warnings) std::printf("swish render: warning: %s\n", w.c_str());
   render::writePreviewPng(o.out, img, popts.background);
-  std::printf("%s: %ux%u, left: with swish's normal map, right: without (%s%s), on %s\n", o.out.c_str(), img.width, img.height,
-              info.name.c_str(), popts.body ? ", mannequin body" : "", device.deviceName().c_str());
+  std::printf("%s: %ux%u, left: with swish's normal map, right: without (%s, %s), on %s\n", o.out.c_str(), img.width, img.height,
+              info.name.c_str(), popts.body ? ("on " + bodyLabel).c_str() : "garment only", device.deviceName().c_str());
   if (o.validation)
     for (const auto& m : device.validationMessages()) std::fprintf(stderr, "validation: %s\n", m.c_str());
   return o.validation && !device.validationMessages().empty() ? 1 : 0;
@@ -109,7 +113,7 @@ static CommandRegistration registration{
       auto o = std::make_shared<RenderOptions>();
       app.add_option("model", o->model, "the .swish model")->required();
       app.add_option("--pose", o->pose, "JOINT=RX,RY,RZ: degrees on top of the rest rotation (repeatable); none: the rest pose");
-      app.add_option("--character", o->character, "body to draw: 'default' (the embedded mannequin), a glTF/FBX file, or 'none'");
+      app.add_option("--character", o->character, "body to draw: 'auto' (the body the model was baked on, from its metadata; an error when that file is not at hand), 'default' (the embedded mannequin), a glTF/FBX file, or 'none'");
       app.add_option("--out,-o", o->out, "output PNG");
       app.add_option("--width", o->width, "width of each half, pixels")->check(CLI::Range(16, 4096));
       app.add_option("--height", o->height, "height, pixels")->check(CLI::Range(16, 4096));

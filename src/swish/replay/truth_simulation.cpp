@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "swish/bake/pipeline/bake_config.hpp"
+#include "swish/bake/pipeline/baked_character.hpp"
 #include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
 #include "swish/core/error.hpp"
@@ -23,26 +24,6 @@ using nlohmann::json;
 
 // Rest data written by code and read back from a float32 file: equal, but allow float noise.
 constexpr float kSameTolerance = 1e-5f;
-
-std::string str(const json& j, const char* key) {
-  return j.is_object() && j.contains(key) && j.at(key).is_string() ? j.at(key).get<std::string>() : std::string();
-}
-std::vector<std::string> strings(const json& j, const char* key) {
-  std::vector<std::string> out;
-  if (j.is_object() && j.contains(key) && j.at(key).is_array())
-    for (const auto& e : j.at(key))
-      if (e.is_string()) out.push_back(e.get<std::string>());
-  return out;
-}
-
-// A file the bake named: as written, else beside the model file.
-fs::path findBakeFile(const std::string& name, const ModelEntry& entry) {
-  std::error_code ec;
-  if (fs::is_regular_file(name, ec)) return name;
-  if (!entry.file.empty() && fs::path(name).is_relative() && fs::is_regular_file(entry.file.parent_path() / name, ec))
-    return entry.file.parent_path() / name;
-  return {};
-}
 
 double threadCpuSeconds() {
   timespec t{};
@@ -108,35 +89,19 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     note_ = "the procedural stand-in model was not baked from a simulation: no source simulation to run";
     return;
   }
-  const json meta = json::parse(entry.model.metadata, nullptr, false);
-  if (meta.is_discarded() || !meta.is_object() || !meta.contains("dataset_settings") || !meta["dataset_settings"].is_object()) {
+  bake::BakedCharacter baked = bake::findBakedCharacter(entry.model.metadata, entry.file);
+  if (baked.kind == bake::BakedCharacter::Kind::Unknown) {
     note_ = "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character and "
             "cloth settings of its source simulation are unknown";
     return;
   }
-  const json& ds = meta["dataset_settings"];
-  const json chj = ds.value("character", json::object());
-  bake::DatasetBuildSettings s;
-  std::string how = "the embedded default character, rebuilt by code";
-  if (const std::string file = str(chj, "file"); !file.empty()) {
-    s.characterFile = findBakeFile(file, entry);
-    if (s.characterFile.empty()) {
-      note_ = "the bake's character file " + file + " is not at hand (looked as written and beside the model)";
-      return;
-    }
-    s.bodyMeshNames = strings(chj, "body_mesh");
-    s.garmentMeshNames = strings(chj, "garment_mesh");
-    s.simulationMeshNames = strings(chj, "simulation_mesh");
-    how = "imported from " + s.characterFile.string();
-  } else if (const std::string recipe = str(chj, "recipe"); !recipe.empty()) {
-    s.characterRecipe = findBakeFile(recipe, entry);
-    if (s.characterRecipe.empty()) {
-      note_ = "the bake's character recipe " + recipe + " is not at hand (looked as written and beside the model)";
-      return;
-    }
-    how = "the default character from recipe " + s.characterRecipe.string();
+  if (!baked.problem.empty()) {
+    note_ = baked.problem;
+    return;
   }
-  s.inputJoints = strings(ds, "input_joints");
+  const json& ds = baked.datasetSettings;
+  bake::DatasetBuildSettings& s = baked.settings;
+  const std::string how = baked.kind == bake::BakedCharacter::Kind::File ? "imported from " + baked.description : baked.description;
   if (s.inputJoints.empty())
     for (uint32_t j : entry.model.inputJoints) s.inputJoints.push_back(entry.model.skeleton.joints[j].name);
   try {
