@@ -8,14 +8,10 @@
 // per fetch: the mesh weights as vec4[instance][K4 / 4] (K4 = K rounded up to 4, zero padded; every
 // thread fetches the same texels) and the skin matrices as vec4[instance][joint][3], the top three
 // rows of each affine matrix (the bottom row is 0 0 0 1). On lavapipe a vec4 texel fetch costs about
-// what ONE scalar load through a buffer address costs (descriptor_binding.hpp): per instance this pass
-// went from 32 + 48 scalar address loads per vertex to 8 + 12 texel fetches, about 3.5x less time per
-// instance in bench_replay's deform stage. Shared-memory staging of the weights measured 2x slower on
-// lavapipe, whose shared-memory loads and barriers are costly, and so did a subgroup broadcast: one
-// weight texel fetched per lane, then subgroupBroadcast(texel, q) for q < K4 (with the bounds check
-// below replaced by a clamp, so that every lane is active) made the stage slower, not faster
-// (bench_replay, 12 alternating runs, fastest frame: 22 characters 3.70 -> 4.91 ms, 1 character
-// 0.90 -> 1.02 ms).
+// what ONE scalar load through a buffer address costs (descriptor_binding.hpp), so 8 + 12 fetches per
+// vertex and instance replace 32 + 48 scalar loads. Shared-memory staging of the weights and a subgroup
+// broadcast of them were both measured slower on lavapipe, whose shared-memory loads, barriers and
+// broadcasts are costly (figures: docs/performance.md, "Deform").
 //
 // Conforms to runtime/reference_pca.cpp (x = mean + sum_k basis_k * w_k, k ascending, starting at the
 // mean) and runtime/reference_skinning.cpp (core/skinning.cpp: B = sum over influences with w != 0 of
@@ -26,8 +22,7 @@
 // The basis: deform.comp reads it through its buffer address, deform_basis_texels.comp as R32 texels
 // (binding 2), where it fits in the device's maxTexelBufferElements (DeformPass decides). Lavapipe loads
 // through an address lane by lane, and the basis is 3K loads per vertex per frame, whatever the
-// instance count: with K = 64 (the default model then) bench_replay's 1-character frame went from 2.92 to
-// 2.44 ms with the texels (5 alternating runs, medians), 22 characters the same.
+// instance count, so the texel form pays most where characters are few (docs/performance.md).
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.

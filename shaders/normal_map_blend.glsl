@@ -9,30 +9,27 @@
 // max(c / 127, -1), prev snorm16 -> max(c / 32767, -1); mix written as prev * (1 - alpha) +
 // decoded * alpha; rounded to snorm16 by packSnorm2x16 (within 1 LSB of the reference's lround).
 // Why not the images themselves: on lavapipe a storage-image load or store of RG16_SNORM converts the
-// format lane by lane. bench_replay's blend stage (22 characters, 256x256 maps, one run alternating
-// with the former image form) went from 4.4 to 3.5 ms with the buffers, the copy and the exact
-// dispatch below.
+// format lane by lane; the buffers, the copy and the exact dispatch below are measurably faster
+// (docs/performance.md, "Normal-map blend", for this and the choices below).
 //
 // One invocation per column of ROWS x 4 texels of one character (ROWS block rows of 4 texels, a
 // multiple of 4: maps are multiples of 4; NormalMapBlendPass picks 16, 8 or 4, the largest dividing the
 // map height): the character's slot and alpha are loaded once for 4 * ROWS texels, and each row is ONE
 // texel fetch of decoded texels (R32G32_UINT: 4 texels of 2 snorm8 bytes), ONE texel fetch of prev
-// (R32G32B32A32_UINT: 4 packed texels) and ONE uvec4 store. One invocation per texel measured 2.2x
-// slower on lavapipe, which runs invocations 8 at a time on a CPU core and pays per-lane costs for
-// every buffer load and per invocation for the indexing and the character's (address) load; 16 rows
-// instead of 4 measured 20-25% faster (bench_replay, 22 characters of 256x256, blend stage, 12
-// alternating runs on a busy machine: fastest frame 2.81 -> 2.12 ms, median 3.16 -> 2.53 ms; 8 rows
-// 2.42 / 2.71 ms).
+// (R32G32B32A32_UINT: 4 packed texels) and ONE uvec4 store. Lavapipe runs invocations 8 at a time on a
+// CPU core and pays per-lane costs for every buffer load and per invocation for the indexing and the
+// character's (address) load, so fewer, fatter invocations win: one per texel was much slower, and 16
+// rows beat 4.
 //
 // Stores: lavapipe stores lane by lane and word by word, so where the device has shaderInt64 the pass
 // uses normal_map_blend_store64.comp, this code storing each row as two 64-bit words instead of four
-// 32-bit ones (same bits; blend stage 14% faster on lavapipe, bench_replay, 22 characters).
+// 32-bit ones (same bits, fewer stores).
 //
 // The dispatch is (block columns, height / ROWS, characters) with workgroups of ROW_GROUP block columns,
 // a divisor of the block columns that NormalMapBlendPass picks (EXACT), so that no invocation falls
 // outside the map and the shader needs no bounds check: on lavapipe a bounds check (an early return)
 // puts every store under an execution mask, a load, select and store per lane and component instead
-// of a store (the blend measured 4 to 14% faster without it). Where the block columns have no usable
+// of a store. Where the block columns have no usable
 // divisor, the pass picks 64 and EXACT = false, and the bounds check is compiled in.
 #include "swish_buffers.glsl"
 #include "swish_layouts.h"

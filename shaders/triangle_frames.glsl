@@ -10,14 +10,13 @@
 // (instance-independent) are loaded and computed once for all instances. The per-instance streams go
 // through the pass's descriptor set (binding numbers in swish_triangle_frames_layout.h): positions are
 // fetched as texels and the terms stored as nine floats of a storage buffer, the cheap ways on
-// lavapipe (descriptor_binding.hpp): lavapipe stores lane by lane and float by float, so the nine
-// floats cost 3/4 of the three padded vec4s (with a usable-UV flag) this pass stored before.
+// lavapipe (descriptor_binding.hpp): lavapipe stores lane by lane and float by float, so nine floats
+// cost 3/4 of three padded vec4s.
 //
 // Stores: where the device has shaderInt64, TangentFramesPass uses triangle_frames_store64.comp, this
 // code storing the first eight floats as four 64-bit words (same bits; the instance blocks start at a
-// multiple of 4 floats) and B.z as a float: 5 stores per triangle instead of 9. bench_replay, 22
-// characters, tangent stage, 10 alternating runs: fastest frame 2.88 -> 2.49 ms, median 3.20 -> 2.64
-// ms. Fetching the positions as R32G32B32_SFLOAT texels (3 fetches instead of 9) measured no faster.
+// multiple of 4 floats) and B.z as a float: 5 stores per triangle instead of 9 (measured in
+// docs/performance.md, "Tangent frames"; fetching positions as RGB32 texels was no faster).
 #include "swish_buffers.glsl"
 #include "swish_frame_math.glsl"
 #include "swish_triangle_frames_layout.h"

@@ -17,9 +17,7 @@
 // Stores: where the device has shaderInt64, TangentFramesPass uses vertex_frames_gather_store64.comp,
 // this code storing the tangent as two 64-bit words and the normal (3 floats from float 3o) as one
 // 64-bit word and a float, the word on the 8-byte aligned pair (x,y for even o, y,z for odd o; selects,
-// not branches): 4 stores instead of 7, same bits. bench_replay, 22 characters, tangent stage, with
-// the 64-bit triangle pass on both sides, 14 alternating runs on a busy machine: fastest frame 3.82 ->
-// 3.63 ms, median 4.46 -> 4.35 ms (2.49 -> 2.46 ms fastest in a quieter set of 10).
+// not branches): 4 stores instead of 7, same bits (docs/performance.md, "Tangent frames").
 #include "swish_frame_math.glsl"
 #include "swish_triangle_frames_layout.h"
 

@@ -4,10 +4,8 @@
 //
 // Why not buffer addresses for everything: lavapipe (Mesa 22.3), the CPU device the benchmarks run on,
 // loads through a buffer address one lane at a time and one component at a time (a loop per
-// component), while a texel fetch of a whole vec4 is one gather. Measured on lavapipe (llvmpipe, 8
-// lanes, one thread, cache-resident data), per 8-lane operation: scalar load through an address
-// ~10-14 ns, vec4 through an address ~52 ns; R32 texel fetch ~9 ns, RGBA32 texel fetch ~13 ns; vec4
-// store through an address ~58 ns, into a storage buffer ~27 ns. The per-instance streams (mesh
+// component), while a texel fetch of a whole vec4 is one gather, and a vec4 store into a storage
+// buffer costs about half one through an address (figures: docs/performance.md). The per-instance streams (mesh
 // weights, skin matrices, deformed positions, triangle terms, the adjacency walked per instance,
 // decoded maps) are therefore read as texel buffers and the vec4 outputs written through storage
 // buffers; model data read once per frame keeps its address, except the deform's PCA basis, the
