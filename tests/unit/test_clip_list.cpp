@@ -17,6 +17,7 @@
 #include "swish/bake/bake_config.hpp"
 #include "swish/bake/clip_list.hpp"
 #include "swish/bake/bake_evaluation.hpp"
+#include "swish/bake/bake_pipeline.hpp"
 #include "swish/bake/default_character.hpp"
 #include "swish/bake/pose_sampling.hpp"
 #include "swish/core/error.hpp"
@@ -248,7 +249,7 @@ TEST(ClipListCorpus, EveryClipOfBothSkeletonsReadsOntoTheDefaultCharacter) {
   for (size_t i = 0; i < clips.size(); ++i) EXPECT_EQ(clips[i].frames.size(), sources[i].expectedFrames) << sources[i].file;
 
   // Frame 0 of both conversions is a reference T-pose (arms along +-X, legs down). Through the joint map
-  // the character's upper arms, forearms and thighs point the same way in both (within 10 degrees; a
+  // the character's upper arms, forearms and thighs point the same way in both (within 10 degrees, the forearms 30; a
   // left/right swap or a wrong axis is 90 or more). Their local rotations differ more: the two rigs
   // twist their limbs differently at rest, and direction-based retargeting keeps that twist (printed).
   const auto gc = character.skeleton.globalTransforms(clips[0].frames[0]);
@@ -263,10 +264,11 @@ TEST(ClipListCorpus, EveryClipOfBothSkeletonsReadsOntoTheDefaultCharacter) {
     const double degrees = std::acos(std::clamp(double(dc.dot(dd)), -1.0, 1.0)) * 180.0 / M_PI;
     const double rotation = gc[a].rotation.angularDistance(gd[a].rotation) * 180.0 / M_PI;
     std::printf("T-pose, CMU vs Daz conversion: %-24s direction %5.1f deg, global rotation %5.1f deg\n", pair, degrees, rotation);
-    EXPECT_LT(degrees, 10.0) << pair << " of " << sources[67].file;
+    // The forearms differ by about 20 degrees: the Daz reference pose bends the elbows a little.
+    EXPECT_LT(degrees, p.find("ForeArm>") != std::string::npos ? 30.0 : 10.0) << pair << " of " << sources[67].file;
   }
-  // The chain bends the Daz spine over Spine and Spine1 alike (equal shares): over a clip, Spine
-  // turns as far as Spine1 does, never stays at rest.
+  // The chain bends the Daz spine over Spine and Spine1 by the map's shares (0.65 / 0.35): over a
+  // clip, Spine turns 0.65 / 0.35 times as far as Spine1, never stays at rest.
   const size_t spine = size_t(character.skeleton.find("Spine")), spine1 = size_t(character.skeleton.find("Spine1"));
   double a = 0.0, b = 0.0;
   for (const Pose& p : clips[67 + 7].frames) {  // 13_01: sit on a stool and stand up
@@ -274,7 +276,7 @@ TEST(ClipListCorpus, EveryClipOfBothSkeletonsReadsOntoTheDefaultCharacter) {
     b += p.local[spine1].angularDistance(clips[67 + 7].frames[0].local[spine1]);
   }
   EXPECT_GT(a, 0.0);
-  EXPECT_NEAR(a / b, 1.0, 0.05);
+  EXPECT_NEAR(a / b, 0.65 / 0.35, 0.05);
 }
 
 TEST(ClipListCorpus, ABadFileAmongManyIsNamed) {
@@ -357,4 +359,39 @@ TEST(ClipListCorpus, TheSpineChainSharesAreWhatTheCmuClipsShow) {
               rest0.mean, rest0.p95, rest1.mean, rest1.p95);
   EXPECT_NEAR(committed, share, 0.1);
   EXPECT_LT(split0.mean + split1.mean, rest0.mean + rest1.mean);
+}
+
+// The committed small corpus recipe (assets/corpus_small/bake.json, docs/baking.md) loads: both
+// skeletons' 150 clips, subjects 8 and 10 held out.
+TEST(ClipListCorpus, TheSmallCorpusRecipeLoads) {
+  SKIP_WITHOUT_CORPUS();
+  const BakeConfig cfg = loadBakeConfig(test::sourceDir() / "assets/corpus_small/bake.json");
+  ASSERT_TRUE(cfg.part1.has_value());
+  EXPECT_EQ(cfg.part1->clips.size(), 150u);
+  const auto [training, heldOut] = splitHeldOutSubjects(*cfg.part1);
+  EXPECT_EQ(heldOut.clips.size(), 17u);  // 11 walks of subject 8, 6 clips of subject 10
+  EXPECT_EQ(training.clips.size(), 133u);
+  EXPECT_EQ(heldOut.evenPoses, 60u);
+  EXPECT_FALSE(heldOut.includeRestPose);
+}
+
+TEST(ClipList, HeldOutSubjectsMustBeInTheListAndLeaveSomethingToTrainOn) {
+  const Corpus c;
+  auto config = [&](const nlohmann::json& holdout) {
+    return nlohmann::json{{"output", "o"},
+                          {"part1", {{"clips", {"mocap"}}, {"thinning", {{"target_poses", 10}}}, {"holdout", holdout}}}};
+  };
+  const BakeConfig ok = parseBakeConfig(config({{"subjects", {"2"}}, {"poses", 12}}), "recipe.json", c.base());
+  EXPECT_EQ(ok.part1->holdoutPoses, 12u);
+  const auto [training, heldOut] = splitHeldOutSubjects(*ok.part1);
+  EXPECT_EQ(training.clips.size(), 2u);
+  EXPECT_EQ(heldOut.clips.size(), 2u);
+  EXPECT_EQ(heldOut.clips[0].file.filename(), "02_01.bvh");
+  auto error = [&](const nlohmann::json& h) {
+    return test::errorOf([&] { parseBakeConfig(config(h), "recipe.json", c.base()); });
+  };
+  EXPECT_SAYS(error({{"subjects", {"7"}}}), "part1.holdout.subjects: no clip of subject '7'");
+  EXPECT_SAYS(error({{"subjects", {"1", "02"}}}), "holds out every clip");
+  EXPECT_SAYS(error({{"poses", 3}}), "part1.holdout.subjects: is required");
+  EXPECT_SAYS(error({{"subjects", {"2"}}, {"every", 3}}), "part1.holdout.every: unknown key");
 }
