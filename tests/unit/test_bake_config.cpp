@@ -115,7 +115,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(c.work, std::filesystem::path("/tmp/w"));  // absolute paths stay as they are
   EXPECT_EQ(c.dataset, std::filesystem::path("/tmp/w/dataset"));
   const DatasetBuildSettings& s = *c.part1;
-  EXPECT_EQ(s.characterFile, std::filesystem::path(__FILE__));
+  EXPECT_EQ(s.characterFile, std::filesystem::path(kThisFile));
   EXPECT_EQ(s.garmentMeshNames, std::vector<std::string>{"shirt"});
   EXPECT_EQ(s.clips[0].naming, io::JointNaming::Mixamo);
   ASSERT_EQ(s.clips[0].jointMap.size(), 1u);
