@@ -98,6 +98,10 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   EXPECT_LT(out.evaluation.truncationMm.max, 0.05);  // rank 3 data, 3 components: only float round-off
   EXPECT_LT(out.evaluation.totalMm.mean, 2.0);       // the MLP learns the smooth drive
   EXPECT_GT(out.evaluation.totalMm.mean, 0.0);
+  // The baselines on the same poses: skinning alone misses the displacements the network predicts; the
+  // PCA mean shape holds their average only.
+  EXPECT_GT(out.evaluation.restSkinnedMm.mean, 2.0 * out.evaluation.totalMm.mean);
+  EXPECT_GT(out.evaluation.meanSkinnedMm.mean, 2.0 * out.evaluation.totalMm.mean);
   EXPECT_LE(out.evaluation.normalTotal.meanDegrees, out.evaluation.normalSelection.meanDegrees + 1.5);
   EXPECT_EQ(out.model.normalMaps.mapCount(), 24u);
 
@@ -111,6 +115,8 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   EXPECT_FALSE(std::filesystem::is_empty(dir / "gallery"));
   const auto report = nlohmann::json::parse(std::ifstream(dir / "report.json"));
   EXPECT_DOUBLE_EQ(report["vertex_error_held_out"]["total"]["mean_mm"].get<double>(), out.evaluation.totalMm.mean);
+  EXPECT_DOUBLE_EQ(report["vertex_error_held_out"]["baseline_rest_skinned"]["p95_mm"].get<double>(),
+                   out.evaluation.restSkinnedMm.p95);
 
   saveModel(out.model, dir / "synthetic.swish");
   const Model loaded = loadModel(dir / "synthetic.swish");

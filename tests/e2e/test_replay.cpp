@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
 
 #include "support/gpu_test.hpp"
+#include "support/paths.hpp"
 #include "support/random_model.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
@@ -279,6 +281,45 @@ TEST_F(ReplayE2E, WritesPerFrameMeshesAndNormalMaps) {
     std::snprintf(name, sizeof name, "normal_maps/c1_%06d.png", f);
     EXPECT_TRUE(fs::exists(dir_ / "out" / name)) << name;
   }
+}
+
+// A clip on another skeleton (the Daz-rig CMU conversion, ../shared/mocap/cmu-daz) plays on the default
+// model through the joint map its scene entry names; without it the scene stops, naming the character
+// and asking for the pairs.
+TEST_F(ReplayE2E, AClipWithOtherJointNamesPlaysThroughItsJointMap) {
+  const fs::path clip = test::sharedMocap("cmu-daz/10_04.bvh");
+  if (!fs::exists(clip)) {
+    if (std::getenv("CI")) FAIL() << clip << " is absent in CI";
+    GTEST_SKIP() << clip << " is absent (the shared mocap corpus)";
+  }
+  const fs::path map = test::sourceDir() / "assets/joint_maps/cmu_daz.json";
+  json j{{"name", "daz"}, {"frames", {{"count", 3}, {"rate", 30}}}, {"outputs", {{"directory", "out"}}}};
+  j["characters"].push_back({{"name", "walker"}, {"model", "default"},
+                             {"animation", {{"file", clip.string()}, {"timeOffset", 1.0}, {"jointMap", map.string()}}}});
+  const auto r = replay::runReplayJob(scene(j), jobOptions());
+  EXPECT_FALSE(r.result.failed()) << (r.result.failures.empty() ? "" : r.result.failures[0]);
+  const json rep = json::parse(std::ifstream(dir_ / "out/report.json"));
+  EXPECT_EQ(rep["summary"]["frames"], 3);
+  EXPECT_LE(rep["summary"]["gpuVsCpu"]["maxPositionErrorMm"].get<double>(), replay::kPositionToleranceMm);
+
+  j["characters"][0]["animation"].erase("jointMap");
+  j["outputs"]["directory"] = "out2";
+  try {
+    replay::runReplayJob(scene(j), jobOptions());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("characters[0]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("add pairs to the joint map"), std::string::npos) << e.what();
+  }
+  // A malformed inline map is named by its JSON path.
+  j["characters"][0]["animation"]["jointMap"] = {{"chest", {{"joints", {"Spine", "Spine1"}}, {"shares", {0.9, 0.9}}}}};
+  try {
+    replay::runReplayJob(scene(j), jobOptions());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("characters[0].animation.jointMap.chest.shares"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }
 
 TEST_F(ReplayE2E, AnErrorLeavesNoPartialOutputs) {

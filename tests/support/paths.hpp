@@ -11,6 +11,10 @@ inline std::filesystem::path sharedAsset(const std::string& name) {
   return std::filesystem::path(SWISH_SHARED_ASSETS_DIR) / name;
 }
 inline std::filesystem::path sourceDir() { return SWISH_SOURCE_DIR; }
+// ../shared/mocap beside the project (the CMU motion corpus: cmu/, cmu-daz/, each with index.tsv).
+inline std::filesystem::path sharedMocap(const std::string& name = "") {
+  return std::filesystem::path(SWISH_SHARED_ASSETS_DIR).parent_path() / "mocap" / name;
+}
 // The CMU clips of Debian's assimp-testmodels package.
 inline std::filesystem::path debianMocap(const std::string& name) {
   return std::filesystem::path("/usr/share/assimp/models/BVH") / name;

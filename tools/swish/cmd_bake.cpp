@@ -2,12 +2,16 @@
 // writes <output>/<name>.swish and <output>/report/. The config is validated before any work. Part 1
 // (character + clips -> simulated poses -> dataset) and part 2 (dataset -> model) are both resumable:
 // interrupt it and run the same command again.
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "swish/bake/pipeline/bake_config.hpp"
 #include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/character/default_character.hpp"
+#include "swish/core/error.hpp"
 #include "swish/io/gltf_export.hpp"
 #include "swish/command.hpp"
 
@@ -16,15 +20,22 @@ namespace {
 swish::cli::RunFn setup(CLI::App& sub) {
   struct Opts {
     std::string config, defaultCharacterGlb;
-    bool force = false, checkOnly = false;
+    bool force = false, checkOnly = false, readClips = false;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("config", o->config, "bake recipe (JSON)");
+  sub.add_option("config", o->config,
+                 "bake recipe (JSON; schema in src/swish/bake/pipeline/bake_config.hpp). part1.clips takes files, folders, globs "
+                 "(\"mocap/cmu/*.bvh\") and index files ({\"index\": \"mocap/cmu-daz/index.tsv\", \"joint_map\": "
+                 "\"map.json\", \"weights\": {..}}: src/swish/bake/poses/clip_list.hpp); part1.holdout keeps whole subjects "
+                 "out of training and reports the model on them (docs/baking.md)");
   sub.add_option("--write-default-character", o->defaultCharacterGlb,
                  "write the embedded default character (mannequin + jersey, skinned) to a .glb file to look at "
                  "or to use as a starting point, and stop (regenerates assets/default/default_character.glb)");
   sub.add_flag("--force", o->force, "re-train part 2 even when the model is current");
   sub.add_flag("--check", o->checkOnly, "validate the config and stop");
+  sub.add_flag("--read-clips", o->readClips,
+               "validate the config, read and retarget every clip of part1.clips onto the character (in parallel; "
+               "a bad file stops it, named), print frames per subject and the time taken, and stop");
   return [o]() -> int {
     if (!o->defaultCharacterGlb.empty()) {
       swish::io::writeCharacterGlb(o->defaultCharacterGlb, swish::bake::makeDefaultCharacter());
@@ -46,8 +57,29 @@ swish::cli::RunFn setup(CLI::App& sub) {
                     cfg.part1->includeRestPose ? " (+ the rest pose unless one is near it)" : "",
                     cfg.part1->simulationVertices, cfg.part1->simulation.material.name.c_str(),
                     cfg.simulationDir().string().c_str(), cfg.dataset.string().c_str());
-      else
+      if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {
+        const auto [training, heldOut] = swish::bake::splitHeldOutSubjects(*cfg.part1);
+        std::string names;
+        for (const auto& n : cfg.part1->holdoutSubjects) names += (names.empty() ? "" : ", ") + n;
+        std::printf("held-out subjects %s: %zu clip(s) -> %zu evenly spaced frames -> dataset %s (training: %zu clip(s))\n",
+                    names.c_str(), heldOut.clips.size(), cfg.part1->holdoutPoses,
+                    cfg.holdoutDatasetDir().string().c_str(), training.clips.size());
+      }
+      if (!cfg.part1)
         std::printf("part 1: none (the dataset %s must exist)\n", cfg.dataset.string().c_str());
+      return 0;
+    }
+    if (o->readClips) {
+      if (!cfg.part1) throw swish::Error(o->config + ": --read-clips needs a \"part1\" section");
+      const auto start = std::chrono::steady_clock::now();
+      const swish::Character character = swish::bake::loadDatasetCharacter(*cfg.part1);
+      std::vector<std::string> joints = cfg.part1->inputJoints;
+      for (const auto& j : cfg.train.inputJoints)
+        if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
+      swish::bake::importClips(cfg.part1->clips, character.skeleton, joints, cfg.part1->threads,
+                               [](const std::string& line) { std::printf("%s\n", line.c_str()); });
+      std::printf("read-clips: done in %.2f s (character included)\n",
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       return 0;
     }
     swish::bake::BakeRunOptions run;

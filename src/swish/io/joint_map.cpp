@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <fstream>
 #include <unordered_map>
 
 #include "swish/core/error.hpp"
@@ -48,6 +50,8 @@ constexpr NamePair kUnrealToCmu[] = {
     {"footr", "RightFoot"},      {"ballr", "RightToeBase"},
 };
 
+constexpr int kDrivenByChain = -2;  // mapWith's mark while matching names: not free for a clip joint
+
 JointMapping mapWith(const std::vector<std::string>& clip, const Skeleton& character, JointNaming naming,
                      const JointMapOptions& options) {
   JointMapping m;
@@ -55,7 +59,7 @@ JointMapping mapWith(const std::vector<std::string>& clip, const Skeleton& chara
   m.sourceOf.assign(character.size(), -1);
   std::vector<bool> used(clip.size(), false);
   auto assign = [&](int charJoint, int clipJoint) {
-    if (charJoint < 0 || clipJoint < 0 || m.sourceOf[size_t(charJoint)] >= 0 || used[size_t(clipJoint)]) return;
+    if (charJoint < 0 || clipJoint < 0 || m.sourceOf[size_t(charJoint)] != -1 || used[size_t(clipJoint)]) return;
     m.sourceOf[size_t(charJoint)] = clipJoint;
     used[size_t(clipJoint)] = true;
   };
@@ -70,6 +74,14 @@ JointMapping mapWith(const std::vector<std::string>& clip, const Skeleton& chara
     if (j < 0) throw Error("joint map: character has no joint '" + charName + "' (explicit pair '" + clipName + "')");
     assign(j, c);
   }
+  // A chain's joints other than its last are driven through it (retarget.hpp), never by a clip joint
+  // of the same name.
+  for (const JointChain& chain : options.chains)
+    for (size_t i = 0; i < chain.joints.size(); ++i) {
+      const int j = character.find(chain.joints[i]);
+      if (j < 0) throw Error("joint map: character has no joint '" + chain.joints[i] + "' (a chain)");
+      if (i + 1 < chain.joints.size()) m.sourceOf[size_t(j)] = kDrivenByChain;
+    }
   auto table = [&](const NamePair* begin, const NamePair* end) {
     for (const NamePair* p = begin; p != end; ++p) assign(character.find(p->cmu), clipIndex(p->clip));
   };
@@ -78,10 +90,89 @@ JointMapping mapWith(const std::vector<std::string>& clip, const Skeleton& chara
   // Names that agree after normalisation (the whole map for naming == Same), then CMU variants.
   for (size_t j = 0; j < character.size(); ++j) assign(int(j), clipIndex(character.joints[j].name));
   table(std::begin(kCmuVariants), std::end(kCmuVariants));
+  for (int& s : m.sourceOf)
+    if (s == kDrivenByChain) s = -1;
   return m;
 }
 
+[[noreturn]] void fail(const std::string& what, const std::string& key, const std::string& problem) {
+  throw Error(what + (key.empty() ? "" : "." + key) + ": " + problem);
+}
+
 }  // namespace
+
+JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& what) {
+  if (!json.is_object())
+    fail(what, "", "must be a JSON object {\"clip joint\": \"character joint\" or [chain joints, parent first]}");
+  JointMapOptions out;
+  for (auto it = json.begin(); it != json.end(); ++it) {
+    const std::string& clipJoint = it.key();
+    if (clipJoint.empty()) fail(what, "\"\"", "an empty clip joint name");
+    const nlohmann::json& v = it.value();
+    if (v.is_string()) {
+      if (v.get<std::string>().empty()) fail(what, clipJoint, "must be a non-empty joint name");
+      out.explicitPairs.emplace_back(clipJoint, v.get<std::string>());
+      continue;
+    }
+    JointChain chain;
+    const nlohmann::json* joints = &v;
+    if (v.is_object()) {
+      for (auto k = v.begin(); k != v.end(); ++k)
+        if (k.key() != "joints" && k.key() != "shares")
+          fail(what, clipJoint + "." + k.key(), "unknown key (known: joints, shares)");
+      if (!v.contains("joints")) fail(what, clipJoint + ".joints", "is required (the chain, parent first)");
+      joints = &v.at("joints");
+    } else if (!v.is_array()) {
+      fail(what, clipJoint, "must be a character joint name, an array of chain joints or {\"joints\", \"shares\"}");
+    }
+    if (!joints->is_array() || joints->empty())
+      fail(what, clipJoint, "a chain must list at least one character joint, parent first");
+    for (const auto& j : *joints) {
+      if (!j.is_string() || j.get<std::string>().empty()) fail(what, clipJoint, "chain joints must be non-empty names");
+      chain.joints.push_back(j.get<std::string>());
+    }
+    if (v.is_object() && v.contains("shares")) {
+      const auto& sh = v.at("shares");
+      if (!sh.is_array() || sh.size() != chain.joints.size())
+        fail(what, clipJoint + ".shares", "must hold one number per chain joint (" + std::to_string(chain.joints.size()) + ")");
+      double sum = 0.0;
+      for (const auto& x : sh) {
+        if (!x.is_number() || !(x.get<double>() >= 0.0 && x.get<double>() <= 1.0))
+          fail(what, clipJoint + ".shares", "each share must be a number in 0..1");
+        chain.shares.push_back(x.get<float>());
+        sum += x.get<double>();
+      }
+      if (std::abs(sum - 1.0) > 1e-3) fail(what, clipJoint + ".shares", "must sum to 1 (they sum to " + std::to_string(sum) + ")");
+    } else {
+      chain.shares.assign(chain.joints.size(), 1.f / float(chain.joints.size()));
+    }
+    out.explicitPairs.emplace_back(clipJoint, chain.joints.back());
+    if (chain.joints.size() > 1) out.chains.push_back(std::move(chain));
+  }
+  return out;
+}
+
+JointMapOptions readJointMapFile(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot open the joint map file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file.string() + ": the joint map is not valid JSON: " + e.what());
+  }
+  return parseJointMap(j, file.string());
+}
+
+nlohmann::json jointMapToJson(const JointMapOptions& map) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [clip, character] : map.explicitPairs) {
+    out[clip] = character;
+    for (const JointChain& c : map.chains)
+      if (!c.joints.empty() && c.joints.back() == character) out[clip] = {{"joints", c.joints}, {"shares", c.shares}};
+  }
+  return out;
+}
 
 size_t JointMapping::mappedCount() const {
   return size_t(std::count_if(sourceOf.begin(), sourceOf.end(), [](int s) { return s >= 0; }));

@@ -3,9 +3,22 @@
 // normalisation (namespace prefixes such as "mixamorig:" or "Armature|" dropped, case and '_', ' ', '.'
 // ignored). Where a clip's naming differs from the character's (CMU), a small table of conventions
 // translates it: Mixamo and Unreal mannequin names onto CMU names. Explicit pairs override everything.
+//
+// A clip joint may also drive a chain of character joints (JointChain): a skeleton with fewer spine
+// joints than the character's (the Daz rig's abdomen + chest against CMU's LowerBack, Spine, Spine1)
+// drives the chain's last joint, and that joint's rotation relative to the chain's parent is shared out
+// along the chain (retarget.hpp), so the spine bends over all its joints instead of one.
+//
+// Joint maps as JSON (a bake recipe's clips, a scene's animation, or a file they name):
+//   {"clip joint": "character joint",                       one pair
+//    "chest": ["Spine", "Spine1"],                          a chain, equal shares, parent first
+//    "chest": {"joints": ["Spine", "Spine1"], "shares": [0.4, 0.6]}}   a chain with its shares
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "swish/core/skeleton.hpp"
 
@@ -13,11 +26,29 @@ namespace swish::io {
 
 enum class JointNaming { Auto, Same, Mixamo, Unreal };
 
+// The character joints `joints` (parent first, each the next one's parent) are driven together by the
+// clip joint paired with the last of them; joint i takes shares[i] of the rotation (the shares sum to 1).
+struct JointChain {
+  std::vector<std::string> joints;
+  std::vector<float> shares;
+};
+
 struct JointMapOptions {
   JointNaming naming = JointNaming::Auto;  // Auto: whichever convention maps the most joints
   // Explicit clip joint name -> character joint name pairs, applied first.
   std::vector<std::pair<std::string, std::string>> explicitPairs;
+  std::vector<JointChain> chains;  // each chain's last joint is one of explicitPairs' character joints
+  bool empty() const { return explicitPairs.empty() && chains.empty(); }
 };
+
+// A joint map from its JSON form (above). `what` names it in errors ("scene.json: characters[2].animation.
+// joint_map.chest: ..."): a non-object, a non-string joint, an empty chain, shares that do not match
+// the joints or do not sum to 1.
+JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& what);
+// A joint map file: a JSON object of the same form; Error naming the file when missing or malformed.
+JointMapOptions readJointMapFile(const std::filesystem::path& file);
+// The JSON form back (for manifests, fingerprints and reports).
+nlohmann::json jointMapToJson(const JointMapOptions& map);
 
 struct JointMapping {
   std::vector<int> sourceOf;  // per character joint: index of the clip joint that drives it, or -1

@@ -1,5 +1,6 @@
 #include "swish/io/retarget.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "swish/core/error.hpp"
@@ -22,6 +23,62 @@ std::optional<Quatd> kabsch(const std::vector<Vec3d>& a, const std::vector<Vec3d
   return Quatd(svd.matrixV() * d * svd.matrixU().transpose()).normalized();
 }
 
+// A chain of character joints driven together (JointChain): indices, parent first, and per joint its
+// share and Q_i, the product of the chain's rest local rotations up to and including joint i.
+struct ResolvedChain {
+  std::vector<size_t> joints;
+  std::vector<double> shares;
+  std::vector<Quatd> restUpTo;
+  int parent = -1;  // the first joint's parent
+};
+
+std::vector<ResolvedChain> resolveChains(const std::vector<JointChain>& chains, const Skeleton& character,
+                                         const JointMapping& map, const std::string& what) {
+  std::vector<ResolvedChain> out;
+  for (const JointChain& c : chains) {
+    ResolvedChain r;
+    std::string names;
+    for (const auto& n : c.joints) names += (names.empty() ? "" : ", ") + n;
+    Quatd q = Quatd::Identity();
+    for (size_t i = 0; i < c.joints.size(); ++i) {
+      const int j = character.find(c.joints[i]);
+      if (j < 0) throw Error(what + ": joint map chain [" + names + "]: the character has no joint '" + c.joints[i] + "'");
+      if (i > 0 && character.joints[size_t(j)].parent != int(r.joints.back()))
+        throw Error(what + ": joint map chain [" + names + "]: '" + c.joints[i] + "' is not the child of '" +
+                    c.joints[i - 1] + "' in the character");
+      r.joints.push_back(size_t(j));
+      r.shares.push_back(i < c.shares.size() ? double(c.shares[i]) : 1.0 / double(c.joints.size()));
+      q = q * character.joints[size_t(j)].rest.rotation.cast<double>();
+      r.restUpTo.push_back(q);
+    }
+    if (map.sourceOf[r.joints.back()] < 0)
+      throw Error(what + ": joint map chain [" + names + "]: no clip joint drives its last joint '" + c.joints.back() + "'");
+    r.parent = character.joints[r.joints.front()].parent;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// D^t for a rotation D: the shortest-arc fraction t of it.
+Quatd power(const Quatd& d, double t) {
+  const Quatd s = d.w() < 0 ? Quatd(-d.w(), -d.x(), -d.y(), -d.z()) : d;
+  return Quatd::Identity().slerp(t, s);
+}
+
+// Shares the rotation D that the chain's joints add to their rest rotations (in the frame of the
+// chain's parent: global(last) = G_parent * D * Q_last) out along the chain: local_i = Q_{i-1}^-1 *
+// D^{share_i} * Q_i. The product of the new locals is D * Q_last, so the last joint's global rotation,
+// and every joint below it, is unchanged; D = identity gives the rest locals back.
+void shareChain(const ResolvedChain& c, const std::vector<Quatd>& global, Pose& pose) {
+  const Quatd parent = c.parent < 0 ? Quatd::Identity() : global[size_t(c.parent)];
+  const Quatd d = (parent.conjugate() * global[c.joints.back()] * c.restUpTo.back().conjugate()).normalized();
+  Quatd before = Quatd::Identity();
+  for (size_t i = 0; i < c.joints.size(); ++i) {
+    pose.local[c.joints[i]] = (before.conjugate() * power(d, c.shares[i]) * c.restUpTo[i]).normalized().cast<float>();
+    before = c.restUpTo[i];
+  }
+}
+
 }  // namespace
 
 AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, const RetargetOptions& options,
@@ -37,7 +94,10 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
   for (const auto& name : options.requiredJoints) {
     const int j = character.find(name);
     if (j < 0) throw Error(what + ": the character has no joint '" + name + "' (a required joint)");
-    if (map.sourceOf[size_t(j)] < 0 && j != 0) unmatched.push_back(name);
+    const bool inChain = std::any_of(options.jointMap.chains.begin(), options.jointMap.chains.end(), [&](const JointChain& c) {
+      return std::find(c.joints.begin(), c.joints.end(), name) != c.joints.end();
+    });
+    if (map.sourceOf[size_t(j)] < 0 && j != 0 && !inChain) unmatched.push_back(name);
   }
   if (!unmatched.empty()) {
     std::string list, clipNames;
@@ -47,6 +107,8 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
                 " (clip joints: " + clipNames + (clip.jointNames.size() > 12 ? ", ..." : "") +
                 "); add pairs to the joint map");
   }
+
+  const std::vector<ResolvedChain> chains = resolveChains(options.jointMap.chains, character, map, what);
 
   // Rest globals of both skeletons, in double.
   const auto charRest = character.globalTransforms(character.restPose());
@@ -125,6 +187,7 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
       if (!pose.local[h].coeffs().allFinite())
         throw Error(what + ", frame " + std::to_string(f) + ": non-finite rotation for joint '" + character.joints[h].name + "'");
     }
+    for (const ResolvedChain& c : chains) shareChain(c, global, pose);
     const Vec3d d = g[size_t(rootSource)].translation.cast<double>() - root0;
     pose.rootTranslation = character.joints[0].rest.translation + (double(scale) * d).cast<float>();
   }

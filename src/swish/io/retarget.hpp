@@ -9,7 +9,10 @@
 // least-squares rotation (Kabsch) of all of them. Then, per frame,
 //     R_h(t) = R_s(t) * R_s(rest)^-1 * A_h * R_h(rest)          (global rotations)
 // so each character bone points where the clip's bone points. Unmapped joints keep their rest local
-// rotation. Root translation: the character's rest root plus the clip root's displacement from its
+// rotation, except along a joint map chain (joint_map.hpp): there the rotation D the chain adds to its
+// rest rotations (global(last) = G_parent * D * Q_last, Q_i the product of the chain's rest locals up to
+// joint i) is shared out, local_i = Q_{i-1}^-1 * D^share_i * Q_i, so the last joint's global rotation
+// (and all below it) stays the clip's while the bend spreads over the chain. Root translation: the character's rest root plus the clip root's displacement from its
 // first frame, scaled by the ratio of the skeletons' mapped bone lengths (clip units -> metres).
 #include <string>
 #include <vector>

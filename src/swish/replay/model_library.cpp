@@ -128,10 +128,12 @@ std::map<std::string, const Model*> ModelLibrary::modelMap() const {
   return m;
 }
 
-std::shared_ptr<const AnimationClip> ModelLibrary::clip(const fs::path& file, const std::string& key) {
-  auto& slot = clips_[{file.string(), key}];
+std::shared_ptr<const AnimationClip> ModelLibrary::clip(const fs::path& file, const std::string& key,
+                                                       const nlohmann::json& jointMap, const std::string& what) {
+  auto& slot = clips_[{file.string(), key, jointMap.dump()}];
   if (!slot) {
     io::AnimationImportOptions o;
+    if (!jointMap.is_null()) o.retarget.jointMap = io::parseJointMap(jointMap, what);
     o.retarget.requiredJoints.clear();  // a model's input joints are checked below, by the caller's model
     for (uint32_t j : at(key).model.inputJoints) o.retarget.requiredJoints.push_back(at(key).model.skeleton.joints[j].name);
     slot = std::make_shared<AnimationClip>(io::importAnimation(file, at(key).model.skeleton, o));

@@ -8,9 +8,12 @@
 //      clip /usr/share/assimp/models/BVH/01_01.bvh, and every report says so (ModelEntry::label).
 #include <filesystem>
 #include <map>
+#include <tuple>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "swish/core/character.hpp"
 #include "swish/model/model.hpp"
@@ -37,12 +40,15 @@ class ModelLibrary {
   std::map<std::string, const Model*> modelMap() const;
   const std::vector<std::unique_ptr<ModelEntry>>& entries() const { return entries_; }
 
-  // The clip of `file` retargeted onto model `key`'s skeleton, imported once per (file, model).
-  std::shared_ptr<const AnimationClip> clip(const std::filesystem::path& file, const std::string& key);
+  // The clip of `file` retargeted onto model `key`'s skeleton through `jointMap` (io/joint_map.hpp's
+  // JSON form; null: by naming convention), imported once per (file, model, joint map). `what` names
+  // the joint map in errors ("scene.json: characters[2].animation.jointMap").
+  std::shared_ptr<const AnimationClip> clip(const std::filesystem::path& file, const std::string& key,
+                                            const nlohmann::json& jointMap = nullptr, const std::string& what = "jointMap");
 
  private:
   std::vector<std::unique_ptr<ModelEntry>> entries_;
-  std::map<std::pair<std::string, std::string>, std::shared_ptr<const AnimationClip>> clips_;
+  std::map<std::tuple<std::string, std::string, std::string>, std::shared_ptr<const AnimationClip>> clips_;
 };
 
 // Where the project's assets/ folder is looked for, in order: the current folder, the swish

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "swish/core/types.hpp"
 
 namespace swish::runtime {
@@ -35,6 +37,10 @@ struct SceneClip {
   std::string clipName;        // empty: the file's (only) clip; else must match it
   double timeOffsetSeconds = 0.0;  // clip time at scene time 0 (wraps around the clip's length)
   double speed = 1.0;          // playback speed, > 0
+  // The clip's joint map (io/joint_map.hpp's JSON form: pairs and chains), inline or read from
+  // jointMapFile; null: the names are matched by convention. The replay parses it (io::parseJointMap).
+  nlohmann::json jointMap;
+  std::filesystem::path jointMapFile;  // empty: inline or none
 };
 
 struct SceneCharacter {

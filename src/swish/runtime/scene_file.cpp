@@ -105,7 +105,7 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
   if (r.has("animation") == r.has("poseStream")) r.fail("needs exactly one of \"animation\" and \"poseStream\"");
   if (r.has("animation")) {
     const Reader a = r.child("animation");
-    a.requireObject({"file", "clip", "timeOffset", "speed"});
+    a.requireObject({"file", "clip", "timeOffset", "speed", "jointMap"});
     SceneClip clip;
     const Reader file = a.required("file");
     clip.file = resolve(base, file.string());
@@ -115,6 +115,22 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
     if (a.has("speed")) {
       clip.speed = a.child("speed").number();
       if (!(clip.speed > 0.0 && clip.speed <= 100.0)) a.child("speed").fail("must be in (0, 100]");
+    }
+    if (a.has("jointMap")) {
+      const Reader m = a.child("jointMap");
+      if (m.value().is_string()) {
+        clip.jointMapFile = resolve(base, m.string());
+        if (checkFiles) {
+          requireFile(m, clip.jointMapFile);
+          clip.jointMap = readJsonFile(clip.jointMapFile, "joint map");
+          if (!clip.jointMap.is_object()) m.fail(clip.jointMapFile.string() + ": the joint map must be a JSON object");
+        }
+      } else if (m.value().is_object()) {
+        clip.jointMap = m.value();
+      } else {
+        m.fail("must be a joint map object {\"clip joint\": \"character joint\"} or a joint map file, is " +
+               std::string(m.value().type_name()));
+      }
     }
     c.clip = clip;
   } else {
@@ -213,6 +229,8 @@ json sceneToJson(const Scene& s) {
     if (c.clip)
       cj["animation"] = {{"file", c.clip->file.string()}, {"clip", c.clip->clipName},
                          {"timeOffset", c.clip->timeOffsetSeconds}, {"speed", c.clip->speed}};
+    if (c.clip && !c.clip->jointMapFile.empty()) cj["animation"]["jointMap"] = c.clip->jointMapFile.string();
+    else if (c.clip && !c.clip->jointMap.is_null()) cj["animation"]["jointMap"] = c.clip->jointMap;
     if (c.poseStream) cj["poseStream"] = c.poseStream->string();
     const auto& t = c.placement.translation;
     cj["placement"] = {{"translation", {t.x(), t.y(), t.z()}}, {"yawDegrees", c.placement.yawDegrees}};

@@ -30,7 +30,10 @@
 //         "file": "/usr/share/assimp/models/BVH/01_01.bvh",   BVH (or any assimp animation)
 //         "clip": "01_01",                    optional: must match the file's clip name
 //         "timeOffset": 1.5,                  seconds into the clip at scene time 0 (wraps), default 0
-//         "speed": 1.0                        playback speed in (0, 100], default 1
+//         "speed": 1.0,                       playback speed in (0, 100], default 1
+//         "jointMap": "daz_to_cmu.json"       optional: the clip's joint map (io/joint_map.hpp), a file
+//                                             or inline {"clip joint": "model joint" or [chain]}, for
+//                                             clips whose joint names no convention matches
 //       },
 //       "poseStream": "qb_poses.json",        a recorded pose stream (replay/pose_stream.hpp)
 //       "placement": {                        optional

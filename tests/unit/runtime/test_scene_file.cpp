@@ -155,6 +155,27 @@ TEST_F(SceneFileTest, InvalidJsonAndMissingSceneFile) {
   EXPECT_THROW(swish::runtime::loadScene(dir_ / "absent.json"), swish::Error);
 }
 
+TEST_F(SceneFileTest, AJointMapIsInlineOrAFile) {
+  json j = valid();
+  j["characters"][0]["animation"]["jointMap"] = {{"hip", "Hips"}, {"chest", {"Spine", "Spine1"}}};
+  std::ofstream(dir_ / "daz.json") << R"({"abdomen": "LowerBack"})";
+  j["characters"][1]["animation"]["jointMap"] = "daz.json";
+  const auto s = parseScene(j, source());
+  EXPECT_EQ(s.characters[0].clip->jointMap["hip"], "Hips");
+  EXPECT_TRUE(s.characters[0].clip->jointMapFile.empty());
+  EXPECT_EQ(s.characters[1].clip->jointMapFile, dir_ / "daz.json");
+  EXPECT_EQ(s.characters[1].clip->jointMap["abdomen"], "LowerBack");
+  EXPECT_EQ(swish::runtime::sceneToJson(s)["characters"][1]["animation"]["jointMap"], (dir_ / "daz.json").string());
+
+  j["characters"][1]["animation"]["jointMap"] = "none.json";
+  EXPECT_NE(errorOf(j).find("characters[1].animation.jointMap"), std::string::npos) << errorOf(j);
+  j["characters"][1]["animation"]["jointMap"] = 3;
+  EXPECT_NE(errorOf(j).find("must be a joint map object"), std::string::npos) << errorOf(j);
+  std::ofstream(dir_ / "list.json") << "[1, 2]";
+  j["characters"][1]["animation"]["jointMap"] = "list.json";
+  EXPECT_NE(errorOf(j).find("the joint map must be a JSON object"), std::string::npos) << errorOf(j);
+}
+
 TEST(DefaultScene, FootballPlayParses) {
   const fs::path file = swish::test::sourceDir() / "assets/scenes/football.json";
   const bool haveClips = fs::exists(swish::test::debianMocap("01_01.bvh")) && fs::exists(swish::test::debianMocap("01_03.bvh"));

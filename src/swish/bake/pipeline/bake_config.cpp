@@ -4,6 +4,7 @@
 #include <set>
 #include <sstream>
 
+#include "swish/bake/poses/clip_list.hpp"
 #include "swish/core/error.hpp"
 #include "swish/files/json_file.hpp"
 
@@ -93,39 +94,6 @@ void parseCharacter(const Checker& c, const nlohmann::json& v, const std::filesy
   s.simulationMeshNames = c.strings(v, p, "simulation_mesh", {});
 }
 
-void parseClips(const Checker& c, const nlohmann::json& v, const std::filesystem::path& baseDir,
-                DatasetBuildSettings& s) {
-  const std::string p = "part1.clips";
-  if (!v.is_array() || v.empty()) c.fail(p, "must be a non-empty array of clip files or clip objects");
-  for (size_t i = 0; i < v.size(); ++i) {
-    const std::string q = p + "[" + std::to_string(i) + "]";
-    ClipSource clip;
-    if (v[i].is_string()) {
-      clip.file = c.existingFile(v[i], q, baseDir);
-    } else {
-      c.onlyKeys(v[i], q, {"file", "naming", "joint_map", "fps"});
-      if (!v[i].contains("file")) c.fail(q + ".file", "is required");
-      clip.file = c.existingFile(v[i].at("file"), q + ".file", baseDir);
-      const std::string naming = c.string(v[i], "naming", "auto", q);
-      if (naming == "auto") clip.naming = io::JointNaming::Auto;
-      else if (naming == "same") clip.naming = io::JointNaming::Same;
-      else if (naming == "mixamo") clip.naming = io::JointNaming::Mixamo;
-      else if (naming == "unreal") clip.naming = io::JointNaming::Unreal;
-      else c.fail(q + ".naming", "'" + naming + "' is not one of auto, same, mixamo, unreal");
-      if (v[i].contains("joint_map")) {
-        const auto& m = v[i].at("joint_map");
-        if (!m.is_object()) c.fail(q + ".joint_map", "must be an object {\"clip joint\": \"character joint\"}");
-        for (auto it = m.begin(); it != m.end(); ++it) {
-          if (!it.value().is_string()) c.fail(q + ".joint_map." + it.key(), "must be a joint name (string)");
-          clip.jointMap.emplace_back(it.key(), it.value().get<std::string>());
-        }
-      }
-      clip.framesPerSecond = c.number(v[i], q, "fps", 0, 1000, 0);
-    }
-    s.clips.push_back(std::move(clip));
-  }
-}
-
 // The "simulation", "transfer" and "normal_maps" objects of `j` (named `prefix` in errors): a bake
 // config's part1, or the settings a dataset and a baked model carry (DatasetBuildSettings::toJson).
 void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::string& prefix, DatasetBuildSettings& s) {
@@ -188,12 +156,33 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
 DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const std::filesystem::path& baseDir) {
   c.onlyKeys(j, "part1",
              {"character", "clips", "input_joints", "sampling", "thinning", "simulation", "transfer", "normal_maps",
-              "preview"});
+              "preview", "holdout"});
   DatasetBuildSettings s;
   if (j.contains("character")) parseCharacter(c, j.at("character"), baseDir, s);
   if (!j.contains("clips")) c.fail("part1.clips", "is required (the animation to sample poses from)");
-  parseClips(c, j.at("clips"), baseDir, s);
+  s.clips = parseClipList(j.at("clips"), c.source.empty() ? "" : c.source + ": ", baseDir);
   s.inputJoints = c.strings(j, "part1", "input_joints", s.inputJoints);
+
+  if (j.contains("holdout")) {
+    // Whole subjects kept out of training, evaluated on evenly spaced frames of their clips.
+    const nlohmann::json& h = j.at("holdout");
+    const std::string p = "part1.holdout";
+    c.onlyKeys(h, p, {"subjects", "poses"});
+    s.holdoutSubjects = c.strings(h, p, "subjects", {});
+    if (s.holdoutSubjects.empty()) c.fail(p + ".subjects", "is required (the subjects to hold out)");
+    s.holdoutPoses = size_t(c.number(h, p, "poses", 1, 1e6, 200, true));
+    std::set<std::string> held;
+    for (const auto& subject : s.holdoutSubjects) held.insert(normaliseSubject(subject));
+    std::set<std::string> seen;
+    size_t training = 0;
+    for (const ClipSource& clip : s.clips) {
+      seen.insert(normaliseSubject(clip.subject));
+      training += !held.count(normaliseSubject(clip.subject));
+    }
+    for (const auto& subject : s.holdoutSubjects)
+      if (!seen.count(normaliseSubject(subject))) c.fail(p + ".subjects", "no clip of subject '" + subject + "' in part1.clips");
+    if (training == 0) c.fail(p + ".subjects", "holds out every clip: nothing is left to train on");
+  }
 
   const nlohmann::json sampling = j.value("sampling", nlohmann::json::object());
   std::string p = "part1.sampling";

@@ -14,9 +14,13 @@
 //     "part1": {                         part 1 (bake/pipeline/part1_dataset.hpp); absent: the dataset must exist
 //       "character": "default" | {"recipe": "recipe.json"} |
 //                    {"file": "x.glb", "body_mesh": [..], "garment_mesh": [..], "simulation_mesh": [..]},
-//       "clips": ["a.bvh", {"file": "b.fbx", "naming": "auto|same|mixamo|unreal",
-//                           "joint_map": {"clip joint": "character joint"}, "fps": 0}],
+//       "clips": ["a.bvh", "mocap/cmu/*.bvh", {"file": "b.fbx", "naming": "auto|same|mixamo|unreal",
+//                           "joint_map": {"clip joint": "character joint"} | "map.json", "fps": 0,
+//                           "weight": 1}, {"index": "mocap/cmu-daz/index.tsv", "joint_map": ..}]
+//                  (folders, globs, index files, weights, subjects: bake/poses/clip_list.hpp),
 //       "input_joints": ["LowerBack", ...],
+//       "holdout": {"subjects": ["8", "14"], "poses": 200},   whole subjects kept out of training and
+//                  evaluated on `poses` frames evenly spaced over their clips (bake/report/subject_evaluation.hpp)
 //       "sampling": {"characters", "seconds_per_character", "sample_rate", "mirror_odd_characters",
 //                    "speed_jitter", "seed"},
 //       "thinning": {"tolerance": 0.1} | {"target_poses": 200}, plus "include_rest_pose" (default true:
@@ -64,6 +68,9 @@ struct BakeConfig {
   std::filesystem::path reportDir() const { return output / "report"; }
   std::filesystem::path simulationDir() const { return work / "simulation"; }
   std::filesystem::path previewDir() const { return reportDir() / "dataset_preview"; }
+  // The held-out subjects' poses (part1.holdout): their own simulations and dataset.
+  std::filesystem::path holdoutSimulationDir() const { return work / "simulation_holdout"; }
+  std::filesystem::path holdoutDatasetDir() const { return work / "holdout_dataset"; }
 };
 
 // `source` names the config in error messages; `baseDir` resolves relative paths.

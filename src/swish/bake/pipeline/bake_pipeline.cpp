@@ -4,7 +4,13 @@
 #include <cstdio>
 #include <fstream>
 
+#include <optional>
+#include <set>
+
 #include "swish/bake/report/bake_report.hpp"
+#include "swish/bake/poses/clip_list.hpp"
+#include "swish/bake/report/subject_evaluation.hpp"
+#include "swish/files/json_file.hpp"
 #include "swish/bake/dataset/dataset_io.hpp"
 #include "swish/core/error.hpp"
 #include "swish/files/atomic_write.hpp"
@@ -18,6 +24,10 @@ using Clock = std::chrono::steady_clock;
 std::string fingerprint(const BakeConfig& cfg) {
   std::ifstream in(cfg.dataset / "manifest.json");
   std::string manifest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {  // the held-out subjects' dataset is evaluated too
+    std::ifstream h(cfg.holdoutDatasetDir() / "manifest.json");
+    manifest += std::string((std::istreambuf_iterator<char>(h)), std::istreambuf_iterator<char>());
+  }
   return std::to_string(std::hash<std::string>{}(manifest)) + "/" + cfg.train.toJson().dump();
 }
 
@@ -34,6 +44,24 @@ bool part2Current(const BakeConfig& cfg) {
 }
 }  // namespace
 
+std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const DatasetBuildSettings& s) {
+  DatasetBuildSettings training = s, heldOut = s;
+  training.clips.clear();
+  heldOut.clips.clear();
+  std::set<std::string> held;
+  for (const auto& subject : s.holdoutSubjects) held.insert(normaliseSubject(subject));
+  for (const ClipSource& c : s.clips) (held.count(normaliseSubject(c.subject)) ? heldOut : training).clips.push_back(c);
+  if (held.empty()) return {training, heldOut};
+  if (training.clips.empty()) throw Error("bake part 1: part1.holdout holds out every clip: nothing is left to train on");
+  // Frames as a game plays them, one character, unmirrored; nothing added, nothing previewed.
+  heldOut.evenPoses = s.holdoutPoses;
+  heldOut.includeRestPose = false;
+  heldOut.previewPoses = 0;
+  heldOut.sampling.characters = 1;
+  heldOut.sampling.mirrorOddCharacters = false;
+  return {training, heldOut};
+}
+
 BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   const auto t0 = Clock::now();
   auto log = [&](const std::string& s) {
@@ -49,10 +77,18 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     log("part 1: building the dataset " + cfg.dataset.string());
     DatasetBuildSettings part1Settings = *cfg.part1;
     part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
-    const DatasetBuildResult part1 = buildDataset(part1Settings, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
+    const auto [training, heldOut] = splitHeldOutSubjects(part1Settings);
+    const DatasetBuildResult part1 = buildDataset(training, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
+    if (!heldOut.clips.empty()) {
+      log("part 1: the held-out subjects' frames: " + std::to_string(heldOut.clips.size()) + " clips -> " +
+          cfg.holdoutDatasetDir().string());
+      const DatasetBuildResult h = buildDataset(heldOut, cfg.holdoutDatasetDir(), cfg.holdoutSimulationDir(), {}, opt.log);
+      res.holdoutPart1 = h.toJson();
+    }
     res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
     res.part1 = part1.toJson();
     res.part1["seconds"] = res.part1Seconds;
+    if (!res.holdoutPart1.is_null()) res.part1["held_out_subjects"] = res.holdoutPart1;
     std::filesystem::create_directories(cfg.reportDir());
     writeTextFileAtomic(cfg.reportDir() / "part1.json", res.part1.dump(2) + "\n");
     char line[256];
@@ -87,13 +123,29 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
       std::snprintf(line, sizeof line, "part 2: %3.0f%% %-32s %6.1f s elapsed", 100.0 * f, stage.c_str(), el);
     log(line);
   });
+  std::optional<SubjectEvaluation> subjects;
+  if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {
+    log("part 2: evaluating on the held-out subjects' dataset " + cfg.holdoutDatasetDir().string());
+    const Dataset holdout = readDataset(cfg.holdoutDatasetDir());
+    const nlohmann::json origins = readJsonFile(cfg.holdoutDatasetDir() / "pose_origins.json", "pose origins");
+    subjects = evaluateHeldOutSubjects(out, ds, holdout, origins, cfg.part1->holdoutSubjects, cfg.part1->holdoutPoses);
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "part 2: held-out subjects: %zu poses, vertex error mean %.2f mm, p95 %.2f mm (rest shape skinned "
+                  "%.2f / %.2f mm); random held-out frames of training clips %.2f / %.2f mm",
+                  subjects->overall.poses, subjects->overall.totalMm.mean, subjects->overall.totalMm.p95,
+                  subjects->overall.restSkinnedMm.mean, subjects->overall.restSkinnedMm.p95, out.evaluation.totalMm.mean,
+                  out.evaluation.totalMm.p95);
+    log(line);
+  }
   Model model = out.model;
   nlohmann::json meta = nlohmann::json::parse(model.metadata);
+  if (subjects) meta["errors"]["held_out_subjects"] = subjects->toJson();
   meta["bake_fingerprint"] = fingerprint(cfg);
   meta["name"] = cfg.name;
   model.metadata = meta.dump();
   std::filesystem::create_directories(cfg.output);
-  writeBakeReport(out, ds, cfg.reportDir());
+  writeBakeReport(out, ds, cfg.reportDir(), 4, subjects ? &*subjects : nullptr);
   saveModel(model, cfg.modelPath());  // last: its presence marks part 2 done
   res.part2Seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();

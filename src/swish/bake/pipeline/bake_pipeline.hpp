@@ -22,7 +22,14 @@ struct BakeRunResult {
   bool part2Skipped = false;
   double seconds = 0.0, part1Seconds = 0.0, part2Seconds = 0.0;
   nlohmann::json part1;  // DatasetBuildResult::toJson + "seconds" (also <report>/part1.json); null without part 1
+  nlohmann::json holdoutPart1;  // the held-out subjects' dataset build (part1.holdout); null without
 };
+
+// Part 1's settings split by part1.holdout: the training clips (the held-out subjects' removed) and the
+// held-out subjects' clips, with the settings that build their evaluation dataset (evenly spaced
+// frames, one unmirrored character, no rest pose, no preview). Without held-out subjects the second has
+// no clips. Throws Error when every clip is held out.
+std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const DatasetBuildSettings& settings);
 
 BakeRunResult runBake(const BakeConfig& config, const BakeRunOptions& options = {});
 

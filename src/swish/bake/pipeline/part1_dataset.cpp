@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <mutex>
 
 #include <tbb/parallel_for.h>
@@ -90,6 +91,83 @@ bool resetDatasetIfStale(const fs::path& dir, const nlohmann::json& settings,
 
 }  // namespace
 
+PoseSamples evenlySpacedFrames(const std::vector<AnimationClip>& clips, size_t count) {
+  PoseSamples out;
+  double total = 0.0;
+  for (const AnimationClip& c : clips) total += double(std::max<size_t>(c.frames.size(), 2) - 1);
+  for (uint32_t ci = 0; ci < clips.size(); ++ci) {
+    const size_t frames = clips[ci].frames.size();
+    if (frames == 0) throw Error("clip " + std::to_string(ci) + " '" + clips[ci].name + "' has no frames");
+    const double span = double(std::max<size_t>(frames, 2) - 1);  // frames 1 .. frames-1 (or frame 0 alone)
+    const size_t k = std::max<size_t>(1, size_t(std::llround(double(count) * span / total)));
+    for (size_t i = 0; i < k; ++i) {
+      const double f = frames < 2 ? 0.0 : 1.0 + (double(i) + 0.5) * (span - 1.0) / double(k);
+      out.origins.push_back({0, ci, float(f), false});
+    }
+  }
+  return out;
+}
+
+std::vector<AnimationClip> importClips(const std::vector<ClipSource>& sources, const Skeleton& skeleton,
+                                       const std::vector<std::string>& requiredJoints, int threads,
+                                       const std::function<void(const std::string&)>& log) {
+  // Each clip is read and retargeted on its own (BVH parsing dominates), in parallel; the first
+  // failure in list order is reported, naming its file, so the message does not depend on timing.
+  const auto start = Clock::now();
+  std::vector<AnimationClip> clips(sources.size());
+  std::vector<std::string> errors(sources.size());
+  auto one = [&](size_t i) {
+    const ClipSource& c = sources[i];
+    try {
+      io::AnimationImportOptions o;
+      o.retarget.jointMap.naming = c.naming;
+      o.retarget.jointMap.explicitPairs = c.jointMap;
+      o.retarget.jointMap.chains = c.jointChains;
+      o.retarget.requiredJoints = requiredJoints;
+      o.framesPerSecond = c.framesPerSecond;
+      clips[i] = io::importAnimation(c.file, skeleton, o);
+      if (c.expectedFrames > 0 && clips[i].frames.size() != c.expectedFrames)
+        errors[i] = c.file.string() + ": " + std::to_string(clips[i].frames.size()) + " frames, but its index file says " +
+                    std::to_string(c.expectedFrames);
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      errors[i] = what.find(c.file.string()) == std::string::npos ? c.file.string() + ": " + what : what;
+    }
+  };
+  if (threads > 0) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] { tbb::parallel_for(size_t(0), sources.size(), size_t(1), one); });
+  } else {
+    tbb::parallel_for(size_t(0), sources.size(), size_t(1), one);
+  }
+  size_t failures = 0;
+  for (const auto& e : errors) failures += !e.empty();
+  for (const auto& e : errors)
+    if (!e.empty())
+      throw Error("bake part 1: clip " + e +
+                  (failures > 1 ? " (and " + std::to_string(failures - 1) + " more clips failed)" : std::string()));
+  if (log) {
+    size_t frames = 0;
+    std::map<std::string, size_t> perSubject;
+    for (size_t i = 0; i < clips.size(); ++i) {
+      frames += clips[i].frames.size();
+      perSubject[sources[i].subject] += 1;
+      if (clips.size() <= 20)
+        log("part 1: clip " + sources[i].file.string() + ": " + std::to_string(clips[i].frames.size()) + " frames at " +
+            std::to_string(int(clips[i].framesPerSecond)) + " fps" +
+            (sources[i].weight != 1.0 ? ", weight " + std::to_string(sources[i].weight) : std::string()));
+    }
+    std::string subjects;
+    for (const auto& [subject, n] : perSubject)
+      subjects += (subjects.empty() ? "" : ", ") + (subject.empty() ? std::string("(none)") : subject) + ": " + std::to_string(n);
+    char line[160];
+    std::snprintf(line, sizeof line, "part 1: %zu clips, %zu frames read and retargeted in %.2f s; clips per subject: ",
+                  clips.size(), frames, since(start));
+    log(line + subjects);
+  }
+  return clips;
+}
+
 Character loadDatasetCharacter(const DatasetBuildSettings& s) {
   if (!s.characterFile.empty()) {
     io::CharacterImportOptions o;
@@ -119,9 +197,17 @@ nlohmann::json DatasetBuildSettings::toJson() const {
     for (const auto& [a, b] : c.jointMap) m[a] = b;
     clipList.push_back({{"file", c.file.string()}, {"naming", namingName(c.naming)}, {"joint_map", m},
                         {"fps", c.framesPerSecond}});
+    // Keys that decide the poses only where they are set, so recipes without them keep their datasets.
+    if (!c.jointChains.empty()) {
+      io::JointMapOptions o;
+      o.explicitPairs = c.jointMap;
+      o.chains = c.jointChains;
+      clipList.back()["joint_map"] = io::jointMapToJson(o);
+    }
+    if (c.weight != 1.0) clipList.back()["weight"] = c.weight;
   }
   const ClothSimSettings& m = simulation;
-  return {
+  nlohmann::json out = {
       {"character",
        {{"file", characterFile.string()}, {"recipe", characterRecipe.string()}, {"body_mesh", bodyMeshNames},
         {"garment_mesh", garmentMeshNames}, {"simulation_mesh", simulationMeshNames}}},
@@ -144,6 +230,10 @@ nlohmann::json DatasetBuildSettings::toJson() const {
        {{"size", transfer.normalMap.width}, {"max_distance", transfer.normalMap.maxDistance},
         {"dilation_rings", transfer.normalMap.dilationRings}, {"bit_depth", normalMapBitDepth}}},
   };
+  // Set only where used, so that recipes without them keep their datasets.
+  if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
+  if (evenPoses > 0) out["even_poses"] = evenPoses;
+  return out;
 }
 
 nlohmann::json DatasetBuildResult::toJson() const {
@@ -171,7 +261,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   DatasetBuildResult res;
   auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
   if (s.clips.empty()) throw Error("bake part 1: no animation clips");
-  if ((s.thinningTolerance > 0.f) == (s.targetPoses > 0))
+  if (s.evenPoses == 0 && (s.thinningTolerance > 0.f) == (s.targetPoses > 0))
     throw Error("bake part 1: give exactly one of a thinning tolerance and a target pose count");
   s.simulation.validate();
 
@@ -193,44 +283,47 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   step("character", t);
 
   t = Clock::now();
-  std::vector<AnimationClip> clips;
-  for (const ClipSource& c : s.clips) {
-    io::AnimationImportOptions o;
-    o.retarget.jointMap.naming = c.naming;
-    o.retarget.jointMap.explicitPairs = c.jointMap;
-    o.retarget.requiredJoints = s.inputJoints;
-    o.framesPerSecond = c.framesPerSecond;
-    clips.push_back(io::importAnimation(c.file, character.skeleton, o));
-    res.clipFrames += clips.back().frames.size();
-    log("part 1: clip " + c.file.string() + ": " + std::to_string(clips.back().frames.size()) + " frames at " +
-        std::to_string(int(clips.back().framesPerSecond)) + " fps");
-  }
+  const std::vector<AnimationClip> clips = importClips(s.clips, character.skeleton, s.inputJoints, s.threads, log);
+  for (const AnimationClip& c : clips) res.clipFrames += c.frames.size();
   step("clips", t);
 
   // Poses: sample, thin, back to full-skeleton poses.
   t = Clock::now();
   PoseSamplingOptions so = s.sampling;
   so.joints = s.inputJoints;
-  const PoseSamples samples = samplePoses(character.skeleton, clips, so);
-  res.samples = samples.size();
-  const ThinningResult thin =
-      s.targetPoses > 0 ? thinPosesToCount(samples, s.targetPoses) : thinPoses(samples, s.thinningTolerance);
+  if (std::any_of(s.clips.begin(), s.clips.end(), [](const ClipSource& c) { return c.weight != 1.0; }))
+    for (const ClipSource& c : s.clips) so.clipWeights.push_back(c.weight);
+  const PoseSamples samples = s.evenPoses > 0 ? evenlySpacedFrames(clips, s.evenPoses)
+                                             : samplePoses(character.skeleton, clips, so);
+  res.samples = samples.origins.size();
+  ThinningResult thin;
+  if (s.evenPoses > 0) {
+    for (uint32_t k = 0; k < samples.origins.size(); ++k) thin.kept.push_back(k);
+  } else {
+    thin = s.targetPoses > 0 ? thinPosesToCount(samples, s.targetPoses) : thinPoses(samples, s.thinningTolerance);
+  }
   res.tolerance = thin.tolerance;
   std::vector<Pose> poses;
-  for (uint32_t k : thin.kept)
-    poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, samples.origins[k])));
+  res.origins = nlohmann::json::array();
+  for (uint32_t k : thin.kept) {
+    const PoseSamples::Origin& o = samples.origins[k];
+    poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, o)));
+    res.origins.push_back({{"clip", s.clips[o.clip].file.stem().string()}, {"subject", s.clips[o.clip].subject},
+                           {"frame", o.frame}, {"mirrored", o.mirrored}});
+  }
   {
     char line[200];
     std::snprintf(line, sizeof line, "part 1: %zu samples thinned to %zu poses (tolerance %.4f, %d passes) in %.2f s",
                   res.samples, poses.size(), double(thin.tolerance), thin.passes, since(t));
     log(line);
   }
-  if (s.includeRestPose) {
+  if (s.includeRestPose && s.evenPoses == 0) {
     const Pose rest = canonicalPose(character.skeleton, character.skeleton.restPose());
     const float nearest = nearestKeptDistance(samples, thin.kept, runtime::computeTheta(inputJoints, rest.local));
     if (nearest > thin.tolerance) {
       poses.push_back(rest);
       res.restPoseAdded = true;
+      res.origins.push_back({{"clip", "rest pose"}});
     }
     char line[200];
     std::snprintf(line, sizeof line, "part 1: the rest pose is %.4f from the nearest kept pose: ", double(nearest));
@@ -302,6 +395,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
   res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
   const DatasetWriter writer(datasetDir, character, inputJoints, settingsJson, s.normalMapBitDepth);
+  writeTextFileAtomic(datasetDir / "pose_origins.json", res.origins.dump(1) + "\n");
 
   // Simulation (resumable per pose; failures are recorded in their files and left out).
   t = Clock::now();

@@ -35,11 +35,16 @@
 
 namespace swish::bake {
 
+// One clip of the recipe (bake/poses/clip_list.hpp expands folders, globs and index files into these).
 struct ClipSource {
   std::filesystem::path file;
   io::JointNaming naming = io::JointNaming::Auto;
   std::vector<std::pair<std::string, std::string>> jointMap;  // clip joint -> character joint
+  std::vector<io::JointChain> jointChains;                    // character joints driven together
   double framesPerSecond = 0.0;                               // resampling of key-framed formats; 0: the file's
+  double weight = 1.0;                                        // sampling density (pose_sampling.hpp)
+  std::string subject;                                        // the performer (held-out subjects, reports)
+  size_t expectedFrames = 0;                                  // an index file's frame count (0: unknown)
 };
 
 struct DatasetBuildSettings {
@@ -56,7 +61,17 @@ struct DatasetBuildSettings {
   std::vector<std::string> alsoRequiredJoints;
   PoseSamplingOptions sampling;   // .joints is replaced by inputJoints
 
-  // Thinning: exactly one of the two is > 0.
+  // Whole subjects kept out of training (part1.holdout): their clips are not sampled for the dataset;
+  // the bake simulates `holdoutPoses` frames of them, evenly spaced over their clips, into a second
+  // dataset (BakeConfig::holdoutDatasetDir) that part 2 evaluates the model on (subject_evaluation.hpp).
+  std::vector<std::string> holdoutSubjects;
+  size_t holdoutPoses = 0;
+  // > 0: instead of sampling and thinning, this many frames evenly spaced over the clips (each clip
+  // in proportion to its length, at least one, frame 0 skipped: the conversions put a reference
+  // T-pose there). The held-out subjects' dataset is built this way: frames as a game plays them.
+  size_t evenPoses = 0;
+
+  // Thinning: exactly one of the two is > 0 (unless evenPoses is).
   float thinningTolerance = 0.f;
   size_t targetPoses = 0;
   // The character's rest pose (the A-pose every simulation starts from) joins the kept poses, last,
@@ -85,6 +100,18 @@ struct DatasetBuildSettings {
   PoseShapeSettings poseShape() const;
 };
 
+// `count` frames evenly spaced over the clips (DatasetBuildSettings::evenPoses), as samples with
+// origins only (no Theta values: nothing is thinned).
+PoseSamples evenlySpacedFrames(const std::vector<AnimationClip>& clips, size_t count);
+
+// Reads and retargets the clips onto `skeleton` in parallel (`threads` 0: all cores). Throws Error
+// naming the first clip in list order that fails (missing, malformed, unmapped joints, a frame count
+// other than its index file's), with the number of other failures. `log` gets one summary line (and a
+// line per clip for short lists).
+std::vector<AnimationClip> importClips(const std::vector<ClipSource>& sources, const Skeleton& skeleton,
+                                       const std::vector<std::string>& requiredJoints, int threads,
+                                       const std::function<void(const std::string&)>& log = {});
+
 // The character the settings name: the embedded default, the default from a recipe file, or an
 // imported glTF/FBX file. Throws Error naming the file on failure.
 Character loadDatasetCharacter(const DatasetBuildSettings& settings);
@@ -110,6 +137,9 @@ struct DatasetBuildResult {
   bool rebuilt = false;            // settings had changed: the dataset's pose files were deleted first
   std::vector<DatasetBuildStep> steps;
   std::vector<std::filesystem::path> previews;
+  // Per pose id: where it came from ({"clip", "subject", "frame", "mirrored"}; the rest pose part 1
+  // adds: {"clip": "rest pose"}). Also written to <dataset>/pose_origins.json.
+  nlohmann::json origins;
   nlohmann::json toJson() const;
 };
 

@@ -202,6 +202,8 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       {"vertex_total", toJson(ev.totalMm)},
       {"vertex_pca_truncation", toJson(ev.truncationMm)},
       {"vertex_regression", toJson(ev.regressionMm)},
+      {"vertex_baseline_rest_skinned", toJson(ev.restSkinnedMm)},
+      {"vertex_baseline_mean_skinned", toJson(ev.meanSkinnedMm)},
       {"mesh_components", K},
       {"mesh_explained_variance", out.meshPca.explainedVariance[K]},
       {"mlp", {{"best_epoch", out.regressor.bestEpoch}, {"epochs", out.regressor.epochsRun},

@@ -77,6 +77,25 @@ PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationCli
   if (!(options.sampleRate >= 0.0) || !(options.secondsPerCharacter >= 0.0))
     throw Error("pose sampling: sample rate and duration must be >= 0");
   for (size_t c = 0; c < clips.size(); ++c) checkClip(skeleton, clips[c], c);
+  const std::vector<double>& weights = options.clipWeights;
+  if (!weights.empty() && weights.size() != clips.size())
+    throw Error("pose sampling: " + std::to_string(weights.size()) + " clip weights for " + std::to_string(clips.size()) + " clips");
+  double weightSum = 0.0;
+  for (double w : weights) {
+    if (!(w > 0.0) || !std::isfinite(w)) throw Error("pose sampling: clip weights must be > 0");
+    weightSum += w;
+  }
+  auto weightOf = [&](size_t clip) { return weights.empty() ? 1.0 : weights[clip]; };
+  // A clip drawn with probability proportional to its weight (uniform, as before weights, without them).
+  auto drawClip = [&](Rng& rng) -> uint32_t {
+    if (weights.empty()) return uint32_t(rng.below(clips.size()));
+    double x = rng.uniform(0.0, weightSum);
+    for (size_t i = 0; i < weights.size(); ++i) {
+      if (x < weights[i]) return uint32_t(i);
+      x -= weights[i];
+    }
+    return uint32_t(weights.size() - 1);
+  };
 
   std::vector<int> joints, mirroredJoints;
   const auto mirror = mirrorMap(skeleton);
@@ -110,7 +129,7 @@ PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationCli
       for (uint32_t ci = 0; ci < clips.size(); ++ci) {
         const AnimationClip& clip = clips[ci];
         const double rate = options.sampleRate > 0 ? options.sampleRate : clip.framesPerSecond;
-        const double step = speed * clip.framesPerSecond / rate;
+        const double step = speed * clip.framesPerSecond / (rate * weightOf(ci));
         const double last = double(clip.frames.size() - 1);
         for (double f = 0.0; f <= last + 1e-9; f += step) emit(c, ci, float(f), mirrored);
       }
@@ -118,7 +137,7 @@ PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationCli
     }
     // A recording of the given length: clips one after another in random order, the first one
     // entered at a random frame (character 0 starts at clip 0, frame 0).
-    uint32_t ci = c == 0 ? 0 : uint32_t(rng.below(clips.size()));
+    uint32_t ci = c == 0 ? 0 : drawClip(rng);
     double frame = c == 0 ? 0.0 : rng.uniform(0.0, double(clips[ci].frames.size() - 1));
     const double rate = options.sampleRate > 0 ? options.sampleRate : clips[0].framesPerSecond;
     const size_t count = size_t(std::llround(options.secondsPerCharacter * rate));
@@ -126,7 +145,7 @@ PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationCli
       emit(c, ci, float(frame), mirrored);
       frame += speed * clips[ci].framesPerSecond / rate;
       if (frame > double(clips[ci].frames.size() - 1)) {
-        ci = uint32_t(rng.below(clips.size()));
+        ci = drawClip(rng);
         frame = 0.0;
       }
     }

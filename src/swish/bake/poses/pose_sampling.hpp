@@ -40,6 +40,10 @@ struct PoseSamplingOptions {
   bool mirrorOddCharacters = true;   // characters 1, 3, 5... play mirrored (left <-> right)
   float speedJitter = 0.1f;          // characters > 0 play at 1 +- this (uniform)
   uint64_t seed = 1;
+  // Per clip (empty: all 1), > 0: how densely the clip is sampled. Every clip once: weight w samples
+  // it at w times the rate. A recording of given length: a clip is entered with probability
+  // proportional to its weight. The thinning then works on the union (pose_thinning.hpp).
+  std::vector<double> clipWeights;
 };
 
 // Samples the clips (already retargeted onto `skeleton`) into Theta vectors. Throws Error when a joint

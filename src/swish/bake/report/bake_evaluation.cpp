@@ -53,7 +53,10 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
   }
   // The PCA basis as a PcaResult-like projector for the truncation error.
   const MatXf& basis = model.meshPca.basis;
-  std::vector<double> total, trunc, regr;
+  std::vector<double> total, trunc, regr, restSkinned, meanSkinned;
+  Points3f meanShape(Eigen::Index(n), 3);
+  for (size_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) meanShape(Eigen::Index(v), k) = model.meshPca.mean[Eigen::Index(3 * v + size_t(k))];
   total.reserve(n * heldOut.size());
   trunc.reserve(n * heldOut.size());
   regr.reserve(n * heldOut.size());
@@ -74,6 +77,8 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
     const Points3f truncated = runtime::referenceSkin(
         runtime::referencePcaReconstruct(model.meshPca, std::span<const float>(projected.data(), size_t(K))),
         model.gameMesh.skin, mats);
+    const Points3f restBaseline = runtime::referenceSkin(model.gameMesh.positions, model.gameMesh.skin, mats);
+    const Points3f meanBaseline = runtime::referenceSkin(meanShape, model.gameMesh.skin, mats);
     PoseEvaluation pe;
     pe.poseId = p->id;
     for (size_t v = 0; v < n; ++v) {
@@ -85,6 +90,12 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
       pe.meanMm += e / double(n);
       pe.truncationMeanMm += t / double(n);
       pe.maxMm = std::max(pe.maxMm, e);
+      const double r = 1000.0 * double((restBaseline.row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm());
+      const double m = 1000.0 * double((meanBaseline.row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm());
+      restSkinned.push_back(r);
+      meanSkinned.push_back(m);
+      pe.restSkinnedMeanMm += r / double(n);
+      pe.meanSkinnedMeanMm += m / double(n);
     }
     if (ev.hasNormalMaps) {
       const VecXf trueCode = normalMapCode(*normalPca, p->normalMap);
@@ -105,6 +116,8 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
   ev.totalMm = distanceStats(std::move(total));
   ev.truncationMm = distanceStats(std::move(trunc));
   ev.regressionMm = distanceStats(std::move(regr));
+  ev.restSkinnedMm = distanceStats(std::move(restSkinned));
+  ev.meanSkinnedMm = distanceStats(std::move(meanSkinned));
   ev.normalDatabase = dbAcc.stats();
   ev.normalSelection = selAcc.stats();
   ev.normalTotal = totAcc.stats();

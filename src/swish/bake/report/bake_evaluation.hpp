@@ -8,6 +8,9 @@
 //   truncation = skin(PCA projection of the true pre-skin shape) vs truth  (what K components can hold)
 //   regression = skin(prediction) vs skin(PCA projection)                  (what the MLP gets wrong)
 //   total      = skin(prediction) vs truth
+// and two baselines on the same poses, so a reader sees whether the network helps at all:
+//   rest skinned = skin(the garment's rest shape) vs truth        (linear skinning, no correctives)
+//   mean skinned = skin(the PCA mean shape) vs truth               (the average corrective, no network)
 // Normal-map angular error (degrees) against the baked map of the pose:
 //   database   = the uncompressed database map nearest the pose's TRUE code    (what 128 maps can hold)
 //   selection  = the uncompressed database map nearest the PREDICTED code
@@ -37,6 +40,7 @@ struct PoseEvaluation {
   uint32_t poseId = 0;
   double meanMm = 0.0, maxMm = 0.0;
   double truncationMeanMm = 0.0;
+  double restSkinnedMeanMm = 0.0, meanSkinnedMeanMm = 0.0;  // the baselines' mean on this pose
   double normalTotalDegrees = 0.0;  // mean over texels (NaN-free; 0 without normal maps)
   uint32_t selectedMap = 0, idealMap = 0;
 };
@@ -44,6 +48,7 @@ struct PoseEvaluation {
 struct BakeEvaluation {
   size_t poses = 0;
   DistanceStats totalMm, truncationMm, regressionMm;
+  DistanceStats restSkinnedMm, meanSkinnedMm;  // the baselines
   bool hasNormalMaps = false;
   AngularErrorStats normalDatabase, normalSelection, normalTotal, normalVqAdded;
   double selectionAgreement = 0.0;  // share of poses whose predicted map is the ideal one

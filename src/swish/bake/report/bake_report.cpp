@@ -56,7 +56,9 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   r["mesh_pca"] = {{"components", out.meshPca.components()}, {"method", out.meshPca.randomized ? "randomized" : "exact"},
                    {"per_k", perK}};
   r["vertex_error_held_out"] = {{"total", toJson(ev.totalMm)}, {"pca_truncation", toJson(ev.truncationMm)},
-                                {"regression", toJson(ev.regressionMm)}};
+                                {"regression", toJson(ev.regressionMm)},
+                                {"baseline_rest_skinned", toJson(ev.restSkinnedMm)},
+                                {"baseline_mean_skinned", toJson(ev.meanSkinnedMm)}};
   r["mlp"] = {{"best_epoch", out.regressor.bestEpoch}, {"epochs_run", out.regressor.epochsRun},
               {"best_validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds},
               {"activation", activationName(out.regressor.activation)}};
@@ -82,7 +84,7 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   nlohmann::json worst = nlohmann::json::array();
   for (size_t i : worstPoses(ev, 8)) {
     const auto& p = ev.perPose[i];
-    worst.push_back({{"pose", p.poseId}, {"mean_mm", p.meanMm}, {"max_mm", p.maxMm}, {"truncation_mean_mm", p.truncationMeanMm},
+    worst.push_back({{"pose", p.poseId}, {"mean_mm", p.meanMm}, {"max_mm", p.maxMm}, {"truncation_mean_mm", p.truncationMeanMm}, {"rest_skinned_mean_mm", p.restSkinnedMeanMm},
                      {"normal_deg", p.normalTotalDegrees}, {"selected_map", p.selectedMap}, {"ideal_map", p.idealMap}});
   }
   r["worst_poses"] = worst;
@@ -90,9 +92,10 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
 }
 
 std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset& ds, const std::filesystem::path& dir,
-                                      size_t galleryPoses) {
+                                      size_t galleryPoses, const SubjectEvaluation* subjects) {
   std::filesystem::create_directories(dir);
-  const nlohmann::json r = bakeReportJson(out, ds);
+  nlohmann::json r = bakeReportJson(out, ds);
+  if (subjects) r["held_out_subjects"] = subjects->toJson();
   writeTextFileAtomic(dir / "report.json", r.dump(2) + "\n");
   const auto& ev = out.evaluation;
 
@@ -133,9 +136,12 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   row("total", ev.totalMm);
   row("PCA truncation", ev.truncationMm);
   row("regression (MLP)", ev.regressionMm);
+  row("baseline: rest shape skinned (no correctives)", ev.restSkinnedMm);
+  row("baseline: PCA mean shape skinned", ev.meanSkinnedMm);
   md << "\nK = " << out.meshPca.components() << " components explain "
      << f2(100.0 * out.meshPca.explainedVariance[out.meshPca.components()]) << "% of the training variance ("
      << (out.meshPca.randomized ? "randomised" : "exact") << " SVD).\n\n![error against K](error_vs_k.svg)\n\n";
+  if (subjects) md << subjects->markdown(ev);
   md << "## MLP\n\n" << activationName(out.regressor.activation) << ", best validation epoch " << out.regressor.bestEpoch
      << " of " << out.regressor.epochsRun << ", validation loss " << f3(out.regressor.bestValidationLoss) << ", trained in "
      << f2(out.regressor.seconds) << " s.\n\n![training curve](training_curve.svg)\n\n";
@@ -165,7 +171,8 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
          << " maps (" << f2(double(out.bc5AtVqMemoryBytes) / 1048576.0) << " MiB): the equal-memory row above.";
     md << "\n\n";
   }
-  md << "## Worst held-out poses\n\n| pose | mean mm | max mm | truncation mm | normal deg | gallery |\n|---|---|---|---|---|---|\n";
+  md << "## Worst held-out poses\n\n| pose | mean mm | max mm | truncation mm | rest skinned mm | normal deg | gallery |\n"
+        "|---|---|---|---|---|---|---|\n";
   std::filesystem::create_directories(dir / "gallery");
   std::vector<std::filesystem::path> galleryFiles;
   size_t shown = 0;
@@ -191,7 +198,7 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
       }
     }
     md << "| " << p.poseId << " | " << f2(p.meanMm) << " | " << f2(p.maxMm) << " | " << f2(p.truncationMeanMm) << " | "
-       << f2(p.normalTotalDegrees) << " | " << cell << " |\n";
+       << f2(p.restSkinnedMeanMm) << " | " << f2(p.normalTotalDegrees) << " | " << cell << " |\n";
   }
   // The worst poses of an earlier bake are other poses: their images must not linger in the gallery.
   constexpr std::string_view kGallerySuffixes[] = {"_truth.png", "_runtime.png"};

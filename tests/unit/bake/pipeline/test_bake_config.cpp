@@ -14,6 +14,8 @@ using namespace swish;
 using namespace swish::bake;
 
 namespace {
+// An existing file for the clip lists (not __FILE__: with CCACHE_BASEDIR the compiler sees a relative path).
+const std::string kThisFile = (test::sourceDir() / "tests/unit/test_bake_config.cpp").string();
 std::string errorOf(const nlohmann::json& j) {
   return test::errorOf([&] { parseBakeConfig(j, "recipe.json", "/base"); });
 }
@@ -73,7 +75,7 @@ namespace {
 // A part 1 section whose clip exists (this very source file stands in: the config only checks that
 // files exist; reading them is part 1's work).
 nlohmann::json part1(nlohmann::json extra = nlohmann::json::object()) {
-  nlohmann::json p = {{"clips", {std::string(__FILE__)}}, {"thinning", {{"target_poses", 200}}}};
+  nlohmann::json p = {{"clips", {kThisFile}}, {"thinning", {{"target_poses", 200}}}};
   for (auto it = extra.begin(); it != extra.end(); ++it) p[it.key()] = it.value();
   return p;
 }
@@ -100,8 +102,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
 
   const BakeConfig c = parseBakeConfig(
       {{"output", "o"}, {"work", "/tmp/w"},
-       {"part1", part1({{"character", {{"file", std::string(__FILE__)}, {"garment_mesh", {"shirt"}}}},
-                        {"clips", {{{"file", std::string(__FILE__)}, {"naming", "mixamo"},
+       {"part1", part1({{"character", {{"file", kThisFile}, {"garment_mesh", {"shirt"}}}},
+                        {"clips", {{{"file", kThisFile}, {"naming", "mixamo"},
                                     {"joint_map", {{"Hips", "Hips"}}}}}},
                         {"input_joints", {"Spine", "Spine1"}},
                         {"thinning", {{"tolerance", 0.25}, {"include_rest_pose", false}}},
@@ -113,7 +115,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(c.work, std::filesystem::path("/tmp/w"));  // absolute paths stay as they are
   EXPECT_EQ(c.dataset, std::filesystem::path("/tmp/w/dataset"));
   const DatasetBuildSettings& s = *c.part1;
-  EXPECT_EQ(s.characterFile, std::filesystem::path(__FILE__));
+  EXPECT_EQ(s.characterFile, std::filesystem::path(kThisFile));
   EXPECT_EQ(s.garmentMeshNames, std::vector<std::string>{"shirt"});
   EXPECT_EQ(s.clips[0].naming, io::JointNaming::Mixamo);
   ASSERT_EQ(s.clips[0].jointMap.size(), 1u);
@@ -150,15 +152,15 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"thinning", {{"target_poses", 10}, {"include_rest_pose", 1}}}}), "part1.thinning.include_rest_pose");
   says(part1Error({{"clips", {"/nonexistent/walk.bvh"}}}), "part1.clips[0]: file /nonexistent/walk.bvh does not exist");
   says(part1Error({{"clips", nlohmann::json::array()}}), "part1.clips: must be a non-empty array");
-  says(part1Error({{"clips", {{{"file", std::string(__FILE__)}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");
+  says(part1Error({{"clips", {{{"file", kThisFile}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");
   says(part1Error({{"character", "mannequin"}}), "part1.character: must be \"default\"");
   says(part1Error({{"character", {{"file", "/nonexistent/c.glb"}}}}), "part1.character.file: file");
-  says(part1Error({{"character", {{"recipe", std::string(__FILE__)}, {"garment_mesh", {"x"}}}}}),
+  says(part1Error({{"character", {{"recipe", kThisFile}, {"garment_mesh", {"x"}}}}}),
        "mesh names apply to an imported");
   says(part1Error({{"input_joints", {"Spine", 3}}}), "part1.input_joints: must hold non-empty strings");
   says(part1Error({{"transfer", {{"smoothing_weights", "cubic"}}}}), "part1.transfer.smoothing_weights");
   says(errorOf({{"output", "o"}, {"part1", {{"thinning", {{"target_poses", 10}}}}}}), "part1.clips: is required");
-  says(errorOf({{"output", "o"}, {"part1", {{"clips", {std::string(__FILE__)}}}}}), "part1.thinning: is required");
+  says(errorOf({{"output", "o"}, {"part1", {{"clips", {kThisFile}}}}}), "part1.thinning: is required");
 }
 
 TEST(BakeConfig, MissingFileIsAClearError) {

@@ -1,0 +1,262 @@
+#include "swish/bake/report/subject_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "swish/core/error.hpp"
+#include "swish/runtime/mlp_evaluator.hpp"
+#include "swish/runtime/reference_pca.hpp"
+#include "swish/runtime/reference_skinning.hpp"
+#include "swish/runtime/theta.hpp"
+
+namespace swish::bake {
+
+namespace {
+std::string f2(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", v);
+  return b;
+}
+}  // namespace
+
+nlohmann::json evaluationSummary(const BakeEvaluation& ev) {
+  nlohmann::json j = {{"poses", ev.poses},
+                      {"vertex", toJson(ev.totalMm)},
+                      {"baseline_rest_skinned", toJson(ev.restSkinnedMm)},
+                      {"baseline_mean_skinned", toJson(ev.meanSkinnedMm)}};
+  if (ev.hasNormalMaps) j["normal_total"] = toJson(ev.normalTotal);
+  return j;
+}
+
+nlohmann::json SubjectEvaluation::toJson() const {
+  nlohmann::json clips = nlohmann::json::array();
+  for (const Clip& c : perClip) {
+    nlohmann::json j = evaluationSummary(c.evaluation);
+    j["clip"] = c.clip;
+    j["subject"] = c.subject;
+    clips.push_back(std::move(j));
+  }
+  nlohmann::json j = {{"subjects", subjects}, {"poses_planned", posesPlanned}, {"overall", evaluationSummary(overall)},
+                      {"per_clip", clips}};
+  if (!guard.rows.empty()) j["novelty_guard_study"] = guard.toJson();
+  return j;
+}
+
+std::string GuardSetting::name() const {
+  if (!clamp) return "no guard";
+  if (!(end > start)) return "clamp to the training range";
+  return "clamp + blend to the mean shape, novelty " + f2(start) + " .. " + f2(end);
+}
+
+nlohmann::json GuardStudy::toJson() const {
+  nlohmann::json rs = nlohmann::json::array();
+  for (const Row& r : rows)
+    rs.push_back({{"clamp", r.setting.clamp}, {"blend_start", r.setting.start}, {"blend_end", r.setting.end},
+                  {"held_out_subjects", bake::toJson(r.subjects)}, {"random_frames", bake::toJson(r.random)}});
+  return {{"novelty_unit", unit},
+          {"novelty_held_out_subjects", {{"mean", noveltySubjects.mean}, {"p95", noveltySubjects.p95}, {"max", noveltySubjects.max}}},
+          {"novelty_random_frames", {{"mean", noveltyRandom.mean}, {"p95", noveltyRandom.p95}, {"max", noveltyRandom.max}}},
+          {"error_novelty_correlation", errorNoveltyCorrelation},
+          {"settings", rs},
+          {"chosen", chosen}};
+}
+
+std::string GuardStudy::markdown() const {
+  std::ostringstream md;
+  md << "### The novelty guard, measured offline\n\n"
+     << "Novelty: the distance of a pose's normalised network input to the nearest training pose, in units of the "
+        "training poses' own nearest-neighbour distance (p95, "
+     << f2(unit) << " RMS per input). Held-out subjects: mean " << f2(noveltySubjects.mean) << ", p95 "
+     << f2(noveltySubjects.p95) << ", max " << f2(noveltySubjects.max) << "; random held-out frames: mean "
+     << f2(noveltyRandom.mean) << ", p95 " << f2(noveltyRandom.p95) << ", max " << f2(noveltyRandom.max)
+     << ". Per-pose mean error against novelty on the held-out subjects: correlation " << f2(errorNoveltyCorrelation)
+     << ".\n\n| guard | held-out subjects mean | p95 | max | random frames mean | p95 | max |\n|---|---|---|---|---|---|---|\n";
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    md << "| " << r.setting.name() << (i == chosen ? " (lowest held-out mean)" : "") << " | " << f2(r.subjects.mean)
+       << " | " << f2(r.subjects.p95) << " | " << f2(r.subjects.max) << " | " << f2(r.random.mean) << " | "
+       << f2(r.random.p95) << " | " << f2(r.random.max) << " |\n";
+  }
+  md << "\nThe thresholds are chosen on the same held-out subjects they are reported on (an optimistic figure "
+        "for the chosen row); the run time does not apply the guard yet.\n\n";
+  return md.str();
+}
+
+GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const DatasetPose*>& trainingPoses,
+                             const std::vector<const DatasetPose*>& subjects, const std::vector<const DatasetPose*>& random) {
+  GuardStudy g;
+  if (trainingPoses.size() < 2) return g;
+  const runtime::MlpEvaluator mlp(model);
+  const int K = model.meshComponents();
+  const int D = mlp.inputSize();
+  const size_t n = model.gameMesh.vertexCount();
+  auto input = [&](const DatasetPose* p) {
+    const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
+    VecXf x(D);
+    for (int i = 0; i < D; ++i) x[i] = (theta[size_t(i)] - model.inputNorm.mean[i]) / model.inputNorm.scale[i];
+    return x;
+  };
+  MatXf train(D, Eigen::Index(trainingPoses.size()));
+  VecXf lo = VecXf::Constant(K, std::numeric_limits<float>::max()), hi = VecXf::Constant(K, -std::numeric_limits<float>::max());
+  for (size_t i = 0; i < trainingPoses.size(); ++i) {
+    train.col(Eigen::Index(i)) = input(trainingPoses[i]);
+    const VecXf pre = Eigen::Map<const VecXf>(trainingPoses[i]->gameMeshPreSkin.data(), Eigen::Index(3 * n));
+    const VecXf w = model.meshPca.basis.transpose() * (pre - model.meshPca.mean);
+    lo = lo.cwiseMin(w);
+    hi = hi.cwiseMax(w);
+  }
+  const double rms = std::sqrt(double(D));
+  auto nearest = [&](const VecXf& x, Eigen::Index skip) {
+    double best = std::numeric_limits<double>::max();
+    for (Eigen::Index j = 0; j < train.cols(); ++j)
+      if (j != skip) best = std::min(best, double((train.col(j) - x).squaredNorm()));
+    return std::sqrt(best) / rms;
+  };
+  std::vector<double> own;
+  for (Eigen::Index j = 0; j < train.cols(); ++j) own.push_back(nearest(train.col(j), j));
+  g.unit = std::max(1e-9, distanceStats(own).p95);
+
+  struct Prepared {
+    const DatasetPose* pose;
+    double novelty;
+    std::vector<float> lambda;
+    std::vector<Mat4f> mats;
+  };
+  auto prepare = [&](const std::vector<const DatasetPose*>& set) {
+    std::vector<Prepared> out;
+    for (const DatasetPose* p : set) {
+      Prepared q{p, nearest(input(p), -1) / g.unit, std::vector<float>(size_t(mlp.outputSize())), model.skeleton.skinningMatrices(p->pose)};
+      mlp.evaluate(runtime::computeTheta(model.inputJoints, p->pose.local), q.lambda);
+      out.push_back(std::move(q));
+    }
+    return out;
+  };
+  const auto subj = prepare(subjects), rand = prepare(random);
+  auto noveltyOf = [](const std::vector<Prepared>& v) {
+    std::vector<double> x;
+    for (const auto& p : v) x.push_back(p.novelty);
+    return distanceStats(x);
+  };
+  g.noveltySubjects = noveltyOf(subj);
+  g.noveltyRandom = noveltyOf(rand);
+
+  // Vertex errors of a set under a setting; per-pose means for the correlation.
+  auto errors = [&](const std::vector<Prepared>& set, const GuardSetting& s, std::vector<double>* perPose) {
+    std::vector<double> all;
+    all.reserve(set.size() * n);
+    std::vector<float> w(static_cast<size_t>(K));
+    for (const Prepared& p : set) {
+      for (int k = 0; k < K; ++k) {
+        float v = p.lambda[size_t(k)];
+        if (s.clamp) v = std::clamp(v, lo[k], hi[k]);
+        w[size_t(k)] = v;
+      }
+      if (s.clamp && s.end > s.start) {
+        const float b = float(std::clamp((p.novelty - s.start) / (s.end - s.start), 0.0, 1.0));
+        for (float& v : w) v *= 1.f - b;
+      }
+      const Points3f shape = runtime::referenceSkin(runtime::referencePcaReconstruct(model.meshPca, w), model.gameMesh.skin, p.mats);
+      double sum = 0.0;
+      for (size_t v = 0; v < n; ++v) {
+        const double e = 1000.0 * double((shape.row(Eigen::Index(v)) - p.pose->gameMeshWorld.row(Eigen::Index(v))).norm());
+        all.push_back(e);
+        sum += e;
+      }
+      if (perPose) perPose->push_back(sum / double(n));
+    }
+    return distanceStats(std::move(all));
+  };
+  std::vector<GuardSetting> settings = {{false, 0, 0}, {true, 0, 0}};
+  for (double start : {1.0, 1.5, 2.0, 3.0})
+    for (double width : {1.0, 2.0, 4.0}) settings.push_back({true, start, start + width});
+  std::vector<double> perPose;
+  for (size_t i = 0; i < settings.size(); ++i) {
+    g.rows.push_back({settings[i], errors(subj, settings[i], i == 0 ? &perPose : nullptr), errors(rand, settings[i], nullptr)});
+    if (g.rows.back().subjects.mean < g.rows[g.chosen].subjects.mean) g.chosen = i;
+  }
+  // Pearson correlation of per-pose error and novelty (held-out subjects, no guard).
+  if (subj.size() > 2) {
+    double mx = 0, my = 0;
+    for (size_t i = 0; i < subj.size(); ++i) {
+      mx += subj[i].novelty / double(subj.size());
+      my += perPose[i] / double(subj.size());
+    }
+    double sxy = 0, sxx = 0, syy = 0;
+    for (size_t i = 0; i < subj.size(); ++i) {
+      sxy += (subj[i].novelty - mx) * (perPose[i] - my);
+      sxx += (subj[i].novelty - mx) * (subj[i].novelty - mx);
+      syy += (perPose[i] - my) * (perPose[i] - my);
+    }
+    g.errorNoveltyCorrelation = sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+  }
+  return g;
+}
+
+std::string SubjectEvaluation::markdown(const BakeEvaluation& random) const {
+  std::string names;
+  for (const auto& s : subjects) names += (names.empty() ? "" : ", ") + s;
+  std::ostringstream md;
+  md << "## Held-out subjects\n\n"
+     << "Subjects " << names << " were kept out of training: " << overall.poses << " of their frames (of "
+     << posesPlanned << " planned, evenly spaced over " << perClip.size()
+     << " clips) were simulated and evaluated through the same path. Beside each figure, the two baselines on the "
+        "same poses: the garment's rest shape skinned (no correctives) and the PCA mean shape skinned.\n\n"
+     << "| poses | n | vertex mean | p95 | max | rest skinned mean | p95 | mean skinned mean | p95 | normal deg |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  auto row = [&](const std::string& name, const BakeEvaluation& e) {
+    md << "| " << name << " | " << e.poses << " | " << f2(e.totalMm.mean) << " | " << f2(e.totalMm.p95) << " | "
+       << f2(e.totalMm.max) << " | " << f2(e.restSkinnedMm.mean) << " | " << f2(e.restSkinnedMm.p95) << " | "
+       << f2(e.meanSkinnedMm.mean) << " | " << f2(e.meanSkinnedMm.p95) << " | "
+       << (e.hasNormalMaps ? f2(e.normalTotal.meanDegrees) : std::string("-")) << " |\n";
+  };
+  row("random held-out frames of training clips", random);
+  row("held-out subjects " + names, overall);
+  for (const Clip& c : perClip) row("  " + c.clip + " (subject " + c.subject + ")", c.evaluation);
+  size_t worse = 0;
+  for (const Clip& c : perClip) worse += c.evaluation.totalMm.p95 > c.evaluation.restSkinnedMm.p95;
+  md << "\nHeld-out subjects over random frames (mean): "
+     << (random.totalMm.mean > 0 ? f2(overall.totalMm.mean / random.totalMm.mean) + "x" : std::string("-"))
+     << ". Clips whose p95 is worse than the rest shape skinned: " << worse << " of " << perClip.size() << ".\n\n";
+  if (!guard.rows.empty()) md << guard.markdown();
+  return md.str();
+}
+
+SubjectEvaluation evaluateHeldOutSubjects(const BakeTrainOutput& out, const Dataset& training, const Dataset& holdout,
+                                          const nlohmann::json& origins,
+                                          const std::vector<std::string>& subjects, size_t posesPlanned) {
+  if (holdout.poses.empty()) throw Error("held-out subjects: the dataset holds no pose (every simulation failed?)");
+  if (holdout.character.garment.vertexCount() != out.model.gameMesh.vertexCount())
+    throw Error("held-out subjects: the dataset's game mesh has " + std::to_string(holdout.character.garment.vertexCount()) +
+                " vertices, the model's " + std::to_string(out.model.gameMesh.vertexCount()));
+  const PcaResult* normalPca = out.model.normalMaps.mapCount() > 0 ? &out.normalPca.pca : nullptr;
+  SubjectEvaluation r;
+  r.subjects = subjects;
+  r.posesPlanned = posesPlanned;
+  std::vector<const DatasetPose*> all;
+  std::map<std::string, std::pair<std::string, std::vector<const DatasetPose*>>> byClip;
+  for (const DatasetPose& p : holdout.poses) {
+    all.push_back(&p);
+    std::string clip = "?", subject = "?";
+    if (origins.is_array() && p.id < origins.size()) {
+      clip = origins[p.id].value("clip", std::string("?"));
+      subject = origins[p.id].value("subject", std::string("?"));
+    }
+    auto& slot = byClip[clip];
+    slot.first = subject;
+    slot.second.push_back(&p);
+  }
+  r.overall = evaluateModel(out.model, all, out.databaseMaps, normalPca);
+  for (const auto& [clip, entry] : byClip)
+    r.perClip.push_back({clip, entry.first, evaluateModel(out.model, entry.second, out.databaseMaps, normalPca)});
+  std::vector<const DatasetPose*> trained, random;
+  for (uint32_t i : out.trainingPoses) trained.push_back(&training.poses[i]);
+  for (uint32_t i : out.testPoses) random.push_back(&training.poses[i]);
+  r.guard = studyNoveltyGuard(out.model, trained, all, random);
+  return r;
+}
+
+}  // namespace swish::bake

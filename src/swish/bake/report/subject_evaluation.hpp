@@ -1,0 +1,78 @@
+#pragma once
+// The honest figure: the model on whole subjects it never trained on (part1.holdout), beside the usual
+// figure on random held-out frames of its training clips. The held-out subjects' frames are simulated
+// into their own dataset (BakeConfig::holdoutDatasetDir, evenly spaced over their clips); here each is
+// evaluated through the same run-time path as the bake's own held-out poses (bake_evaluation.hpp):
+// vertex error mean / p95 / max and normal-map angular error, with both baselines (the rest shape
+// skinned, the PCA mean shape skinned) on the same poses, overall and per held-out clip.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "swish/bake/pipeline/part2_training.hpp"
+
+namespace swish::bake {
+
+// A study of the run-time novelty guard, on the bake's own poses: how far each pose's network input
+// (Theta, normalised as the network normalises it) lies from the nearest training pose, and what a guard
+// would do to the error. Novelty is that distance (RMS over the inputs) divided by the 95th percentile
+// of the training poses' distances to their nearest other training pose: 1 is as far out as the sparse
+// end of the training set. The guard: clamp the mesh weights to the range the training shapes span
+// (their PCA projections), then blend them towards 0 (the PCA mean shape, the better of the two
+// baselines) as novelty goes from `start` to `end`.
+struct GuardSetting {
+  bool clamp = false;
+  double start = 0.0, end = 0.0;  // end > start: blend; else none
+  std::string name() const;
+};
+struct GuardStudy {
+  double unit = 0.0;  // the training poses' nearest-neighbour distance, p95 (RMS per input)
+  DistanceStats noveltySubjects, noveltyRandom;  // of the novelty values (no unit)
+  double errorNoveltyCorrelation = 0.0;         // held-out subjects: per-pose mean error vs novelty (Pearson)
+  struct Row {
+    GuardSetting setting;
+    DistanceStats subjects, random;  // vertex error (mm)
+  };
+  std::vector<Row> rows;  // [0]: no guard, [1]: clamp only, then clamp + blend settings
+  size_t chosen = 0;      // the row with the lowest mean on the held-out subjects
+  nlohmann::json toJson() const;
+  std::string markdown() const;
+};
+
+// `trainingPoses` trained the model; the guard is measured on both other sets.
+GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const DatasetPose*>& trainingPoses,
+                             const std::vector<const DatasetPose*>& heldOutSubjects,
+                             const std::vector<const DatasetPose*>& randomFrames);
+
+struct SubjectEvaluation {
+  std::vector<std::string> subjects;
+  size_t posesPlanned = 0;  // frames part 1 was asked to simulate; the dataset holds those that succeeded
+  BakeEvaluation overall;
+  struct Clip {
+    std::string clip, subject;
+    BakeEvaluation evaluation;
+  };
+  std::vector<Clip> perClip;
+  GuardStudy guard;
+
+  // {"subjects", "poses", "overall": {...}, "per_clip": [{"clip", "subject", ...}]}, each evaluation as
+  // {"poses", "vertex": {mean_mm, p95_mm, max_mm}, "baseline_rest_skinned", "baseline_mean_skinned",
+  //  "normal_total": {mean_deg, ...}}: what the report and the model metadata carry.
+  nlohmann::json toJson() const;
+  // The report's section: the held-out subjects against `randomFrames` (the bake's random held-out
+  // frames of training clips) side by side, then per clip.
+  std::string markdown(const BakeEvaluation& randomFrames) const;
+};
+
+// The compact JSON form of one evaluation (as in SubjectEvaluation::toJson).
+nlohmann::json evaluationSummary(const BakeEvaluation& ev);
+
+// `holdout` is the held-out subjects' dataset, `origins` its pose_origins.json (per pose id: clip,
+// subject). Throws Error when the dataset does not fit the model (another game mesh) or is empty.
+// `training` is the dataset the model was trained on (out.trainingPoses and out.testPoses index it).
+SubjectEvaluation evaluateHeldOutSubjects(const BakeTrainOutput& out, const Dataset& training, const Dataset& holdout,
+                                          const nlohmann::json& origins, const std::vector<std::string>& subjects,
+                                          size_t posesPlanned);
+
+}  // namespace swish::bake
