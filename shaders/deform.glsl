@@ -24,6 +24,11 @@
 // through an address lane by lane, and the basis is 3K loads per vertex per frame, whatever the
 // instance count, so the texel form pays most where characters are few (docs/performance.md).
 //
+// The push-out (runtime/reference_push_out.hpp, the specification): after skinning, each instance's
+// vertex is pushed out of that instance's posed body capsules, in order. Every thread of the dispatch
+// reads the same capsule at the same time (a uniform address), and the loop's trip count is a push
+// constant, so a frame without push-out (capsuleCount 0) skips it in one uniform branch.
+//
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
 #include "swish_buffers.glsl"
@@ -96,6 +101,22 @@ void main() {
         b3 = use ? b3 + w * c3 : b3;
       }
       y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
+    }
+    if (p.capsuleCount > 0u) {
+      FloatsIn caps = FloatsIn(p.capsules);
+      for (uint c = 0u; c < p.capsuleCount; ++c) {
+        const uint b = (instance * p.capsuleCount + c) * 8u;
+        const vec3 a = vec3(caps.v[b], caps.v[b + 1u], caps.v[b + 2u]);
+        const float r = caps.v[b + 3u];
+        const vec3 d = vec3(caps.v[b + 4u], caps.v[b + 5u], caps.v[b + 6u]);
+        const float invLenSq = caps.v[b + 7u];
+        precise const vec3 w = y - a;
+        precise const float t = clamp(((w.x * d.x + w.y * d.y) + w.z * d.z) * invLenSq, 0.0, 1.0);
+        precise const vec3 q = a + d * t;
+        precise const vec3 e = y - q;
+        precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
+        if (s > 1e-12 && s < r * r) y = q + e * (r / sqrt(s));  // kMinPushDistanceSq
+      }
     }
     const uint o = (instance * p.vertexCount + v) * 3u;
     outBuf.v[o] = y.x;

@@ -35,19 +35,21 @@ struct alignas(8) Address {
 // hundred they would spill).
 #define SWISH_MAX_MESH_COMPONENTS 256
 
-// deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances. The mesh
-// weights (float[instanceCount][K4]) and skin matrix rows (vec4[instanceCount][jointCount][3]) are
-// texel buffers of its descriptor set.
+// deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
+// push-out of the posed body proxy (runtime/reference_push_out.hpp). The mesh weights
+// (float[instanceCount][K4]) and skin matrix rows (vec4[instanceCount][jointCount][3]) are texel
+// buffers of its descriptor set.
 struct DeformParams {
   SWISH_ADDRESS mean;           // float[3N]
   SWISH_ADDRESS basis;          // float[K][3N]
   SWISH_ADDRESS skinJoints;     // uint[N][influences]
   SWISH_ADDRESS skinWeights;    // float[N][influences]
   SWISH_ADDRESS positionsOut;   // float[instanceCount][N][3]
+  SWISH_ADDRESS capsules;       // float[instanceCount][capsuleCount][8]: posed capsules (unused when 0)
   uint vertexCount;
   uint instanceCount;
   uint jointCount;
-  uint pad0;
+  uint capsuleCount;            // 0: no push-out
 };
 
 // tangent_frames.comp: normals and tangents of deformed meshes, one thread per (vertex, instance).
@@ -108,7 +110,7 @@ struct CopyVec4Params {
 
 #ifdef __cplusplus
 static_assert(sizeof(Address) == 8);
-static_assert(sizeof(DeformParams) == 5 * 8 + 16);
+static_assert(sizeof(DeformParams) == 6 * 8 + 16);
 static_assert(sizeof(TangentFramesParams) == 9 * 8 + 16);
 static_assert(sizeof(VqDecodeParams) == 5 * 8 + 16);
 static_assert(sizeof(NormalMapBlendCharacter) == 8);

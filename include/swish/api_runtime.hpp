@@ -85,6 +85,10 @@ struct BatchOptions {
   uint32_t characters = 1;      // characters of this model drawn per frame
   uint32_t framesInFlight = 2;  // 1..8: sets of frame resources; frame f uses set f % framesInFlight
   bool normalMaps = true;       // per-character normal maps (ignored when the model or device has none)
+  // Push the deformed garment out of the model's body proxy (capsules fitted inside the body at bake
+  // time, ModelInfo::bodyCapsules; a step at the end of the deform pass): keeps the body the host draws
+  // from showing through where the network puts the cloth inside it. No effect without a proxy.
+  bool pushOut = true;
 };
 
 class Model {

@@ -61,6 +61,7 @@ struct ModelInfo {
   bool hasNormalMaps = false;
   uint32_t normalMapWidth = 0, normalMapHeight = 0, normalMapDatabaseSize = 0;
   float temporalFilterSeconds = 0;        // the normal-map filter's time constant
+  uint32_t bodyCapsules = 0;              // capsules of the body proxy the push-out uses (0: none)
 };
 
 // One vertex attribute of the deformed mesh. Character c's vertices start at

@@ -3,7 +3,9 @@
 // plain vec4 copy kernel of the same byte count measured in the same iterations (vs_copy: goal >= 0.5);
 // and the cost of an empty dispatch (one alone, and amortised over 100 back to back). Also the
 // tangent-frames pass on the same 22 deformed instances, single-pass kernel vs the two-pass
-// (per-triangle terms + per-vertex gather) that FrameRecorder uses.
+// (per-triangle terms + per-vertex gather) that FrameRecorder uses. And the push-out step of the deform
+// (the body proxy's capsules, runtime/reference_push_out.hpp): the same dispatch with and without it,
+// alternating, its share of the deform pass reported (goal <= 10%).
 //   ./bench_deform --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -18,6 +20,7 @@
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 #include "swish/gpu/timestamp_queries.hpp"
+#include "swish/runtime/reference_push_out.hpp"
 
 namespace swish {
 namespace {
@@ -60,18 +63,19 @@ struct DeformSetup {
   uint32_t copyVec4s = 0;
 };
 
-DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning) {
+DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint32_t components = 30, uint32_t capsules = 0) {
   DeformSetup s;
   Rng rng(42);
   test::RandomModelSpec spec;
   spec.vertices = 3000;
-  spec.meshComponents = 30;
+  spec.meshComponents = components;
+  spec.bodyCapsules = capsules;
   spec.influences = 4;
   spec.joints = 24;
   spec.normalMaps = 0;
   s.model = test::makeRandomModel(rng, spec);
   s.gpuModel = std::make_unique<gpu::GpuModel>(ctx, s.model);
-  const size_t n = 3000, k = 30;
+  const size_t n = 3000, k = components;
   std::vector<float> w(instances * k);
   for (auto& x : w) x = float(rng.normal());
   std::vector<Mat4f> m;
@@ -140,6 +144,57 @@ void BM_Deform(benchmark::State& state) {
 }
 // Args: instances, skinning (0: PCA reconstruction only, to see what skinning costs).
 BENCHMARK(BM_Deform)->Args({1, 1})->Args({22, 1})->Args({22, 0})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
+// The deform pass with and without its push-out step: args instances, K, capsules. Each iteration times
+// both dispatches (alternating, so that drift of a shared machine hits both alike); the reported time
+// is the pass with the push-out, `pushout_share` its extra time over the plain deform.
+void BM_DeformPushOut(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1)), capsules = uint32_t(state.range(2));
+  DeformSetup s = makeSetup(*ctx, instances, true, k, capsules);
+  std::vector<float> posed;
+  Rng rng(7);
+  for (uint32_t i = 0; i < instances; ++i)
+    runtime::poseBodyProxy(s.model.bodyProxy, s.model.skeleton.skinningMatrices(test::makeRandomPose(rng, s.model.skeleton, 0.15f)),
+                           posed);
+  gpu::Buffer caps(*ctx, posed.size() * 4, gpu::MemoryKind::DeviceLocal, "posed capsules");
+  caps.upload(*ctx, posed.data(), posed.size() * 4);
+  gpu::TimestampQueries ts(*ctx, 2);
+  gpu::DeformPass::Args a;
+  a.mean = s.gpuModel->mean.address();
+  a.basis = s.gpuModel->basis.address();
+  a.instanceInputs = s.instanceInputs.get();
+  a.skinJoints = s.gpuModel->skinJoints.address();
+  a.skinWeights = s.gpuModel->skinWeights.address();
+  a.positionsOut = s.positions.address();
+  a.vertexCount = 3000;
+  a.instanceCount = instances;
+  a.jointCount = uint32_t(s.model.skeleton.size());
+  gpu::DeformPass::Args pushed = a;
+  pushed.capsules = caps.address();
+  pushed.capsuleCount = capsules;
+  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, pushed); });  // warm-up
+  double with = 0, without = 0;
+  for (auto _ : state) {
+    const double t = gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, pushed); });
+    without += gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); });
+    state.SetIterationTime(t);
+    with += t;
+  }
+  state.counters["plain_us"] = 1e6 * without / double(state.iterations());
+  state.counters["pushout_share"] = (with - without) / without;
+  state.counters["capsules"] = capsules;
+}
+// Args: instances, K, capsules. K = 128 is the default model's; the default model's proxy is ~20 capsules.
+BENCHMARK(BM_DeformPushOut)
+    ->Args({22, 30, 24})
+    ->Args({22, 128, 24})
+    ->Args({1, 128, 24})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->MinTime(0.5);
 
 // Normals + tangents of `instances` deformed instances of the 3000-vertex model (a UV-mapped grid,
 // ~5900 triangles), arg 1: 0 = single-pass tangent_frames.comp, 1 = two passes through a

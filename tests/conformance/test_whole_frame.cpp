@@ -83,6 +83,7 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
   spec.normalMaps = 6;
   spec.mapSize = 24;
   spec.codebookSize = 40;
+  spec.bodyCapsules = 8;  // the push-out inside the deform pass, on in frames 0 and 2, off in frame 1
   const Model model = test::makeRandomModel(modelRng, spec);
   const uint32_t instances = 22;
   gpu::GpuModel gpuModel(ctx(), model, "random model");
@@ -101,7 +102,8 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
 
   std::vector<runtime::BlendedNormalMap> prevMaps;  // reference state; starts at zeros like the GPU images
   for (int frame = 0; frame < 3; ++frame) {
-    const auto in = randomFrameInputs(rng, model, instances, true);
+    auto in = randomFrameInputs(rng, model, instances, true);
+    in.pushOut = frame != 1;
     ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, uint64_t(frame), in); });
     const uint32_t slot = recorder.slotOf(uint64_t(frame));
     const auto gpu = recorder.download(slot);

@@ -44,6 +44,7 @@ class ReplayE2E : public test::GpuTest {
     spec.vertices = 120;
     spec.normalMaps = 4;
     spec.mapSize = 16;
+    spec.bodyCapsules = 6;  // the push-out runs, and the GPU-vs-CPU checks cover it
     model_ = test::makeRandomModel(rng, spec);
     // What the bake records of its evaluation on held-out poses (part2_training.cpp).
     model_.metadata = R"({"errors": {"held_out_poses": 7, "vertex_total": {"mean_mm": 1.5, "p95_mm": 3, "max_mm": 4}}})";
@@ -115,6 +116,10 @@ TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
   EXPECT_TRUE(rep["frames"][0]["times"]["gpuDeform"].is_number());
   EXPECT_EQ(rep["models"][0]["heldOutErrors"]["held_out_poses"], 7);
   EXPECT_TRUE(rep["truth"]["available"].get<bool>());
+  // No bake character behind a random model: penetration is not measured, and the report says why.
+  EXPECT_NE(rep["penetration"]["note"].get<std::string>().find("not measured"), std::string::npos) << rep["penetration"];
+  EXPECT_TRUE(rep["penetration"]["pushOut"].get<bool>());
+  EXPECT_FALSE(rep["penetration"].contains("overall"));
   std::ifstream md(dir_ / "out/report.md");
   const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("7 held-out poses, simulated): vertex error mean 1.5 mm, p95 3 mm"), std::string::npos) << text;

@@ -78,6 +78,9 @@ int main(int argc, char** argv) {
     s.hiddenLayers = 0;
     shapes.push_back({"linear_mlp", s});
     s = small();
+    s.bodyCapsules = 3;
+    shapes.push_back({"body_proxy", s});
+    s = small();
     s.vertices = 20;
     s.mapSize = 8;
     s.codebookSize = 5;

@@ -117,6 +117,17 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
   m.outputNorm.mean = VecXf::Zero(out);
   m.outputNorm.scale = VecXf::Ones(out);
   m.metadata = R"({"generator":"makeRandomModel"})";
+  // Body proxy: capsules over the mesh's box (x, y spanning the grid, z near 0), a few centimetres thick,
+  // so that some vertices lie inside one or more of them and some outside all.
+  const float width = 0.02f * float(cols), height = 0.02f * float((n + cols - 1) / cols);
+  for (uint32_t c = 0; c < s.bodyCapsules; ++c) {
+    BodyCapsule cap;
+    cap.joint = uint32_t(rng.below(s.joints));
+    cap.a = Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
+    cap.b = c % 4 == 3 ? cap.a : Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
+    cap.radius = rng.uniformf(0.005f, 0.05f);
+    m.bodyProxy.capsules.push_back(cap);
+  }
   m.validate("random model");
   return m;
 }

@@ -76,6 +76,10 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
                        {"blockIndices", db.indices.size()}};
   }
   j["temporalFilter"] = {{"timeConstantSeconds", m.temporalFilter.timeConstantSeconds}};
+  json capsules = json::array();
+  for (const BodyCapsule& c : m.bodyProxy.capsules)
+    capsules.push_back({{"joint", m.skeleton.joints[c.joint].name}, {"radiusM", c.radius}, {"lengthM", (c.b - c.a).norm()}});
+  j["bodyProxy"] = {{"capsules", capsules}};
   // Metadata is meant to be JSON; show it as such when it is, as text when it is not.
   const json meta = json::parse(m.metadata, nullptr, /*allow_exceptions=*/false);
   if (meta.is_discarded())
@@ -110,6 +114,8 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
       << " bytes), " << db.indices.size() << " block indices\n";
   }
   o << "  temporal      time constant " << m.temporalFilter.timeConstantSeconds << " s\n";
+  o << "  body proxy    " << m.bodyProxy.capsules.size() << " capsules"
+    << (m.bodyProxy.empty() ? " (no push-out at run time)" : " (the run-time push-out keeps the garment off them)") << "\n";
   o << "  sections\n";
   for (const auto& s : info.sections) {
     char line[128];

@@ -7,6 +7,11 @@
 // seconds of CPU per character and truth frame at the default model's 6568 simulation vertices, run in
 // parallel.
 //
+// Penetration of the garment into the body it was baked on is measured every frame (on the CPU
+// reference's positions, before and after the run time's push-out of the model's body proxy) and
+// reported with a plot; --penetration-every N thins that, 0 turns it off; --no-push-out runs the GPU
+// without the push-out (to see the model's own output).
+//
 // Exit codes: 0 all frames replayed and every check within tolerance; 3 replayed, but bad poses were
 // met or a GPU output differed from the CPU reference beyond tolerance (see the report); 1 an error
 // (bad scene, missing file, no device): nothing was written.
@@ -30,7 +35,8 @@ namespace fs = std::filesystem;
 struct ReplayCliOptions {
   std::string scene, out, device;
   bool plan = false, quiet = false, validation = false, render = false;
-  uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16;
+  uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16, penetrationEvery = 30;
+  bool noPushOut = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
 };
@@ -68,6 +74,8 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.truth.every = o.truthEvery;
   jo.engine.truth.simulationVertices = o.truthVertices;
   jo.engine.truth.substeps = o.truthSubsteps;
+  jo.engine.penetrationEvery = o.penetrationEvery;
+  jo.engine.pushOut = !o.noPushOut;
   const replay::ReplayJobResult r = replay::runReplayJob(scene, jo);
   if (!o.quiet) {
     std::printf("Replayed %zu frames of '%s' on %s.\n", r.result.frames.size(), scene.name.c_str(), r.result.device.c_str());
@@ -84,6 +92,18 @@ int runReplay(const ReplayCliOptions& o) {
       std::printf(".\n");
     }
     std::printf("Ground truth: %s\n", r.result.truthNote.c_str());
+    if (!r.result.penetrationPerCharacter.empty()) {
+      auto line = [](const char* what, const bake::PenetrationPool& p) {
+        std::printf("Garment inside the body, %s: %u of %u character frames with a vertex deeper than %g mm, deepest %.1f mm, "
+                    "p95 of the per-frame deepest %.1f mm, %.3f %% of vertices inside.\n",
+                    what, p.framesVisible, p.frames, bake::kVisiblePenetrationMm, p.deepestMm, p.deepestPercentileMm(0.95),
+                    100.0 * p.share());
+      };
+      line("model", r.result.penetrationOverall.model);
+      if (r.result.penetrationOverall.pushedMeasured) line("after the push-out", r.result.penetrationOverall.pushed);
+    } else {
+      std::printf("Penetration: %s\n", r.result.penetrationNote.c_str());
+    }
   }
   if (o.render) {
     // After the replay's outputs are in place, so that a render failure never loses the report.
@@ -93,10 +113,15 @@ int runReplay(const ReplayCliOptions& o) {
     ro.maxFrames = o.renderFrames;
     ro.device = o.device;
     ro.validation = o.validation;
+    ro.truth = jo.engine.truth;
+    ro.pushOut = !o.noPushOut;
     const replay::ReplayRenderResult rr = replay::renderReplayFrames(scene, models, dir, ro);
     if (!o.quiet) {
       std::printf("Rendered %zu frames of character %u: %s\n", rr.frames.size(), o.renderCharacter,
                   rr.contactSheet.string().c_str());
+      if (!rr.heatSheet.empty())
+        std::printf("Error heat maps of %zu truth frames (model | truth | error, mm): %s\n", rr.heatMaps.size(),
+                    rr.heatSheet.string().c_str());
       if (!rr.note.empty()) std::printf("%s\n", rr.note.c_str());
     }
   }
@@ -120,6 +145,11 @@ swish::cli::CommandRegistration reg{
                      "further from the bake's truth; the report says so)");
       app.add_option("--truth-substeps", o->truthSubsteps, "truth simulation substeps instead of the bake's")
           ->check(CLI::Range(1, 1000));
+      app.add_option("--penetration-every", o->penetrationEvery,
+                     "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "
+                     "on every Nth frame; 0: not at all (default 30: the measure poses a body collider per character, costly on the CPU)");
+      app.add_flag("--no-push-out", o->noPushOut,
+                   "run the GPU without the push-out of the model's body proxy (see what the network alone gives)");
       app.add_option("--frames", o->frames, "replay only this many frames");
       app.add_flag("--quiet", o->quiet, "no progress bar or summary");
       app.add_flag("--validation", o->validation, "enable the Vulkan validation layers");

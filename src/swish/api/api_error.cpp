@@ -60,6 +60,7 @@ ModelInfo describeModel(const swish::Model& m, const std::string& name) {
   info.normalMapHeight = m.normalMaps.height;
   info.normalMapDatabaseSize = m.normalMaps.mapCount();
   info.temporalFilterSeconds = m.temporalFilter.timeConstantSeconds;
+  info.bodyCapsules = uint32_t(m.bodyProxy.capsules.size());
   return info;
 }
 

@@ -67,6 +67,7 @@ CharacterBatch Model::createBatch(const BatchOptions& o) const {
     auto b = std::make_unique<BatchImpl>();
     b->model = impl_;
     b->characters = o.characters;
+    b->inputs.pushOut = o.pushOut;
     b->normalMaps = o.normalMaps && impl_->gpuModel->hasNormalMaps() && impl_->runtime->ctx.supportsNormalMaps();
     b->evaluator = std::make_unique<runtime::FrameEvaluator>(impl_->model, o.characters);
     gpu::FrameRecorderOptions ro;

@@ -57,10 +57,12 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.skinJoints = layout::Address::of(a.skinJoints);
   p.skinWeights = layout::Address::of(a.skinWeights);
   p.positionsOut = layout::Address::of(a.positionsOut);
+  if (a.capsuleCount > 0 && !a.capsules) throw Error("deform pass: " + std::to_string(a.capsuleCount) + " capsules but no capsule buffer");
+  p.capsules = layout::Address::of(a.capsules);
   p.vertexCount = a.vertexCount;
   p.instanceCount = a.instanceCount;
   p.jointCount = a.jointCount;
-  p.pad0 = 0;
+  p.capsuleCount = a.capsuleCount;
   pipeline_.bind(cmd, &p, sizeof(p), a.instanceInputs);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
   return 1;

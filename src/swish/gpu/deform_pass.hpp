@@ -1,6 +1,6 @@
 #pragma once
-// The deform pass (shaders/deform.comp): PCA reconstruction + linear blend skinning of every instance
-// of one model in ONE dispatch; each vertex's basis values are read once per frame for all instances.
+// The deform pass (shaders/deform.comp): PCA reconstruction + linear blend skinning (+ the push-out of
+// the posed body proxy, runtime/reference_push_out.hpp) of every instance of one model in ONE dispatch; each vertex's basis values are read once per frame for all instances.
 // The per-instance inputs (mesh weights, skin matrix rows) are bound as texel buffers through a
 // descriptor set made once per pair of buffers by bindInstanceInputs (descriptor_binding.hpp says why),
 // and with them the model's basis as R32 texels where it fits in the device's maxTexelBufferElements
@@ -31,6 +31,8 @@ class DeformPass {
     VkDeviceAddress skinJoints = 0;    // uint[N][influences]
     VkDeviceAddress skinWeights = 0;   // float[N][influences]
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
+    VkDeviceAddress capsules = 0;      // float[instances][capsuleCount][8], runtime::poseBodyProxy's layout
+    uint32_t capsuleCount = 0;         // per instance; 0: no push-out
     VkDescriptorSet instanceInputs = VK_NULL_HANDLE;  // from bindInstanceInputs
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;

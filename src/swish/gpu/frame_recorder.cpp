@@ -9,6 +9,7 @@
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/gpu/vk_check.hpp"
+#include "swish/runtime/reference_push_out.hpp"
 
 namespace swish::gpu {
 
@@ -85,6 +86,13 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
   matrixRows_.resize(in.skinMatrices.size() * 12);
   DeformPass::packSkinMatrices(in.skinMatrices.data(), in.skinMatrices.size(), matrixRows_.data());
   f.skinMatrices.upload(*ctx_, matrixRows_.data(), matrixRows_.size() * sizeof(float));
+  const bool pushOut = in.pushOut && m.capsuleCount() > 0;
+  if (pushOut) {
+    posedCapsules_.clear();
+    for (uint32_t i = 0; i < in.instanceCount; ++i)
+      runtime::poseBodyProxy(m.bodyProxy(), std::span(in.skinMatrices).subspan(i * j, j), posedCapsules_);
+    f.posedCapsules.upload(*ctx_, posedCapsules_.data(), posedCapsules_.size() * sizeof(float));
+  }
 
   // Orders this frame after earlier frames' GPU work on the queue: their writes of the normal maps this
   // frame blends from, and their reads of buffers this frame overwrites.
@@ -102,6 +110,10 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
   d.vertexCount = m.vertexCount();
   d.instanceCount = in.instanceCount;
   d.jointCount = m.jointCount();
+  if (pushOut) {
+    d.capsules = f.posedCapsules.address();
+    d.capsuleCount = m.capsuleCount();
+  }
   uint32_t dispatches = deform_.record(cmd, d);
   f.timestamps.mark(cmd, kAfterDeform);
 

@@ -1,7 +1,7 @@
 #pragma once
 // Records one frame of swish's GPU work for a batch of instances of one model into a command buffer
 // the caller owns (the caller submits; nothing here submits frame work):
-//   deform (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
+//   deform + push-out (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
 //   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch,
 //   into the normal-map images' own memory where they share it, else then a copy into them)
 // with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
@@ -81,7 +81,7 @@ class FrameRecorder {
   VqDecodePass decode_;
   NormalMapBlendPass blend_;
   std::vector<FrameResources> frames_;
-  std::vector<float> weightRows_, matrixRows_;  // inputs in DeformPass's layouts
+  std::vector<float> weightRows_, matrixRows_, posedCapsules_;  // inputs in DeformPass's layouts
   uint64_t records_ = 0;  // record() calls with normal maps: the clock of FrameResources::slotLastUsed
 };
 

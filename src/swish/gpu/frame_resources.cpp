@@ -20,6 +20,8 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
                        tag + "mesh weights");
   skinMatrices = Buffer(ctx, std::max<VkDeviceSize>(16, DeformPass::skinMatricesBytes(uint32_t(c), m.jointCount())),
                         MemoryKind::HostVisible, tag + "skin matrices");
+  if (m.capsuleCount() > 0)
+    posedCapsules = Buffer(ctx, c * m.capsuleCount() * 8 * sizeof(float), MemoryKind::HostVisible, tag + "posed capsules");
   positions = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "positions");
   if (withFrames) {
     normals = Buffer(ctx, c * n * 3 * sizeof(float), MemoryKind::DeviceLocal, tag + "normals");

@@ -35,6 +35,7 @@ struct FrameResources {
   // Inputs, written by FrameRecorder::record.
   Buffer meshWeights;      // float[instances][K4] (DeformPass::packWeights)
   Buffer skinMatrices;     // vec4[instances][joints][3] (DeformPass::packSkinMatrices)
+  Buffer posedCapsules;    // float[instances][capsules][8] (runtime::poseBodyProxy); empty without a proxy
   Buffer decodeSlotMaps;   // the VQ decode jobs: uint[2][instances], maps then the slots they go to
   Buffer blendCharacters;  // layout::NormalMapBlendCharacter[instances]
   // Outputs.

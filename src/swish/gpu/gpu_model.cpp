@@ -24,7 +24,7 @@ Buffer uploaded(Context& ctx, const std::string& name, const std::vector<T>& v) 
 
 }  // namespace
 
-GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name_(name) {
+GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name_(name), bodyProxy_(m.bodyProxy) {
   const Mesh& g = m.gameMesh;
   const auto fail = [&](const std::string& what) { throw Error(name + ": cannot upload to the GPU: " + what); };
   vertexCount_ = uint32_t(g.vertexCount());

@@ -34,6 +34,9 @@ class GpuModel {
   uint32_t mapWidth() const { return mapWidth_; }
   uint32_t mapHeight() const { return mapHeight_; }
   uint32_t codebookSize() const { return codebookSize_; }
+  // The body proxy the deform kernel's push-out poses each frame (on the CPU; no GPU copy of its own).
+  const BodyProxy& bodyProxy() const { return bodyProxy_; }
+  uint32_t capsuleCount() const { return uint32_t(bodyProxy_.capsules.size()); }
 
   Buffer mean, basis, skinJoints, skinWeights;
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;
@@ -42,6 +45,7 @@ class GpuModel {
 
  private:
   std::string name_;
+  BodyProxy bodyProxy_;
   uint32_t vertexCount_ = 0, triangleCount_ = 0, jointCount_ = 0, meshComponents_ = 0, kernelComponents_ = 1;
   uint32_t influences_ = 1;
   bool hasUvs_ = false;

@@ -86,6 +86,15 @@ void Model::validate(const std::string& what) const {
   } else if (db.codeDims() != 0) {
     fail("normal maps", "keys have dimensions but no maps");
   }
+  if (bodyProxy.capsules.size() > kMaxBodyCapsules)
+    fail("body proxy", n2s(bodyProxy.capsules.size()) + " capsules; at most " + n2s(kMaxBodyCapsules));
+  for (size_t c = 0; c < bodyProxy.capsules.size(); ++c) {
+    const BodyCapsule& cap = bodyProxy.capsules[c];
+    if (cap.joint >= skeleton.size())
+      fail("body proxy", "capsule " + n2s(c) + " joint " + n2s(cap.joint) + " >= joint count " + n2s(skeleton.size()));
+    if (!cap.a.allFinite() || !cap.b.allFinite()) fail("body proxy", "capsule " + n2s(c) + " has non-finite end points");
+    if (!(cap.radius > 0.f) || !(cap.radius < 10.f)) fail("body proxy", "capsule " + n2s(c) + " radius must be in (0, 10) metres");
+  }
   if (!(temporalFilter.timeConstantSeconds >= 0.f) || !std::isfinite(temporalFilter.timeConstantSeconds))
     fail("temporal filter", "time constant must be finite and >= 0");
 }

@@ -65,6 +65,25 @@ struct TemporalFilterParams {
   float timeConstantSeconds = 0.1f;
 };
 
+// A cheap stand-in for the body under the garment, for the run-time push-out (paper 2.3 has none; see
+// runtime/reference_push_out.hpp): capsules that ride on skinning joints. Each capsule is the set of
+// points within `radius` of the segment a..b, given in REST (bind) character space; it is posed rigidly
+// with its joint's skinning matrix. Fitted INSIDE the body (bake/training/body_proxy_fit.hpp), so that pushing a
+// garment vertex out of a capsule never carries it past the real body surface.
+struct BodyCapsule {
+  uint32_t joint = 0;
+  Vec3f a = Vec3f::Zero(), b = Vec3f::Zero();
+  float radius = 0.f;  // metres, > 0
+};
+
+struct BodyProxy {
+  std::vector<BodyCapsule> capsules;  // applied in this order; empty: no push-out
+  bool empty() const { return capsules.empty(); }
+};
+
+// Most capsules a proxy may hold (the deform kernel loops over all of them per vertex and instance).
+inline constexpr size_t kMaxBodyCapsules = 64;
+
 struct Model {
   Skeleton skeleton;                 // the character's skeleton (for FK and skinning)
   std::vector<uint32_t> inputJoints; // skeleton joint indices forming Theta, in this order
@@ -75,6 +94,7 @@ struct Model {
   Mesh gameMesh;                     // rest positions, triangles, UVs, skin, rest normals+tangents
   NormalMapDatabase normalMaps;      // may be empty (a model without normal maps)
   TemporalFilterParams temporalFilter;
+  BodyProxy bodyProxy;               // may be empty (models of format 1.0, or baked without a body)
   std::string metadata = "{}";       // free-form JSON: bake settings, errors measured at bake time
 
   int thetaSize() const { return int(inputJoints.size()) * 6; }

@@ -135,7 +135,11 @@ ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::strin
       fail("section '" + sec.tag + "': checksum mismatch (stored " + hex32(sec.crc) + ", computed " + hex32(crc) +
            "): the file is corrupted");
     if (!seen.insert(sec.tag).second) fail("section '" + sec.tag + "' appears twice");
-    sec.known = findCodec(sec.tag) != nullptr;
+    const SectionCodec* codec = findCodec(sec.tag);
+    sec.known = codec != nullptr;
+    if (codec && codec->sinceMinor > info.minorVersion)
+      fail(where + ": a section of format " + versionText(kModelFileMajorVersion, codec->sinceMinor) + " in a version " +
+           versionText(info.majorVersion, info.minorVersion) + " file");
     // Sections unknown to this reader are legitimate only in a file of a newer minor version.
     if (!sec.known && info.minorVersion <= kModelFileMinorVersion)
       fail("unknown section '" + sec.tag + "' in a version " + versionText(info.majorVersion, info.minorVersion) +
@@ -144,7 +148,8 @@ ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::strin
   }
   if (body.remaining() != 0) fail(std::to_string(body.remaining()) + " bytes after the last section");
   for (const auto& codec : sectionCodecs())
-    if (!seen.count(std::string(codec.tag))) fail("section '" + std::string(codec.tag) + "' is missing");
+    if (!seen.count(std::string(codec.tag)) && codec.sinceMinor <= info.minorVersion)
+      fail("section '" + std::string(codec.tag) + "' is missing");
   return info;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The .swish model file: everything the run time needs for one garment, in one checked binary file.
 //
-// ==================================== Layout, format version 1.0 ====================================
+// ==================================== Layout, format version 1.1 ====================================
 // All integers are unsigned little-endian unless marked i32 (two's complement). f32 is IEEE-754
 // binary32, little-endian, bit pattern kept exactly. There is no padding or alignment anywhere: fields
 // follow each other byte after byte. Matrices are column-major (Eigen's order) unless said otherwise.
@@ -9,7 +9,7 @@
 // File header, 32 bytes:
 //   0   u8[8]  magic: 0x89 'S' 'W' 'I' 'S' 'H' 0x0D 0x0A  (0x89 and CR LF catch text-mode mangling)
 //   8   u16    major version = 1. A reader refuses a larger major version.
-//   10  u16    minor version = 0. Minor versions only ADD sections; a reader skips tags it does not
+//   10  u16    minor version = 1. Minor versions only ADD sections; a reader skips tags it does not
 //              know when the file's minor version is newer than its own, and refuses them otherwise.
 //   12  u32    section count
 //   16  u64    total file size in bytes, header included (catches truncation before anything else)
@@ -21,7 +21,8 @@
 //   12  u32    CRC-32 of the payload
 //   16  u8[payload size] payload; every payload must be read to its last byte (trailing bytes = error)
 //
-// Sections of version 1.0: each exactly once, all required, any order (the writer uses this one).
+// Sections of version 1.0: each exactly once, all required, any order (the writer uses this one and
+// puts BPRX before META).
 //   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
 //          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
 //          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
@@ -45,6 +46,10 @@
 //          M = 0 is a model without normal maps. Decoding: see NormalMapDatabase in model.hpp.
 //   "TFLT" temporal filter: f32 time constant in seconds (0 = no filtering).
 //   "META" free-form metadata, UTF-8 JSON text, the whole payload, no terminator.
+// Added in version 1.1 (required in 1.1 files; a 1.0 file has none and loads with an empty proxy; a
+// 1.0 file that holds one is refused):
+//   "BPRX" body proxy for the run-time push-out: u32 C capsules (0..64), then per capsule u32 joint,
+//          f32[3] end a, f32[3] end b (rest character space), f32 radius (metres). See BodyProxy.
 // After parsing, Model::validate checks every index and size the run time relies on.
 // =====================================================================================================
 #include <array>
@@ -59,7 +64,7 @@
 namespace swish {
 
 constexpr uint16_t kModelFileMajorVersion = 1;
-constexpr uint16_t kModelFileMinorVersion = 0;
+constexpr uint16_t kModelFileMinorVersion = 1;
 constexpr std::array<uint8_t, 8> kModelFileMagic = {0x89, 'S', 'W', 'I', 'S', 'H', 0x0D, 0x0A};
 constexpr size_t kModelFileHeaderBytes = 32;
 constexpr size_t kModelSectionHeaderBytes = 16;

@@ -252,6 +252,29 @@ void readNormalMaps(ByteReader& r, Model& m) {
   r.u16s(db.indices.data(), indices, "block index");
 }
 
+// ---- BPRX (format 1.1) ------------------------------------------------------------------------
+constexpr uint64_t kCapsuleBytes = 4 + 12 + 12 + 4;
+
+void writeBodyProxy(const Model& m, ByteWriter& w) {
+  w.u32(count32(m.bodyProxy.capsules.size(), "body capsule"));
+  for (const BodyCapsule& c : m.bodyProxy.capsules) {
+    w.u32(c.joint);
+    w.f32s({c.a.data(), 3});
+    w.f32s({c.b.data(), 3});
+    w.f32(c.radius);
+  }
+}
+
+void readBodyProxy(ByteReader& r, Model& m) {
+  m.bodyProxy.capsules.resize(r.checkCount(r.u32("body capsule count"), kCapsuleBytes, "body capsule"));
+  for (BodyCapsule& c : m.bodyProxy.capsules) {
+    c.joint = r.u32("body capsule joint");
+    r.f32s(c.a.data(), 3, "body capsule end a");
+    r.f32s(c.b.data(), 3, "body capsule end b");
+    c.radius = r.f32("body capsule radius");
+  }
+}
+
 // ---- TFLT, META -------------------------------------------------------------------------------
 void writeTemporalFilter(const Model& m, ByteWriter& w) { w.f32(m.temporalFilter.timeConstantSeconds); }
 void readTemporalFilter(ByteReader& r, Model& m) { m.temporalFilter.timeConstantSeconds = r.f32("time constant"); }
@@ -271,7 +294,7 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {"MLP ", writeMlp, readMlp},                 {"MPCA", writeMeshPca, readMeshPca},
       {"MESH", writeMesh, readMesh},               {"SKIN", writeSkin, readSkin},
       {"NMDB", writeNormalMaps, readNormalMaps},   {"TFLT", writeTemporalFilter, readTemporalFilter},
-      {"META", writeMetadata, readMetadata},
+      {"BPRX", writeBodyProxy, readBodyProxy, 1},  {"META", writeMetadata, readMetadata},
   };
   return codecs;
 }

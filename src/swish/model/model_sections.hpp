@@ -16,6 +16,9 @@ struct SectionCodec {
   void (*write)(const Model&, ByteWriter&);
   // Reads the whole payload into the model (the container checks that nothing is left over).
   void (*read)(ByteReader&, Model&);
+  // The minor format version that added the section: required in files of that minor version or newer,
+  // absent (and refused) in older ones.
+  uint16_t sinceMinor = 0;
 };
 
 // The sections of the current format version, in the order the writer emits them.

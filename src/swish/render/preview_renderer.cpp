@@ -71,7 +71,7 @@ struct PreviewRenderer::State {
   api::FrameReport lastReport;
 
   State(HostDevice& d, api::Runtime rt, api::Model m, PreviewOptions o)
-      : dev(&d), runtime(std::move(rt)), model(m), batch(m.createBatch({1, o.framesInFlight, true})), opts(std::move(o)), pipes(d) {}
+      : dev(&d), runtime(std::move(rt)), model(m), batch(m.createBatch({1, o.framesInFlight, true, o.pushOut})), opts(std::move(o)), pipes(d) {}
 
   void submitAndWait() {
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};

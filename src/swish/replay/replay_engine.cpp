@@ -12,6 +12,8 @@
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
+#include "swish/bake/cloth/body_collider.hpp"
+#include "swish/bake/report/penetration.hpp"
 #include "swish/core/error.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
@@ -63,6 +65,10 @@ struct Batch {
   std::unique_ptr<gpu::GpuModel> gpuModel;
   std::unique_ptr<gpu::FrameRecorder> recorder;
   std::unique_ptr<ModelTruth> truth;  // when ground truth was asked for
+  // Penetration: the bake's body, one collider per character (posed concurrently).
+  std::unique_ptr<Character> bodyCharacter;
+  std::string bodyNote;
+  std::vector<bake::BodyCollider> colliders;
   // Per frame scratch.
   std::vector<Pose> poses;
   std::vector<float> theta, meshWeights, codes;
@@ -77,6 +83,7 @@ struct TruthJob {
   const ModelTruth* truth = nullptr;
   Pose pose;
   Points3f positions;
+  std::optional<Points3f> withoutPushOut;  // the CPU reference's positions without the push-out (models with a proxy)
   std::optional<runtime::BlendedNormalMap> normalMap;
 };
 
@@ -93,11 +100,16 @@ struct ReplayEngine::Impl {
   std::vector<TruthPool> truthPools;  // per scene character
   TruthPool truthOverall;
   uint32_t truthDone = 0, truthTotal = 0;
+  // Penetration.
+  std::vector<PenetrationSummary> penetrationPools;  // per scene character
+  PenetrationSummary penetrationOverall;
+  double penetrationSeconds = 0;
 
   Impl(const runtime::Scene& s, ModelLibrary& m, const ReplayOptions& o) : scene(s), models(m), options(o) {}
   void setUp();
   bool truthFrame(uint32_t index) const;
   FrameRecord runFrame(uint32_t index, ReplayResult& result);
+  void measurePenetration(FrameRecord& rec);
   void runTruth(ReplayResult& result);
 };
 
@@ -131,6 +143,17 @@ void ReplayEngine::Impl::setUp() {
         }
       } catch (const Error& e) {
         throw Error(where + ": characters[" + std::to_string(c) + "] ('" + ch.name + "'): " + e.what());
+      }
+    }
+    if (options.penetrationEvery > 0 && !B.planned->characters.empty()) {
+      B.bodyCharacter = rebuildBakeCharacter(models.at(B.planned->model), B.bodyNote);
+      if (B.bodyCharacter && B.bodyCharacter->body.triangleCount() == 0) {
+        B.bodyNote = "the bake's character '" + B.bodyCharacter->name + "' has no body mesh";
+        B.bodyCharacter.reset();
+      }
+      if (B.bodyCharacter) {
+        const bake::BodyCollider prototype(B.bodyCharacter->body, 0.05f, "model '" + B.planned->model + "' body");
+        B.colliders.assign(B.planned->characters.size(), prototype);
       }
     }
   }
@@ -190,6 +213,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
     poses.clear();
     poses.reserve(n);
     B.inputs.instanceCount = n;
+    B.inputs.pushOut = options.pushOut;
     B.inputs.skinMatrices.resize(n * jc);
     for (uint32_t i = 0; i < n; ++i) {
       poses.push_back(B.motions[i].poseAt(seconds, rec.frame, issues));
@@ -293,6 +317,8 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
             job.truth = B.truth.get();
             job.pose = B.poses[i];
             job.positions = gpuOut.positions[i];
+            if (B.inputs.pushOut && !B.uploaded().bodyProxy.empty())
+              job.withoutPushOut = runtime::referencePositions(B.uploaded(), B.inputs, i, false);
             if (B.truth->normalMaps() && i < gpuOut.normalMaps.size()) job.normalMap = gpuOut.normalMaps[i];
             rec.truth.push_back({});
             rec.truth.back().character = job.character;
@@ -305,11 +331,43 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
       }
     }
   }
+  if (options.penetrationEvery > 0 && index % options.penetrationEvery == 0) measurePenetration(rec);
   rec.poseIssues = uint32_t(issues.size());
   result.issueCount += issues.size();
   for (auto& i : issues)
     if (result.issues.size() < kMaxIssues) result.issues.push_back(std::move(i));
   return rec;
+}
+
+// The CPU reference's positions of each character with a body, before and after the push-out, against
+// that character's posed body; characters in parallel (each has its own collider).
+void ReplayEngine::Impl::measurePenetration(FrameRecord& rec) {
+  const auto t0 = Clock::now();
+  for (Batch& B : batches) {
+    if (B.colliders.empty()) continue;
+    const Model& m = B.uploaded();
+    const uint32_t n = uint32_t(B.planned->characters.size()), jc = uint32_t(m.skeleton.size());
+    const bool pushed = B.inputs.pushOut && !m.bodyProxy.empty();
+    std::vector<CharacterPenetration> out(n);
+    tbb::parallel_for(uint32_t(0), n, [&](uint32_t i) {
+      bake::BodyCollider& c = B.colliders[i];
+      c.pose(std::vector<Mat4f>(B.inputs.skinMatrices.begin() + size_t(i) * jc, B.inputs.skinMatrices.begin() + size_t(i + 1) * jc));
+      out[i].character = B.planned->characters[i];
+      out[i].model = bake::measurePenetration(c, runtime::referencePositions(m, B.inputs, i, false));
+      if (pushed) {
+        out[i].pushedMeasured = true;
+        out[i].pushed = bake::measurePenetration(c, runtime::referencePositions(m, B.inputs, i, true));
+      }
+    });
+    for (const CharacterPenetration& p : out) {
+      for (PenetrationSummary* s : {&penetrationPools[p.character], &penetrationOverall}) {
+        s->model.add(p.model);
+        if (p.pushedMeasured) s->pushed.add(p.pushed), s->pushedMeasured = true;
+      }
+      rec.penetration.push_back(p);
+    }
+  }
+  penetrationSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
 // Runs the gathered truth simulations in parallel, one task each (a pose takes about a second, so
@@ -327,7 +385,8 @@ void ReplayEngine::Impl::runTruth(ReplayResult& result) {
           // Isolated: while the transfer's inner parallel loops wait, this thread must not pick up
           // another pose, whose second of simulation would then count in this pose's time.
           tbb::this_task_arena::isolate(
-              [&] { out[k] = j.truth->measure(j.pose, j.positions, j.normalMap ? &*j.normalMap : nullptr); });
+              [&] { out[k] = j.truth->measure(j.pose, j.positions, j.normalMap ? &*j.normalMap : nullptr,
+                                           j.withoutPushOut ? &*j.withoutPushOut : nullptr); });
           std::lock_guard<std::mutex> lock(mutex);
           ++truthDone;
           if (options.truthProgress) options.truthProgress(truthDone, truthTotal);
@@ -381,6 +440,21 @@ ReplayResult ReplayEngine::run() {
     I.truthTotal = characters * ((I.scene.frameCount + every - 1) / every);
     I.truthPools = std::vector<TruthPool>(I.scene.characters.size());
   }
+  r.penetrationEvery = I.options.penetrationEvery;
+  for (const Batch& B : I.batches)
+    if (I.options.pushOut && I.plan.gpuWork && !B.model->bodyProxy.empty()) r.pushOut = true;
+  if (I.options.penetrationEvery == 0) {
+    r.penetrationNote = "not measured (--penetration-every 0)";
+  } else {
+    for (const Batch& B : I.batches) {
+      if (!r.penetrationNote.empty()) r.penetrationNote += "; ";
+      r.penetrationNote += "model '" + B.planned->model + "': " +
+                           (B.bodyCharacter ? "the body of the bake's character '" + B.bodyCharacter->name + "' (" +
+                                                  std::to_string(B.bodyCharacter->body.vertexCount()) + " vertices)"
+                                            : "not measured: " + B.bodyNote);
+    }
+    I.penetrationPools = std::vector<PenetrationSummary>(I.scene.characters.size());
+  }
   // Per-model ground truth: the bake's error on held-out poses, when the model's metadata has it.
   for (const auto& e : I.models.entries())
     if (e->model.metadata.find("\"held_out_poses\"") != std::string::npos) r.truthAvailable = true;
@@ -399,6 +473,13 @@ ReplayResult ReplayEngine::run() {
     r.truthOverall = I.truthOverall.summary();
     if (r.truthOverall.samples > 0) r.truthAvailable = true;
   }
+  bool anyPenetration = false;
+  for (const PenetrationSummary& p : I.penetrationPools) anyPenetration |= p.model.frames > 0;
+  if (anyPenetration) {
+    r.penetrationPerCharacter = I.penetrationPools;
+    r.penetrationOverall = I.penetrationOverall;
+  }
+  r.penetrationSeconds = I.penetrationSeconds;
   // With validation on, a validation message is a failure of the run like a wrong output.
   if (I.ctx && I.ctx->validationEnabled())
     for (const std::string& m : I.ctx->validationMessages()) r.failures.push_back("Vulkan validation: " + m);

@@ -12,6 +12,9 @@
 // Errors measured: on every outputs.gpuCheckEvery-th frame, the GPU outputs of that frame against the
 // CPU reference (runtime::referenceFrame) fed the same inputs and the GPU's previous normal maps:
 // positions (mm), normals and tangents (degrees), normal maps (snorm16 steps), per character.
+// Penetration (ReplayOptions::penetrationEvery): the garment against the body the model was baked on
+// (rebuilt as the truth rebuilds it), per character per measured frame, before and after the push-out,
+// on the CPU reference's positions; outside the timed stages.
 // Ground truth (ReplayOptions::truth, `--truth-every N`; truth_simulation.hpp): on every Nth frame each
 // on-screen character's pose is simulated by the bake's source simulation and the frame's GPU output
 // is measured against it: per-vertex error (mm) and normal-map angular error (degrees), per character
@@ -24,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "swish/bake/report/penetration.hpp"
 #include "swish/gpu/context.hpp"
 #include "swish/replay/character_motion.hpp"
 #include "swish/replay/model_library.hpp"
@@ -38,6 +42,10 @@ struct ReplayOptions {
   gpu::ContextOptions device;
   gpu::Context* context = nullptr;  // use this device instead of creating one (tests, hosts)
   TruthOptions truth;               // truth.every 0: none; N: ground truth on every Nth frame
+  bool pushOut = true;              // the run time's push-out of the body proxy (models that have one)
+  // Penetration of the garment into the body it was baked on (the CPU reference's positions, with and
+  // without the push-out) on every Nth frame; 0: not measured.
+  uint32_t penetrationEvery = 30;  // the CPU measure poses a body collider per character: every frame would dwarf the replay
   std::function<void(uint32_t framesDone, uint32_t framesTotal)> progress;
   // Truth simulations done of those planned (called from worker threads, one call at a time).
   std::function<void(uint32_t posesDone, uint32_t posesTotal)> truthProgress;
@@ -64,6 +72,20 @@ struct CharacterCheck {
   bool ok = true;
 };
 
+// One character's penetration on one frame (bake/report/penetration.hpp): the model's reconstruction as it
+// comes out of skinning, and after the push-out (when the model has a body proxy and it is on).
+struct CharacterPenetration {
+  uint32_t character = 0;
+  bake::PenetrationStats model;
+  bool pushedMeasured = false;
+  bake::PenetrationStats pushed;
+};
+
+struct PenetrationSummary {
+  bake::PenetrationPool model, pushed;
+  bool pushedMeasured = false;
+};
+
 struct FrameRecord {
   uint32_t frame = 0;
   FrameTimes times;
@@ -73,6 +95,7 @@ struct FrameRecord {
   uint32_t poseIssues = 0;
   bool truthFrame = false;             // on the --truth-every grid, with a model that has truth
   std::vector<CharacterTruth> truth;   // when truthFrame: per on-screen character with truth, plan order
+  std::vector<CharacterPenetration> penetration;  // per on-screen character with a body, plan order (measured frames)
   double maxPositionErrorMm() const;
   double maxNormalErrorDeg() const;
   int maxMapErrorSteps() const;
@@ -100,6 +123,13 @@ struct ReplayResult {
   double truthWallSeconds = 0;                  // wall time of the truth simulations (all threads together)
   std::vector<TruthSummary> truthPerCharacter;  // per scene character (empty when no truth ran)
   TruthSummary truthOverall;
+  // Penetration (ReplayOptions::penetrationEvery).
+  uint32_t penetrationEvery = 0;
+  std::string penetrationNote;                      // which body, or why none
+  bool pushOut = false;                             // the push-out ran (some model has a proxy and it was on)
+  std::vector<PenetrationSummary> penetrationPerCharacter;  // per scene character (empty when none measured)
+  PenetrationSummary penetrationOverall;
+  double penetrationSeconds = 0;                    // wall time of the measurements
   bool failed() const { return !failures.empty() || issueCount > 0; }
 };
 

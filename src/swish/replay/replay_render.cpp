@@ -2,8 +2,11 @@
 
 #include <cstdio>
 
+#include <tbb/parallel_for.h>
+
 #include "swish/bake/character/default_character.hpp"
 #include "swish/core/error.hpp"
+#include "swish/io/error_heat_map.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/render/body_from_character.hpp"
 #include "swish/render/contact_sheet.hpp"
@@ -47,10 +50,40 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   render::PreviewOptions popts;
   popts.width = o.width;
   popts.height = o.height;
+  popts.pushOut = o.pushOut;
   std::string why;
   popts.body = render::bodyFromCharacter(bake::makeDefaultCharacter(), model.info(), why);
   if (!popts.body) result.note = "no mannequin drawn: " + why;
+  {
+    // Frame the garment and the body around it from the hem up (arms, neck), not the legs and feet.
+    render::Vec3 lo, hi;
+    render::boundsOf(model.info().restPositions, lo, hi);
+    const float hem = lo[1] - 0.08f;
+    if (popts.body)
+      for (size_t i = 0; i + 2 < popts.body->positions.size(); i += 3)
+        if (popts.body->positions[i + 1] >= hem)
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], popts.body->positions[i + a]);
+            hi[a] = std::max(hi[a], popts.body->positions[i + a]);
+          }
+    popts.camera = render::frameBox(lo, hi, float(o.width) / float(o.height), 0.04f);
+  }
   render::PreviewRenderer preview(device, runtime, model, popts);
+
+  std::unique_ptr<ModelTruth> truth;
+  if (o.truth.every > 0) {
+    truth = std::make_unique<ModelTruth>(entry, o.truth);
+    if (!truth->available()) {
+      result.note += std::string(result.note.empty() ? "" : "; ") + "no heat maps: " + truth->note();
+      truth.reset();
+    }
+  }
+  struct HeatJob {
+    uint32_t frame;
+    Pose pose;
+    Points3f model;
+  };
+  std::vector<HeatJob> heatJobs;
 
   const uint32_t frames = scene.frameCount;
   const uint32_t shown = std::max<uint32_t>(1, std::min(o.maxFrames, frames));
@@ -58,7 +91,10 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   std::vector<render::PreviewImage> images;
   std::vector<api::Quat> rotations(skeleton.size());
   for (uint32_t i = 0; i < shown; ++i) {
-    const uint32_t f = scene.firstFrame + uint32_t(uint64_t(i) * frames / shown);
+    uint32_t index = uint32_t(uint64_t(i) * frames / shown);
+    if (truth) index -= index % o.truth.every;  // on the truth grid, as the replay's truth frames
+    if (i > 0 && truth && !heatJobs.empty() && scene.firstFrame + index == heatJobs.back().frame) continue;
+    const uint32_t f = scene.firstFrame + index;
     const Pose pose = motion->poseAt(scene.timeOfFrame(f), f, issues);
     for (size_t j = 0; j < skeleton.size(); ++j)
       rotations[j] = {pose.local[j].x(), pose.local[j].y(), pose.local[j].z(), pose.local[j].w()};
@@ -69,6 +105,57 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
     std::snprintf(name, sizeof name, "frame_%04u.png", f);
     images.push_back(render::renderFramePng(preview, cp, dir / name));
     result.frames.push_back(dir / name);
+    if (truth) {
+      HeatJob job{f, pose, Points3f()};
+      job.pose.rootTranslation = skeleton.restPose().rootTranslation;  // drawn in place, as the preview
+      const api::DeformedMesh mesh = preview.lastJersey();
+      job.model = Eigen::Map<const Points3f>(mesh.positions.data(), Eigen::Index(mesh.positions.size() / 3), 3);
+      heatJobs.push_back(std::move(job));
+    }
+  }
+  if (truth) {
+    // The truth simulations (a couple of seconds each) in parallel; the figures in frame order.
+    std::vector<TruthMeasurement> measured(heatJobs.size());
+    tbb::parallel_for(size_t(0), heatJobs.size(), [&](size_t k) {
+      measured[k] = truth->measure(heatJobs[k].pose, heatJobs[k].model, nullptr);
+    });
+    std::vector<render::PreviewImage> figures;
+    for (size_t k = 0; k < heatJobs.size(); ++k) {
+      if (!measured[k].summary.ok) {
+        result.note += std::string(result.note.empty() ? "" : "; ") + "frame " + std::to_string(heatJobs[k].frame) +
+                       ": no heat map, the truth simulation failed (" + measured[k].summary.failure + ")";
+        continue;
+      }
+      io::HeatMapFigure fig;
+      char title[96];
+      std::snprintf(title, sizeof title, "frame %u  mean %.1f mm  max %.1f mm", heatJobs[k].frame, measured[k].summary.meanMm,
+                    measured[k].summary.maxMm);
+      fig.title = title;
+      fig.model = &heatJobs[k].model;
+      fig.truth = &measured[k].truthPositions;
+      fig.triangles = &entry.model.gameMesh.triangles;
+      fig.scaleMm = 10.0;  // one scale for every frame, so that colours compare across the sheet
+      const io::PngImage png = io::heatMapFigure(fig);
+      char name[32];
+      std::snprintf(name, sizeof name, "heat_%04u.png", heatJobs[k].frame);
+      io::writePng(dir / name, png);
+      result.heatMaps.push_back(dir / name);
+      render::PreviewImage img;
+      img.width = png.width, img.height = png.height;
+      img.rgba.resize(size_t(png.width) * png.height * 4);
+      for (size_t p = 0; p < size_t(png.width) * png.height; ++p) {
+        for (int c = 0; c < 3; ++c) img.rgba[p * 4 + size_t(c)] = uint8_t(png.samples[p * 3 + size_t(c)]);
+        img.rgba[p * 4 + 3] = 255;
+      }
+      figures.push_back(std::move(img));
+    }
+    if (!figures.empty()) {
+      render::ContactSheetOptions so;
+      so.columns = 2;
+      so.thumbnailWidth = 600;
+      result.heatSheet = dir / "heat_sheet.png";
+      render::writeContactSheet(figures, result.heatSheet, so);
+    }
   }
   result.contactSheet = dir / "contact_sheet.png";
   render::writeContactSheet(images, result.contactSheet);

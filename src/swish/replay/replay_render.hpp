@@ -2,13 +2,15 @@
 // `swish replay --render`: draws one scene character's frames with the headless preview renderer (a
 // host of the public API on its own Vulkan device) and writes them as PNG frames plus a contact sheet.
 // The character is drawn in place (its root at the rest position, facing the camera), so the fixed
-// preview camera keeps it framed however far the play carries it across the field.
+// preview camera keeps it framed however far the play carries it across the field: the camera frames the
+// garment and the upper body around it (arms included), not the whole figure on a large canvas.
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "swish/replay/model_library.hpp"
+#include "swish/replay/truth_simulation.hpp"
 #include "swish/runtime/scene.hpp"
 
 namespace swish::replay {
@@ -19,12 +21,19 @@ struct ReplayRenderOptions {
   uint32_t width = 320, height = 426;
   std::string device;       // as --device
   bool validation = false;
+  // With truth.every > 0 (`--truth-every N`): the drawn frames are taken on the truth grid, and each also
+  // gets an error figure heat_NNNN.png (model, truth, per-vertex error heat map with its mm legend;
+  // io/error_heat_map.hpp) and heat_sheet.png; the truth is simulated again here (as the replay's).
+  TruthOptions truth;
+  bool pushOut = true;      // as the replay's --no-push-out
 };
 
 struct ReplayRenderResult {
   std::vector<std::filesystem::path> frames;
   std::filesystem::path contactSheet;
-  std::string note;  // e.g. why no body was drawn
+  std::vector<std::filesystem::path> heatMaps;  // per frame with truth
+  std::filesystem::path heatSheet;              // empty without truth
+  std::string note;  // e.g. why no body was drawn, or why there are no heat maps
 };
 
 // Writes `directory`/frame_NNNN.png and `directory`/contact_sheet.png. Throws Error naming the scene

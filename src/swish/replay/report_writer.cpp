@@ -60,9 +60,32 @@ json truthJson(const TruthSummary& t) {
   json j{{"samples", t.samples}, {"failed", t.failed}, {"seconds", t.seconds}, {"cpuSeconds", t.cpuSeconds}};
   if (t.samples > 0) {
     j["meanMm"] = t.meanMm, j["p95Mm"] = t.p95Mm, j["maxMm"] = t.maxMm;
+    if (t.comparedWithout) j["withoutPushOut"] = {{"meanMm", t.meanMmWithout}, {"p95Mm", t.p95MmWithout}, {"maxMm", t.maxMmWithout}};
     if (t.normalMaps) j["normalMeanDeg"] = t.meanDeg, j["normalP95Deg"] = t.p95Deg, j["normalMaxDeg"] = t.maxDeg;
   }
   return j;
+}
+
+json poolJson(const bake::PenetrationPool& p) {
+  return {{"frames", p.frames},
+          {"framesWithInside", p.framesInside},
+          {"framesVisible", p.framesVisible},
+          {"vertices", p.vertices},
+          {"inside", p.inside},
+          {"visible", p.visible},
+          {"share", p.share()},
+          {"deepestMm", p.deepestMm},
+          {"deepestP95Mm", p.deepestPercentileMm(0.95)}};
+}
+
+json penetrationJson(const PenetrationSummary& s) {
+  json j{{"model", poolJson(s.model)}};
+  if (s.pushedMeasured) j["pushed"] = poolJson(s.pushed);
+  return j;
+}
+
+json statsJson(const bake::PenetrationStats& s) {
+  return {{"inside", s.inside}, {"visible", s.visible}, {"share", s.share()}, {"deepestMm", s.deepestMm}};
 }
 
 // Mean over a frame's measured characters of their mean vertex error, and the worst max; NaN if none.
@@ -102,6 +125,9 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
     j["truth"]["wallSeconds"] = r.truthWallSeconds;
     j["truth"]["overall"] = truthJson(r.truthOverall);
   }
+  j["penetration"] = {{"every", r.penetrationEvery}, {"note", r.penetrationNote}, {"pushOut", r.pushOut},
+                      {"visibleDepthMm", bake::kVisiblePenetrationMm}, {"seconds", r.penetrationSeconds}};
+  if (!r.penetrationPerCharacter.empty()) j["penetration"]["overall"] = penetrationJson(r.penetrationOverall);
   j["frames"] = json::array();
   std::vector<json> perChar(scene.characters.size());
   for (size_t c = 0; c < scene.characters.size(); ++c)
@@ -119,11 +145,21 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
                {"cpuSeconds", c.cpuSeconds}, {"limbCorrections", c.limbCorrections}};
         if (c.ok) {
           t["meanMm"] = c.meanMm, t["p95Mm"] = c.p95Mm, t["maxMm"] = c.maxMm;
+          if (c.comparedWithout)
+            t["withoutPushOut"] = {{"meanMm", c.meanMmWithout}, {"p95Mm", c.p95MmWithout}, {"maxMm", c.maxMmWithout}};
           if (c.normalMap) t["normalMeanDeg"] = c.meanDeg, t["normalP95Deg"] = c.p95Deg, t["normalMaxDeg"] = c.maxDeg;
         } else {
           t["failure"] = c.failure;
         }
         fj["truth"].push_back(t);
+      }
+    }
+    if (!f.penetration.empty()) {
+      fj["penetration"] = json::array();
+      for (const auto& p : f.penetration) {
+        json pj{{"character", scene.characters[p.character].name}, {"model", statsJson(p.model)}};
+        if (p.pushedMeasured) pj["pushed"] = statsJson(p.pushed);
+        fj["penetration"].push_back(pj);
       }
     }
     if (f.checked)
@@ -143,6 +179,8 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
       if (scene.characters[c].name == i.character) perChar[c]["poseIssues"] = perChar[c]["poseIssues"].get<int>() + 1;
   for (size_t c = 0; c < r.truthPerCharacter.size() && c < perChar.size(); ++c)
     perChar[c]["truth"] = truthJson(r.truthPerCharacter[c]);
+  for (size_t c = 0; c < r.penetrationPerCharacter.size() && c < perChar.size(); ++c)
+    if (r.penetrationPerCharacter[c].model.frames > 0) perChar[c]["penetration"] = penetrationJson(r.penetrationPerCharacter[c]);
   j["characters"] = perChar;
   json summary;
   for (const auto& s : stageColumns()) {
@@ -228,7 +266,48 @@ std::string reportMarkdown(const json& j) {
       if (t.contains("normalMeanDeg"))
         s << "; normal-map angular error mean " << fmt(num(t["normalMeanDeg"])) << " deg, p95 " << fmt(num(t["normalP95Deg"]))
           << " deg, max " << fmt(num(t["normalMaxDeg"])) << " deg";
-      s << ".\n\n![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
+      s << ".\n\n";
+      if (t.contains("withoutPushOut")) {
+        const json& w = t["withoutPushOut"];
+        s << "The same truth frames without the push-out (the CPU reference's positions): vertex error mean "
+          << fmt(num(w["meanMm"])) << " mm, p95 " << fmt(num(w["p95Mm"])) << " mm, max " << fmt(num(w["maxMm"]))
+          << " mm: the push-out changes the mean by " << fmt(num(t["meanMm"]) - num(w["meanMm"]), "%+.3f") << " mm and the p95 by "
+          << fmt(num(t["p95Mm"]) - num(w["p95Mm"]), "%+.3f") << " mm.\n\n";
+      }
+      s << "![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
+    }
+  }
+  {
+    const json& p = j["penetration"];
+    s << "## Garment inside the body\n\nPenetration of the garment into the body it was baked on: "
+      << p["note"].get<std::string>() << ". Measured on the CPU reference's positions"
+      << (num(p["every"]) > 1 ? " every " + std::to_string(p["every"].get<int>()) + " frames" : std::string(" every frame"))
+      << ", per character: vertices inside the body (signed distance < 0), those deeper than "
+      << fmt(num(p["visibleDepthMm"]), "%g") << " mm (visible), the deepest. The run time's push-out of the body proxy was "
+      << (p["pushOut"].get<bool>() ? "ON (what the GPU drew and the truth measured)" : "OFF") << ".\n\n";
+    if (p.contains("overall")) {
+      s << "| positions | frames x characters | with any inside | with visible (> " << fmt(num(p["visibleDepthMm"]), "%g")
+        << " mm) | vertices inside | share | visible vertices | deepest mm | p95 of per-frame deepest mm |\n"
+        << "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+      auto row = [&](const char* label, const json& q) {
+        s << "| " << label << " | " << q["frames"] << " | " << q["framesWithInside"] << " | " << q["framesVisible"] << " | "
+          << q["inside"] << " | " << fmt(100.0 * num(q["share"]), "%.3f") << " % | " << q["visible"] << " | "
+          << fmt(num(q["deepestMm"]), "%.2f") << " | " << fmt(num(q["deepestP95Mm"]), "%.2f") << " |\n";
+      };
+      row("model (no push-out)", p["overall"]["model"]);
+      if (p["overall"].contains("pushed")) row("after the push-out", p["overall"]["pushed"]);
+      s << "\n![garment inside the body per frame](plots/penetration_per_frame.svg)\n\n";
+      s << "Per character (deepest mm, frames with visible penetration):\n\n| character | model deepest | model frames visible | "
+           "pushed deepest | pushed frames visible |\n|---|---:|---:|---:|---:|\n";
+      for (const auto& c : j["characters"]) {
+        if (!c.contains("penetration")) continue;
+        const json& q = c["penetration"];
+        s << "| " << c["name"].get<std::string>() << " | " << fmt(num(q["model"]["deepestMm"]), "%.2f") << " | "
+          << q["model"]["framesVisible"] << " | "
+          << (q.contains("pushed") ? fmt(num(q["pushed"]["deepestMm"]), "%.2f") : std::string("-")) << " | "
+          << (q.contains("pushed") ? q["pushed"]["framesVisible"].dump() : std::string("-")) << " |\n";
+      }
+      s << "\n";
     }
   }
   s << "Numerical error of the GPU outputs against the CPU reference (" << sum["checkedFrames"] << " checked frames): "
@@ -339,6 +418,27 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
     writeTextFileAtomic(dir / "plots/truth_error_per_frame.svg",
                         plot("Run time against ground truth (source simulation), per truth frame", "scene frame",
                              "vertex error (mm); normal maps (deg)", ts));
+  }
+  if (!r.penetrationPerCharacter.empty()) {
+    PlotSeries deepModel{"deepest, model (mm)", {}, {}, ""}, deepPushed{"deepest, after the push-out (mm)", {}, {}, ""};
+    PlotSeries visModel{"visible vertices, model (sum over characters / 10)", {}, {}, ""};
+    PlotSeries visPushed{"visible vertices, after the push-out (sum / 10)", {}, {}, ""};
+    for (const auto& f : r.frames) {
+      if (f.penetration.empty()) continue;
+      double dm = 0, dp = 0, vm = 0, vp = 0;
+      bool pushed = false;
+      for (const auto& p : f.penetration) {
+        dm = std::max(dm, p.model.deepestMm), vm += p.model.visible;
+        if (p.pushedMeasured) pushed = true, dp = std::max(dp, p.pushed.deepestMm), vp += p.pushed.visible;
+      }
+      deepModel.x.push_back(f.frame), deepModel.y.push_back(dm);
+      visModel.x.push_back(f.frame), visModel.y.push_back(vm / 10.0);
+      if (pushed) deepPushed.x.push_back(f.frame), deepPushed.y.push_back(dp), visPushed.x.push_back(f.frame), visPushed.y.push_back(vp / 10.0);
+    }
+    std::vector<PlotSeries> ps{deepModel, visModel};
+    if (!deepPushed.x.empty()) ps.push_back(deepPushed), ps.push_back(visPushed);
+    writeTextFileAtomic(dir / "plots/penetration_per_frame.svg",
+                        plot("Garment inside the body, worst character per frame", "scene frame", "mm; vertices / 10", ps));
   }
   io::SvgBarChart stages;
   stages.title = "Median time per stage", stages.unit = "ms";

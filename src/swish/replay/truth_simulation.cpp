@@ -84,37 +84,47 @@ ModelTruth::ModelTruth(const ModelEntry& entry, const TruthOptions& options) : m
   }
 }
 
-void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
+std::unique_ptr<Character> rebuildBakeCharacter(const ModelEntry& entry, std::string& note, std::string* how) {
   if (entry.procedural) {
-    note_ = "the procedural stand-in model was not baked from a simulation: no source simulation to run";
-    return;
+    note = "the procedural stand-in model was not baked from a simulation: no bake character to rebuild";
+    return nullptr;
   }
   bake::BakedCharacter baked = bake::findBakedCharacter(entry.model.metadata, entry.file);
   if (baked.kind == bake::BakedCharacter::Kind::Unknown) {
-    note_ = "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character and "
-            "cloth settings of its source simulation are unknown";
-    return;
+    note = "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character and "
+           "cloth settings of its source simulation are unknown";
+    return nullptr;
   }
   if (!baked.problem.empty()) {
-    note_ = baked.problem;
-    return;
+    note = baked.problem;
+    return nullptr;
   }
-  const json& ds = baked.datasetSettings;
   bake::DatasetBuildSettings& s = baked.settings;
-  const std::string how = baked.kind == bake::BakedCharacter::Kind::File ? "imported from " + baked.description : baked.description;
+  const std::string built =
+      baked.kind == bake::BakedCharacter::Kind::File ? "imported from " + baked.description : baked.description;
   if (s.inputJoints.empty())
     for (uint32_t j : entry.model.inputJoints) s.inputJoints.push_back(entry.model.skeleton.joints[j].name);
+  std::unique_ptr<Character> character;
   try {
-    character_ = std::make_unique<Character>(bake::loadDatasetCharacter(s));
+    character = std::make_unique<Character>(bake::loadDatasetCharacter(s));
   } catch (const Error& e) {
-    note_ = std::string("the bake's character cannot be rebuilt: ") + e.what();
-    return;
+    note = std::string("the bake's character cannot be rebuilt: ") + e.what();
+    return nullptr;
   }
-  if (const std::string diff = characterDifference(entry.model, *character_); !diff.empty()) {
-    note_ = "the rebuilt character '" + character_->name + "' (" + how + ") is not the model's: " + diff;
-    character_.reset();
-    return;
+  if (const std::string diff = characterDifference(entry.model, *character); !diff.empty()) {
+    note = "the rebuilt character '" + character->name + "' (" + built + ") is not the model's: " + diff;
+    return nullptr;
   }
+  if (how) *how = built;
+  return character;
+}
+
+void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
+  std::string how;
+  character_ = rebuildBakeCharacter(entry, note_, &how);
+  if (!character_) return;
+  const json meta = json::parse(entry.model.metadata, nullptr, false);
+  const json& ds = meta["dataset_settings"];
   bake::PoseShapeSettings ps;
   try {
     ps = bake::poseShapeSettingsFromJson(ds, "model metadata dataset_settings");
@@ -159,7 +169,7 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
 ModelTruth::~ModelTruth() = default;
 
 TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions,
-                                     const runtime::BlendedNormalMap* normalMap) const {
+                                     const runtime::BlendedNormalMap* normalMap, const Points3f* without) const {
   const auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = threadCpuSeconds();
   TruthMeasurement m;
@@ -173,14 +183,25 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
   } else {
     // Skinned as the run time skins the prediction: the model's skeleton and weights, the whole pose.
     const Points3f truth = skinPositions(shape.gameMeshPreSkin, model_->gameMesh.skin, model_->skeleton.skinningMatrices(pose));
-    m.vertexMm.resize(size_t(truth.rows()));
-    for (Eigen::Index v = 0; v < truth.rows(); ++v) {
-      const double d = (positions.row(v).cast<double>() - truth.row(v).cast<double>()).norm() * 1000.0;
-      m.vertexMm[size_t(v)] = std::isfinite(d) ? d : 1e30;  // a non-finite output must not hide
-    }
+    auto distances = [&](const Points3f& p) {
+      std::vector<double> mm(size_t(truth.rows()));
+      for (Eigen::Index v = 0; v < truth.rows(); ++v) {
+        const double d = (p.row(v).cast<double>() - truth.row(v).cast<double>()).norm() * 1000.0;
+        mm[size_t(v)] = std::isfinite(d) ? d : 1e30;  // a non-finite output must not hide
+      }
+      return mm;
+    };
+    m.vertexMm = distances(positions);
+    m.truthPositions = truth;
     const bake::DistanceStats st = bake::distanceStats(m.vertexMm);
     m.summary.ok = true;
     m.summary.meanMm = st.mean, m.summary.p95Mm = st.p95, m.summary.maxMm = st.max;
+    if (without && without->rows() == truth.rows()) {
+      m.vertexMmWithout = distances(*without);
+      const bake::DistanceStats w = bake::distanceStats(m.vertexMmWithout);
+      m.summary.comparedWithout = true;
+      m.summary.meanMmWithout = w.mean, m.summary.p95MmWithout = w.p95, m.summary.maxMmWithout = w.max;
+    }
     if (normalMaps_ && normalMap && normalMap->width == shape.normalMap.width && normalMap->height == shape.normalMap.height) {
       const bake::NormalMapImage shown{normalMap->width, normalMap->height, runtime::xyAsFloat(*normalMap)};
       m.angles = std::make_unique<bake::AngularErrorAccumulator>();
@@ -204,6 +225,8 @@ void TruthPool::add(const TruthMeasurement& m) {
   }
   ++samples_;
   vertexMm_.insert(vertexMm_.end(), m.vertexMm.begin(), m.vertexMm.end());
+  if (m.vertexMmWithout.empty()) allWithout_ = false;
+  vertexMmWithout_.insert(vertexMmWithout_.end(), m.vertexMmWithout.begin(), m.vertexMmWithout.end());
   if (m.angles) {
     if (!angles_) angles_ = std::make_unique<bake::AngularErrorAccumulator>();
     angles_->merge(*m.angles);
@@ -216,6 +239,11 @@ TruthSummary TruthPool::summary() const {
   if (!vertexMm_.empty()) {
     const bake::DistanceStats d = bake::distanceStats(vertexMm_);
     s.meanMm = d.mean, s.p95Mm = d.p95, s.maxMm = d.max;
+    if (allWithout_ && vertexMmWithout_.size() == vertexMm_.size()) {
+      const bake::DistanceStats w = bake::distanceStats(vertexMmWithout_);
+      s.comparedWithout = true;
+      s.meanMmWithout = w.mean, s.p95MmWithout = w.p95, s.maxMmWithout = w.max;
+    }
   }
   if (angles_) {
     const bake::AngularErrorStats a = angles_->stats();

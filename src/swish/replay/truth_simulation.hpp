@@ -43,6 +43,9 @@ struct CharacterTruth {
   bool ok = false;          // a truth shape was simulated and measured
   std::string failure;      // why not (the simulation failed: the bake leaves such poses out too)
   double meanMm = 0, p95Mm = 0, maxMm = 0;                   // per-vertex distance to the truth
+  // The same for the positions without the push-out (the CPU reference), when it ran.
+  bool comparedWithout = false;
+  double meanMmWithout = 0, p95MmWithout = 0, maxMmWithout = 0;
   bool normalMap = false;                                    // the normal map was measured
   double meanDeg = 0, p95Deg = 0, maxDeg = 0;                // per-texel angle to the truth map
   uint32_t limbCorrections = 0;  // limbs limb clearance turned out of the trunk before simulating
@@ -54,6 +57,8 @@ struct CharacterTruth {
 struct TruthMeasurement {
   CharacterTruth summary;
   std::vector<double> vertexMm;
+  Points3f truthPositions;              // the truth's game mesh, skinned as the run time skins (when ok)
+  std::vector<double> vertexMmWithout;  // empty unless compared without the push-out
   std::unique_ptr<bake::AngularErrorAccumulator> angles;  // null without a normal map
 };
 
@@ -62,6 +67,8 @@ struct TruthSummary {
   uint32_t samples = 0;  // measured pairs
   uint32_t failed = 0;   // pairs whose truth simulation failed (not measured)
   double meanMm = 0, p95Mm = 0, maxMm = 0;     // over every vertex of every measured pair
+  bool comparedWithout = false;                // every measured pair also measured without the push-out
+  double meanMmWithout = 0, p95MmWithout = 0, maxMmWithout = 0;
   bool normalMaps = false;
   double meanDeg = 0, p95Deg = 0, maxDeg = 0;  // over every texel of every measured map
   double seconds = 0, cpuSeconds = 0;          // summed per-pose seconds (CharacterTruth), failed poses too
@@ -75,7 +82,8 @@ class TruthPool {
  private:
   uint32_t samples_ = 0, failed_ = 0;
   double seconds_ = 0, cpuSeconds_ = 0;
-  std::vector<double> vertexMm_;
+  std::vector<double> vertexMm_, vertexMmWithout_;
+  bool allWithout_ = true;
   std::unique_ptr<bake::AngularErrorAccumulator> angles_;
 };
 
@@ -93,9 +101,11 @@ class ModelTruth {
   bool normalMaps() const { return normalMaps_; }
 
   // Simulates `pose` (on the model's skeleton, as the run time posed the character) and measures the
-  // run time's output of it: `positions` (character space) and `normalMap` (null: not measured).
+  // run time's output of it: `positions` (character space) and `normalMap` (null: not measured);
+  // `withoutPushOut` (optional): the same frame's positions without the push-out, measured beside them.
   // Thread-safe and deterministic. Only when available().
-  TruthMeasurement measure(const Pose& pose, const Points3f& positions, const runtime::BlendedNormalMap* normalMap) const;
+  TruthMeasurement measure(const Pose& pose, const Points3f& positions, const runtime::BlendedNormalMap* normalMap,
+                           const Points3f* withoutPushOut = nullptr) const;
 
  private:
   void prepare(const ModelEntry& entry, const TruthOptions& options);
@@ -106,6 +116,12 @@ class ModelTruth {
   std::unique_ptr<Character> character_;
   std::unique_ptr<bake::PoseShapeSimulator> simulator_;
 };
+
+// The character a model was baked on, rebuilt as its bake built it (the embedded default by code, a
+// recipe or character file named in the metadata, looked for as written and beside the model file) and
+// checked against the model; null with `note` saying why there is none. `how` (optional): how it was
+// built, in words.
+std::unique_ptr<Character> rebuildBakeCharacter(const ModelEntry& entry, std::string& note, std::string* how = nullptr);
 
 // Where the rebuilt `character` differs from `model` (skeleton, game mesh, UVs, skin weights), in
 // words; empty when it matches.

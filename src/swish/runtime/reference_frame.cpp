@@ -5,6 +5,7 @@
 #include "swish/core/error.hpp"
 #include "swish/core/mesh_frames.hpp"
 #include "swish/runtime/reference_pca.hpp"
+#include "swish/runtime/reference_push_out.hpp"
 #include "swish/runtime/reference_skinning.hpp"
 #include "swish/runtime/reference_tangent_frames.hpp"
 
@@ -29,15 +30,28 @@ void FrameKernelInputs::validate(const Model& m) const {
                   " of a database of " + std::to_string(m.normalMaps.mapCount()));
 }
 
+Points3f referencePositions(const Model& m, const FrameKernelInputs& in, uint32_t i, bool pushOut) {
+  if (i >= in.instanceCount) throw Error("reference positions: instance " + std::to_string(i) + " of " + std::to_string(in.instanceCount));
+  const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
+  if (in.meshWeights.size() < (i + 1) * k || in.skinMatrices.size() < (i + 1) * j)
+    throw Error("reference positions: frame inputs too short for instance " + std::to_string(i));
+  const Points3f pre = referencePcaReconstruct(m.meshPca, std::span(in.meshWeights).subspan(i * k, k));
+  const std::span<const Mat4f> mats = std::span(in.skinMatrices).subspan(i * j, j);
+  Points3f out = referenceSkin(pre, m.gameMesh.skin, std::vector<Mat4f>(mats.begin(), mats.end()));
+  if (pushOut && !m.bodyProxy.empty()) {
+    std::vector<float> posed;
+    poseBodyProxy(m.bodyProxy, mats, posed);
+    referencePushOut(out, posed);
+  }
+  return out;
+}
+
 ReferenceFrameOutputs referenceFrame(const Model& m, const FrameKernelInputs& in, const std::vector<BlendedNormalMap>& prev) {
   in.validate(m);
-  const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
   const MeshFrameTopology topo = buildFrameTopology(m.gameMesh.triangles, m.gameMesh.positions);
   ReferenceFrameOutputs out;
   for (uint32_t i = 0; i < in.instanceCount; ++i) {
-    const Points3f pre = referencePcaReconstruct(m.meshPca, std::span(in.meshWeights).subspan(i * k, k));
-    const std::vector<Mat4f> mats(in.skinMatrices.begin() + i * j, in.skinMatrices.begin() + (i + 1) * j);
-    out.positions.push_back(referenceSkin(pre, m.gameMesh.skin, mats));
+    out.positions.push_back(referencePositions(m, in, i, in.pushOut));
     ReferenceTangentFrames f = referenceTangentFrames(out.positions.back(), m.gameMesh, topo);
     out.normals.push_back(std::move(f.normals));
     out.tangents.push_back(std::move(f.tangents));

@@ -1,6 +1,7 @@
 #pragma once
 // The inputs of one frame of the GPU kernels for a batch of instances of one model, and the CPU
-// reference of the whole frame: PCA reconstruction -> skinning -> normals and tangents per instance;
+// reference of the whole frame: PCA reconstruction -> skinning -> push-out of the body proxy ->
+// normals and tangents per instance;
 // VQ decode of each selected map -> temporal blend into each character's normal map. The GPU frame
 // (gpu/frame_recorder.hpp) must reproduce every output within the per-kernel tolerances.
 #include <cstdint>
@@ -17,6 +18,9 @@ struct FrameKernelInputs {
   std::vector<Mat4f> skinMatrices;     // instanceCount x jointCount (Skeleton::skinningMatrices per instance)
   std::vector<uint32_t> selectedMaps;  // instanceCount database maps, or empty: no normal-map work this frame
   std::vector<float> blendAlpha;       // instanceCount weights of the new map (the temporal filter's alpha)
+  // Push the skinned garment out of the model's body proxy (reference_push_out.hpp); no effect for a
+  // model without one.
+  bool pushOut = true;
 
   // Throws Error naming the problem if sizes or map indices do not fit `model`.
   void validate(const Model& model) const;
@@ -28,6 +32,10 @@ struct ReferenceFrameOutputs {
   std::vector<Points4f> tangents;               // per instance
   std::vector<BlendedNormalMap> normalMaps;     // per instance (empty when no maps were selected)
 };
+
+// The skinned positions of one instance alone (PCA -> skinning -> push-out when `pushOut` and the model
+// has a proxy): what referenceFrame's positions are, without the rest of the frame.
+Points3f referencePositions(const Model& model, const FrameKernelInputs& inputs, uint32_t instance, bool pushOut);
 
 // prevMaps: each character's normal map after the previous frame (empty: all zeros, as the GPU images
 // start).

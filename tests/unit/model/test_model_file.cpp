@@ -204,6 +204,13 @@ void expectBitwiseEqual(const Model& a, const Model& b) {
   EXPECT_EQ(da.codebook, db.codebook);
   EXPECT_EQ(da.indices, db.indices);
   EXPECT_EQ(std::memcmp(&a.temporalFilter.timeConstantSeconds, &b.temporalFilter.timeConstantSeconds, 4), 0);
+  ASSERT_EQ(a.bodyProxy.capsules.size(), b.bodyProxy.capsules.size());
+  for (size_t c = 0; c < a.bodyProxy.capsules.size(); ++c) {
+    const auto &ca = a.bodyProxy.capsules[c], &cb = b.bodyProxy.capsules[c];
+    EXPECT_EQ(ca.joint, cb.joint) << "capsule " << c;
+    EXPECT_TRUE(sameBits(ca.a, cb.a) && sameBits(ca.b, cb.b)) << "capsule " << c;
+    EXPECT_EQ(std::memcmp(&ca.radius, &cb.radius, 4), 0) << "capsule " << c;
+  }
   EXPECT_EQ(a.metadata, b.metadata);
 }
 
@@ -319,6 +326,9 @@ TEST(ModelFile, RoundTripIsBitwiseExactForManyShapes) {
   s.hiddenLayers = 0;
   shapes.push_back({"1 influence, linear MLP", s});
   s = {};
+  s.bodyCapsules = 7;
+  shapes.push_back({"body proxy of 7 capsules", s});
+  s = {};
   s.joints = 40;
   s.inputJoints = 16;
   s.vertices = 3001;
@@ -354,13 +364,13 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   auto u16 = [&](size_t at) { return uint32_t(bytes[at] | bytes[at + 1] << 8); };
   auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
   EXPECT_EQ(u16(8), 1u);
-  EXPECT_EQ(u16(10), 0u);
-  EXPECT_EQ(u32(12), 11u);
+  EXPECT_EQ(u16(10), 1u);
+  EXPECT_EQ(u32(12), 12u);
   EXPECT_EQ(uint64_t(u32(16)) | uint64_t(u32(20)) << 32, bytes.size());
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
-  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN", "NMDB", "TFLT", "META"};
+  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN", "NMDB", "TFLT", "BPRX", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());
@@ -470,7 +480,39 @@ TEST(ModelFile, WrongMagicAndVersionsAreClearErrors) {
   const auto info = swish::readModelFileInfo(assemble(extended, 1, 7), "newer.swish");
   EXPECT_FALSE(info.sections[3].known);
   // The same unknown section in a file claiming the current version is corruption.
-  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.0 file");
+  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.1 file");
+}
+
+// Format 1.1 added the body proxy: a 1.0 file (no BPRX) still loads, with no proxy; a 1.1 file without
+// it, or a 1.0 file with it, is refused; a bad capsule is refused naming it.
+TEST(ModelFile, BodyProxySectionOfVersion11) {
+  swish::Rng rng(11);
+  RandomModelSpec spec;
+  spec.vertices = 9;
+  spec.bodyCapsules = 3;
+  const Model m = swish::test::makeRandomModel(rng, spec);
+  auto sections = splitSections(swish::serializeModel(m));
+  expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
+
+  auto without = sections;
+  without.erase(std::find_if(without.begin(), without.end(), [](const RawSection& s) { return s.tag == "BPRX"; }));
+  Model old = m;
+  old.bodyProxy = {};
+  expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 0), "old.swish"), old);
+  EXPECT_CONTAINS(loadError(assemble(without)), "section 'BPRX' is missing");
+  EXPECT_CONTAINS(loadError(assemble(sections, 1, 0)), "a section of format 1.1 in a version 1.0 file");
+
+  auto bad = sections;
+  auto& proxy = sectionOf(bad, "BPRX").payload;
+  putU32(proxy, 4 + 32 + 0, 99);  // capsule 1's joint
+  EXPECT_CONTAINS(loadError(assemble(bad)), "body proxy: capsule 1 joint 99 >= joint count");
+  bad = sections;
+  const float negative = -0.5f;
+  std::memcpy(&sectionOf(bad, "BPRX").payload[4 + 28], &negative, 4);  // capsule 0's radius
+  EXPECT_CONTAINS(loadError(assemble(bad)), "body proxy: capsule 0 radius must be in (0, 10) metres");
+  bad = sections;
+  putU32(sectionOf(bad, "BPRX").payload, 0, 0x10000000u);
+  EXPECT_CONTAINS(loadError(assemble(bad)), "body capsule");
 }
 
 TEST(ModelFile, HostileCountsFailBeforeAllocating) {

@@ -168,6 +168,35 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
   EXPECT_NE(text.find("Run time against ground truth"), std::string::npos) << text;
   EXPECT_NE(text.find("Ground truth per character"), std::string::npos);
   EXPECT_TRUE(fs::exists(job.directory / "plots/truth_error_per_frame.svg"));
+
+  // Penetration into the bake's body, every frame, every character: the model's reconstruction and,
+  // when the model carries a body proxy, the same after the push-out, which the GPU ran and the truth
+  // measured (beside the error without it). The committed model has none (see README): its figures
+  // are measured on a copy given one by `swish body-proxy`.
+  EXPECT_NE(r.penetrationNote.find("the body of the bake's character"), std::string::npos) << r.penetrationNote;
+  const bool proxy = !model_.bodyProxy.empty();
+  EXPECT_EQ(r.pushOut, proxy);
+  for (const auto& f : r.frames) {
+    ASSERT_EQ(f.penetration.size(), 2u) << "frame " << f.frame;
+    for (const auto& p : f.penetration) {
+      EXPECT_EQ(p.model.vertices, model_.gameMesh.vertexCount());
+      EXPECT_LE(p.model.visible, p.model.inside);
+      EXPECT_EQ(p.pushedMeasured, proxy);
+      EXPECT_TRUE(std::isfinite(p.model.deepestMm) && p.model.deepestMm < 150.0);
+    }
+    for (const auto& c : f.truth)
+      if (c.ok) EXPECT_EQ(c.comparedWithout, proxy) << "frame " << f.frame;
+  }
+  EXPECT_EQ(r.penetrationOverall.model.frames, 10u);
+  EXPECT_TRUE(rep["penetration"]["overall"]["model"]["deepestMm"].is_number());
+  EXPECT_TRUE(rep["frames"][0]["penetration"][0]["model"]["inside"].is_number());
+  if (proxy) {
+    EXPECT_LE(r.penetrationOverall.pushed.deepestMm, r.penetrationOverall.model.deepestMm + 1e-9);
+    EXPECT_TRUE(r.truthOverall.comparedWithout);
+    EXPECT_TRUE(rep["truth"]["overall"]["withoutPushOut"]["meanMm"].is_number());
+  }
+  EXPECT_NE(text.find("Garment inside the body"), std::string::npos);
+  EXPECT_TRUE(fs::exists(job.directory / "plots/penetration_per_frame.svg"));
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }
 

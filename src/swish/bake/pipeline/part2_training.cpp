@@ -6,6 +6,7 @@
 
 #include "swish/bake/compression/bc5_baseline.hpp"
 #include "swish/bake/training/model_builder.hpp"
+#include "swish/bake/training/body_proxy_fit.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/runtime/theta.hpp"
@@ -190,10 +191,20 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   parts.temporalFilter.timeConstantSeconds = st.temporalTimeConstant;
   parts.metadata = out.metadata;
   out.model = buildModel(parts);
+  // The run-time push-out's body proxy, fitted to the character's body (none for a body-less character).
+  if (ds.character.body.triangleCount() > 0) {
+    report("body proxy", 0.92);
+    const BodyProxyFit fit = fitBodyProxy(ds.character.body, out.model.skeleton, &out.model.gameMesh);
+    out.model.bodyProxy = fit.proxy;
+    out.metadata["body_proxy"] = {{"capsules", fit.proxy.capsules.size()}, {"joints", fit.capsuleJoints},
+                                  {"dropped", fit.dropped}, {"worst_outside_mm", fit.worstOutsideMm}};
+    stage("body proxy");
+  }
 
   std::vector<const DatasetPose*> held;
   for (uint32_t i : out.testPoses) held.push_back(&ds.poses[i]);
-  out.evaluation = evaluateModel(out.model, held, out.databaseMaps, maps ? &out.normalPca.pca : nullptr);
+  out.evaluation = evaluateModel(out.model, held, out.databaseMaps, maps ? &out.normalPca.pca : nullptr,
+                                 ds.character.body.triangleCount() > 0 ? &ds.character.body : nullptr);
   stage("evaluation");
 
   const auto& ev = out.evaluation;
@@ -206,6 +217,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       {"vertex_baseline_mean_skinned", toJson(ev.meanSkinnedMm)},
       {"mesh_components", K},
       {"mesh_explained_variance", out.meshPca.explainedVariance[K]},
+      {"penetration", penetrationJson(ev)},
       {"mlp", {{"best_epoch", out.regressor.bestEpoch}, {"epochs", out.regressor.epochsRun},
                {"validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds}}}};
   if (maps) {

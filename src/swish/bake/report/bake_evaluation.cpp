@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "swish/bake/compression/normal_map_pca.hpp"
@@ -10,6 +11,7 @@
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/nearest_code.hpp"
 #include "swish/runtime/reference_pca.hpp"
+#include "swish/runtime/reference_push_out.hpp"
 #include "swish/runtime/reference_skinning.hpp"
 #include "swish/runtime/theta.hpp"
 
@@ -18,6 +20,22 @@ namespace swish::bake {
 nlohmann::json toJson(const DistanceStats& s) { return {{"mean_mm", s.mean}, {"p95_mm", s.p95}, {"max_mm", s.max}}; }
 nlohmann::json toJson(const AngularErrorStats& s) {
   return {{"mean_deg", s.meanDegrees}, {"p95_deg", s.p95Degrees}, {"max_deg", s.maxDegrees}};
+}
+
+nlohmann::json toJson(const PenetrationPool& p) {
+  return {{"poses", p.frames},           {"poses_with_inside", p.framesInside}, {"poses_visible", p.framesVisible},
+          {"vertices_inside", p.inside}, {"vertices_visible", p.visible},       {"share_inside", p.share()},
+          {"deepest_mm", p.deepestMm},   {"deepest_p95_mm", p.deepestPercentileMm(0.95)}};
+}
+
+nlohmann::json penetrationJson(const BakeEvaluation& ev) {
+  if (!ev.penetrationMeasured) return nullptr;
+  nlohmann::json j{{"visible_depth_mm", kVisiblePenetrationMm}, {"truth", toJson(ev.truthPenetration)}, {"model", toJson(ev.modelPenetration)}};
+  if (ev.pushOut) {
+    j["pushed"] = toJson(ev.pushedPenetration);
+    j["vertex_total_pushed"] = toJson(ev.totalPushedMm);
+  }
+  return j;
 }
 
 DistanceStats distanceStats(std::vector<double> v) {
@@ -33,9 +51,33 @@ DistanceStats distanceStats(std::vector<double> v) {
   return s;
 }
 
+Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut) {
+  const runtime::MlpEvaluator mlp(model);
+  std::vector<float> lambda(size_t(mlp.outputSize()));
+  mlp.evaluate(runtime::computeTheta(model.inputJoints, pose.local), lambda);
+  const auto mats = model.skeleton.skinningMatrices(pose);
+  Points3f p = runtime::referenceSkin(
+      runtime::referencePcaReconstruct(model.meshPca, std::span<const float>(lambda.data(), size_t(model.meshComponents()))),
+      model.gameMesh.skin, mats);
+  if (pushOut && !model.bodyProxy.empty()) {
+    std::vector<float> posed;
+    runtime::poseBodyProxy(model.bodyProxy, mats, posed);
+    runtime::referencePushOut(p, posed);
+  }
+  return p;
+}
+
 BakeEvaluation evaluateModel(const Model& model, const std::vector<const DatasetPose*>& heldOut,
-                             const std::vector<const NormalMapImage*>& uncompressed, const PcaResult* normalPca) {
+                             const std::vector<const NormalMapImage*>& uncompressed, const PcaResult* normalPca,
+                             const Mesh* body) {
   BakeEvaluation ev;
+  std::optional<BodyCollider> collider;
+  if (body && body->triangleCount() > 0) {
+    collider.emplace(*body, 0.05f, "bake evaluation: body");
+    ev.penetrationMeasured = true;
+  }
+  ev.pushOut = !model.bodyProxy.empty();
+  std::vector<double> totalPushed;
   ev.poses = heldOut.size();
   const size_t n = model.gameMesh.vertexCount();
   const int K = model.meshComponents();
@@ -97,6 +139,26 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
       pe.restSkinnedMeanMm += r / double(n);
       pe.meanSkinnedMeanMm += m / double(n);
     }
+    std::optional<Points3f> pushed;
+    if (ev.pushOut) {
+      pushed = predicted;
+      std::vector<float> posed;
+      runtime::poseBodyProxy(model.bodyProxy, mats, posed);
+      runtime::referencePushOut(*pushed, posed);
+      for (size_t v = 0; v < n; ++v)
+        totalPushed.push_back(1000.0 * double((pushed->row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm()));
+    }
+    if (collider) {
+      collider->pose(mats);
+      pe.truthPenetration = measurePenetration(*collider, p->gameMeshWorld);
+      pe.modelPenetration = measurePenetration(*collider, predicted);
+      ev.truthPenetration.add(pe.truthPenetration);
+      ev.modelPenetration.add(pe.modelPenetration);
+      if (pushed) {
+        pe.pushedPenetration = measurePenetration(*collider, *pushed);
+        ev.pushedPenetration.add(pe.pushedPenetration);
+      }
+    }
     if (ev.hasNormalMaps) {
       const VecXf trueCode = normalMapCode(*normalPca, p->normalMap);
       const std::span<const float> predCode(lambda.data() + K, size_t(model.normalCodeDims()));
@@ -118,6 +180,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
   ev.regressionMm = distanceStats(std::move(regr));
   ev.restSkinnedMm = distanceStats(std::move(restSkinned));
   ev.meanSkinnedMm = distanceStats(std::move(meanSkinned));
+  ev.totalPushedMm = distanceStats(std::move(totalPushed));
   ev.normalDatabase = dbAcc.stats();
   ev.normalSelection = selAcc.stats();
   ev.normalTotal = totAcc.stats();

@@ -16,6 +16,9 @@
 //   selection  = the uncompressed database map nearest the PREDICTED code
 //   total      = the VQ-decoded map nearest the predicted code (what the runtime shows, before the
 //                temporal filter), and vqAdded = selection map uncompressed vs VQ-decoded.
+// Penetration into the body (when the body is given, bake/report/penetration.hpp), per held-out pose, side by
+// side: the truth (the dataset's game mesh), the model's prediction, and the prediction after the
+// run-time push-out of the model's body proxy (when it has one; then also its vertex error).
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +26,7 @@
 #include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/compression/normal_map_metrics.hpp"
 #include "swish/bake/compression/pca.hpp"
+#include "swish/bake/report/penetration.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::bake {
@@ -36,6 +40,8 @@ DistanceStats distanceStats(std::vector<double> values);
 nlohmann::json toJson(const DistanceStats& s);
 nlohmann::json toJson(const AngularErrorStats& s);
 
+nlohmann::json toJson(const PenetrationPool& p);
+
 struct PoseEvaluation {
   uint32_t poseId = 0;
   double meanMm = 0.0, maxMm = 0.0;
@@ -43,6 +49,7 @@ struct PoseEvaluation {
   double restSkinnedMeanMm = 0.0, meanSkinnedMeanMm = 0.0;  // the baselines' mean on this pose
   double normalTotalDegrees = 0.0;  // mean over texels (NaN-free; 0 without normal maps)
   uint32_t selectedMap = 0, idealMap = 0;
+  PenetrationStats truthPenetration, modelPenetration, pushedPenetration;  // when measured
 };
 
 struct BakeEvaluation {
@@ -53,11 +60,26 @@ struct BakeEvaluation {
   AngularErrorStats normalDatabase, normalSelection, normalTotal, normalVqAdded;
   double selectionAgreement = 0.0;  // share of poses whose predicted map is the ideal one
   std::vector<PoseEvaluation> perPose;
+  bool penetrationMeasured = false;
+  PenetrationPool truthPenetration, modelPenetration;
+  bool pushOut = false;  // the model has a body proxy: the pushed figures below are measured
+  PenetrationPool pushedPenetration;
+  DistanceStats totalPushedMm;
 };
 
 // uncompressedMaps: the database maps before VQ, in database order (may be empty if the model has none);
 // normalPca: the PCA that made the keys (to code each held-out map). Throws Error on size mismatches.
+// The penetration figures of an evaluation (null when not measured), for the report and the metadata:
+// truth / model / pushed pools, and the vertex error after the push-out.
+nlohmann::json penetrationJson(const BakeEvaluation& ev);
+
+// The model's skinned garment for a pose through the runtime path (Theta -> MLP -> PCA -> skinning, then
+// the push-out when asked and the model has a proxy).
+Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut);
+
+// body (optional): the character's body, skinned to the model's skeleton: penetration is measured.
 BakeEvaluation evaluateModel(const Model& model, const std::vector<const DatasetPose*>& heldOut,
-                             const std::vector<const NormalMapImage*>& uncompressedMaps, const PcaResult* normalPca);
+                             const std::vector<const NormalMapImage*>& uncompressedMaps, const PcaResult* normalPca,
+                             const Mesh* body = nullptr);
 
 }  // namespace swish::bake

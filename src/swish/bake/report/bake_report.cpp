@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "swish/io/svg_plot.hpp"
+#include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/io/error_heat_map.hpp"
 #include "swish/io/png.hpp"
 #include "swish/files/atomic_write.hpp"
 #include "swish/runtime/reference_vq_decode.hpp"
@@ -59,6 +61,7 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
                                 {"regression", toJson(ev.regressionMm)},
                                 {"baseline_rest_skinned", toJson(ev.restSkinnedMm)},
                                 {"baseline_mean_skinned", toJson(ev.meanSkinnedMm)}};
+  r["penetration_held_out"] = penetrationJson(ev);
   r["mlp"] = {{"best_epoch", out.regressor.bestEpoch}, {"epochs_run", out.regressor.epochsRun},
               {"best_validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds},
               {"activation", activationName(out.regressor.activation)}};
@@ -86,6 +89,11 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
     const auto& p = ev.perPose[i];
     worst.push_back({{"pose", p.poseId}, {"mean_mm", p.meanMm}, {"max_mm", p.maxMm}, {"truncation_mean_mm", p.truncationMeanMm}, {"rest_skinned_mean_mm", p.restSkinnedMeanMm},
                      {"normal_deg", p.normalTotalDegrees}, {"selected_map", p.selectedMap}, {"ideal_map", p.idealMap}});
+    if (ev.penetrationMeasured) {
+      worst.back()["truth_inside_deepest_mm"] = p.truthPenetration.deepestMm;
+      worst.back()["model_inside_deepest_mm"] = p.modelPenetration.deepestMm;
+      if (ev.pushOut) worst.back()["pushed_inside_deepest_mm"] = p.pushedPenetration.deepestMm;
+    }
   }
   r["worst_poses"] = worst;
   return r;
@@ -142,6 +150,28 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
      << f2(100.0 * out.meshPca.explainedVariance[out.meshPca.components()]) << "% of the training variance ("
      << (out.meshPca.randomized ? "randomised" : "exact") << " SVD).\n\n![error against K](error_vs_k.svg)\n\n";
   if (subjects) md << subjects->markdown(ev);
+  if (ev.penetrationMeasured) {
+    md << "## Garment inside the body\n\nHeld-out poses against the character's posed body, truth and model side by side "
+          "(whether the model or the truth puts the cloth inside): vertices inside the body, those deeper than "
+       << f2(kVisiblePenetrationMm) << " mm (visible), the deepest.\n\n"
+       << "| positions | poses with any inside | poses with visible | vertices inside | share | deepest mm | p95 of per-pose deepest mm |\n"
+          "|---|---|---|---|---|---|---|\n";
+    auto prow = [&](const char* name, const PenetrationPool& p) {
+      md << "| " << name << " | " << p.framesInside << " / " << p.frames << " | " << p.framesVisible << " | " << p.inside << " | "
+         << f3(100.0 * p.share()) << " % | " << f2(p.deepestMm) << " | " << f2(p.deepestPercentileMm(0.95)) << " |\n";
+    };
+    prow("truth (simulation, transferred + smoothed)", ev.truthPenetration);
+    prow("model (before the push-out)", ev.modelPenetration);
+    if (ev.pushOut) {
+      prow("model after the run-time push-out", ev.pushedPenetration);
+      md << "\nVertex error with the push-out: mean " << f2(ev.totalPushedMm.mean) << " mm, p95 " << f2(ev.totalPushedMm.p95)
+         << " mm, max " << f2(ev.totalPushedMm.max) << " mm (without: " << f2(ev.totalMm.mean) << " / " << f2(ev.totalMm.p95) << " / "
+         << f2(ev.totalMm.max) << " mm).\n";
+    } else {
+      md << "\nThe model has no body proxy: no push-out at run time.\n";
+    }
+    md << "\n";
+  }
   md << "## MLP\n\n" << activationName(out.regressor.activation) << ", best validation epoch " << out.regressor.bestEpoch
      << " of " << out.regressor.epochsRun << ", validation loss " << f3(out.regressor.bestValidationLoss) << ", trained in "
      << f2(out.regressor.seconds) << " s.\n\n![training curve](training_curve.svg)\n\n";
@@ -171,7 +201,10 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
          << " maps (" << f2(double(out.bc5AtVqMemoryBytes) / 1048576.0) << " MiB): the equal-memory row above.";
     md << "\n\n";
   }
-  md << "## Worst held-out poses\n\n| pose | mean mm | max mm | truncation mm | rest skinned mm | normal deg | gallery |\n"
+  md << "## Worst held-out poses\n\nThe gallery shows, per pose, the model (as the run time shows it"
+     << (out.model.bodyProxy.empty() ? "" : ", after the push-out") << ") beside the truth and an error heat map "
+        "(per-vertex distance to the truth, 0 to 10 mm and beyond), then the truth's and the run time's normal maps.\n\n"
+     << "| pose | mean mm | max mm | truncation mm | rest skinned mm | normal deg | gallery |\n"
         "|---|---|---|---|---|---|---|\n";
   std::filesystem::create_directories(dir / "gallery");
   std::vector<std::filesystem::path> galleryFiles;
@@ -179,12 +212,23 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   for (size_t i : worstPoses(ev, 8)) {
     const auto& p = ev.perPose[i];
     std::string cell = "";
-    if (ev.hasNormalMaps && shown < galleryPoses) {
-      const DatasetPose* pose = nullptr;
-      for (const auto& dp : ds.poses)
-        if (dp.id == p.poseId) pose = &dp;
-      if (pose) {
-        const std::string stem = "gallery/pose_" + std::to_string(p.poseId);
+    const DatasetPose* pose = nullptr;
+    for (const auto& dp : ds.poses)
+      if (dp.id == p.poseId) pose = &dp;
+    if (pose && shown < galleryPoses) {
+      const std::string stem = "gallery/pose_" + std::to_string(p.poseId);
+      const Points3f model = predictPositions(out.model, pose->pose, true);
+      io::HeatMapFigure fig;
+      fig.title = "pose " + std::to_string(p.poseId);
+      fig.model = &model;
+      fig.truth = &pose->gameMeshWorld;
+      fig.triangles = &out.model.gameMesh.triangles;
+      fig.panelWidth = 220, fig.panelHeight = 260;
+      fig.scaleMm = 10.0;  // one scale for the whole gallery
+      io::writePng(dir / (stem + "_heat.png"), io::heatMapFigure(fig));
+      galleryFiles.push_back(dir / (stem + "_heat.png"));
+      cell = "![model, truth, error](" + stem + "_heat.png)";
+      if (ev.hasNormalMaps) {
         const std::string truthPng = stem + "_truth.png", runtimePng = stem + "_runtime.png";
         io::writePng(dir / truthPng, io::encodeNormalMap(pose->normalMap.width, pose->normalMap.height, pose->normalMap.xy, 8));
         const auto dec = runtime::referenceVqDecode(out.model.normalMaps, p.selectedMap);
@@ -193,15 +237,15 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
         io::writePng(dir / runtimePng, io::encodeNormalMap(dec.width, dec.height, xy, 8));
         galleryFiles.push_back(dir / truthPng);
         galleryFiles.push_back(dir / runtimePng);
-        cell = "![truth](" + truthPng + ") ![runtime](" + runtimePng + ")";
-        ++shown;
+        cell += " ![truth](" + truthPng + ") ![runtime](" + runtimePng + ")";
       }
+      ++shown;
     }
     md << "| " << p.poseId << " | " << f2(p.meanMm) << " | " << f2(p.maxMm) << " | " << f2(p.truncationMeanMm) << " | "
        << f2(p.restSkinnedMeanMm) << " | " << f2(p.normalTotalDegrees) << " | " << cell << " |\n";
   }
   // The worst poses of an earlier bake are other poses: their images must not linger in the gallery.
-  constexpr std::string_view kGallerySuffixes[] = {"_truth.png", "_runtime.png"};
+  constexpr std::string_view kGallerySuffixes[] = {"_truth.png", "_runtime.png", "_heat.png"};
   removeStaleOutputs(dir / "gallery", "pose_", kGallerySuffixes, galleryFiles);
   md << "\n## Time per stage\n\n| stage | seconds |\n|---|---|\n";
   for (const auto& s : out.stages) md << "| " << s.stage << " | " << f2(s.seconds) << " |\n";
