@@ -87,6 +87,7 @@ class ReplayE2E : public test::GpuTest {
     replay::ReplayJobOptions o;
     o.quiet = true;
     o.engine.context = &ctx();
+    o.engine.pushOut = true;  // the model carries capsules: the GPU-vs-CPU checks cover the push-out step
     return o;
   }
 

@@ -42,7 +42,7 @@ struct ReplayOptions {
   gpu::ContextOptions device;
   gpu::Context* context = nullptr;  // use this device instead of creating one (tests, hosts)
   TruthOptions truth;               // truth.every 0: none; N: ground truth on every Nth frame
-  bool pushOut = true;              // the run time's push-out of the body proxy (models that have one)
+  bool pushOut = false;             // the run time's push-out of the body proxy (models that have one; --push-out)
   // Penetration of the garment into the body it was baked on (the CPU reference's positions, with and
   // without the push-out) on every Nth frame; 0: not measured.
   uint32_t penetrationEvery = 30;  // the CPU measure poses a body collider per character: every frame would dwarf the replay

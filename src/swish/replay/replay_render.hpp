@@ -25,7 +25,7 @@ struct ReplayRenderOptions {
   // gets an error figure heat_NNNN.png (model, truth, per-vertex error heat map with its mm legend;
   // io/error_heat_map.hpp) and heat_sheet.png; the truth is simulated again here (as the replay's).
   TruthOptions truth;
-  bool pushOut = true;      // as the replay's --no-push-out
+  bool pushOut = false;     // as the replay's --push-out
 };
 
 struct ReplayRenderResult {

@@ -87,6 +87,8 @@ class ReplayTruth : public test::GpuTest {
     replay::ReplayOptions o;
     o.context = &ctx();
     o.truth = truth;
+    o.pushOut = true;          // runs where the model has a proxy (the committed one has none)
+    o.penetrationEvery = 1;    // every frame, every character
     replay::ReplayEngine engine(s, lib, o);
     return engine.run();
   }
