@@ -44,11 +44,12 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   res.report = cfg.reportDir() / "report.md";
 
   // Part 1: the dataset folder (resumable: finished simulations and poses are kept).
-  if (cfg.part1) {
+  if (cfg.part1 && opt.part1) {
     const auto t1 = Clock::now();
     log("part 1: building the dataset " + cfg.dataset.string());
     DatasetBuildSettings part1Settings = *cfg.part1;
     part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
+    part1Settings.simulatedPoseList = opt.simulatedPoseList;
     const DatasetBuildResult part1 = buildDataset(part1Settings, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
     res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
     res.part1 = part1.toJson();
@@ -60,10 +61,18 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
                   part1.transferred + part1.transfersReused, part1.failed.size());
     log(line);
   } else if (!std::filesystem::exists(cfg.dataset / "manifest.json")) {
+    if (cfg.part1)
+      throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() + " (no manifest.json): part 1 has not run");
     throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
                 " (no manifest.json) and no \"part1\" section to make one");
+  } else if (cfg.part1) {
+    log("part 1: not run here; using the dataset " + cfg.dataset.string() + " as it is");
   } else {
     log("part 1: no \"part1\" section; using the dataset " + cfg.dataset.string() + " as it is");
+  }
+  if (!opt.part2) {
+    res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return res;
   }
 
   // Part 2.
