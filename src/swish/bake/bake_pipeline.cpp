@@ -15,9 +15,21 @@ namespace swish::bake {
 namespace {
 using Clock = std::chrono::steady_clock;
 
+// The dataset's content and the train settings. The manifest's per-pose solve times are left out: they
+// are measurements of the run that made the dataset, not content, and would make the model's bytes
+// differ between two bakes of the same recipe (another machine, another load, a cluster's nodes).
 std::string fingerprint(const BakeConfig& cfg) {
   std::ifstream in(cfg.dataset / "manifest.json");
   std::string manifest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  try {
+    nlohmann::json m = nlohmann::json::parse(manifest);
+    if (m.contains("poses") && m["poses"].is_array())
+      for (auto& p : m["poses"])
+        if (p.is_object() && p.contains("residuals") && p["residuals"].is_object()) p["residuals"].erase("seconds");
+    manifest = m.dump();
+  } catch (const nlohmann::json::exception&) {
+    // not JSON: hashed as it is (reading the dataset reports the problem)
+  }
   return std::to_string(std::hash<std::string>{}(manifest)) + "/" + cfg.train.toJson().dump();
 }
 

@@ -229,8 +229,12 @@ std::string arrayIndexList(const std::vector<size_t>& idx) {
   for (size_t i = 0; i < idx.size();) {
     size_t j = i;
     while (j + 1 < idx.size() && idx[j + 1] == idx[j] + 1) ++j;
-    out += (out.empty() ? "" : ",") + std::to_string(idx[i]);
-    if (j > i) out += "-" + std::to_string(idx[j]);
+    if (!out.empty()) out += ',';
+    out += std::to_string(idx[i]);
+    if (j > i) {
+      out += '-';
+      out += std::to_string(idx[j]);
+    }
     i = j + 1;
   }
   return out;
