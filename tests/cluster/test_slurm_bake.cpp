@@ -186,6 +186,10 @@ TEST(SlurmBake, ArrayWithARequeuedTaskMakesTheLocalBakesModel) {
         f[uint32_t(i)] = fileId(bake::simulatedPosePath(sim, uint32_t(i)));
     return f;
   };
+  // Poses finished before any task ran (the one the submission simulated to time it) do not count as
+  // a task's progress.
+  std::map<uint32_t, FileId> atSubmission;
+  for (size_t k = 0; k < shards; ++k) atSubmission.merge(finishedIn(k));
   size_t killed = SIZE_MAX;
   std::map<uint32_t, FileId> before;
   const auto waitStart = Clock::now();
@@ -195,16 +199,26 @@ TEST(SlurmBake, ArrayWithARequeuedTaskMakesTheLocalBakesModel) {
       const size_t k = std::stoul(id.substr(id.find('_') + 1));
       const size_t count = std::min(poses, (k + 1) * shardSize) - k * shardSize;
       auto done = finishedIn(k);
-      if (done.empty() || done.size() + 2 > count) continue;
+      size_t byTask = 0;
+      for (const auto& [pose, fid] : done) byTask += !atSubmission.count(pose);
+      if (byTask == 0 || done.size() + 2 > count) continue;
       const CommandResult rq = runCommand({"scontrol", "requeue", id});
       if (rq.exitCode != 0) continue;  // it finished in between: try another
       killed = k;
       // Poses that finished while the kill was on its way are kept too: what counts is the set after it.
       before = finishedIn(k);
-      // A re-queued job waits (BeginTime) before it may start again; let it start now.
-      runCommand({"scontrol", "update", "JobId=" + id, "StartTime=now"});
-      std::printf("re-queued %s after %.1f s with %zu of %zu poses of its shard finished\n", id.c_str(),
-                  since(waitStart), before.size(), count);
+      // A re-queued job waits two minutes (BeginTime) before it may start again; once it is pending
+      // (its old run ended), let it start now.
+      bool released = false;
+      for (const auto ws = Clock::now(); !released && since(ws) < 60;) {
+        for (const auto& [qid, qstate] : queue(id))
+          if (qid == id && qstate == "PENDING")
+            released = runCommand({"scontrol", "update", "JobId=" + id, "StartTime=now"}).exitCode == 0;
+        if (!released) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      }
+      EXPECT_TRUE(released) << id << " was not pending again within 60 s of its re-queue";
+      std::printf("re-queued %s after %.1f s with %zu of %zu poses of its shard finished (%zu by the task)\n",
+                  id.c_str(), since(waitStart), before.size(), count, byTask);
       break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -213,7 +227,16 @@ TEST(SlurmBake, ArrayWithARequeuedTaskMakesTheLocalBakesModel) {
 
   // Wait for the whole bake (bounded), then stop the cluster.
   const auto doneStart = Clock::now();
-  while (!queue(allJobs).empty() && since(doneStart) < 300) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  std::string lastQueue;
+  while (since(doneStart) < 300) {
+    const auto q = queue(allJobs);
+    if (q.empty()) break;
+    std::string now;
+    for (const auto& [id, state] : q) now += " " + id + ":" + state;
+    if (now != lastQueue) std::printf("%6.1f s:%s\n", since(t), now.c_str());
+    lastQueue = now;
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
   ASSERT_TRUE(queue(allJobs).empty()) << "the bake's jobs were still queued after 300 s";
   std::printf("cluster bake: %.1f s from submission\n", since(t));
   const CommandResult status = swishCmd({"bake", cfg.string(), "--status"});
