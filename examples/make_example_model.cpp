@@ -2,7 +2,7 @@
 // character's skeleton, so that CI can run examples/minimal_host without a baked model.
 #include <cstdio>
 
-#include "swish/bake/default_character.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/replay/procedural_model.hpp"
 

@@ -12,9 +12,9 @@
 #include <memory>
 
 #include "support/paths.hpp"
-#include "swish/bake/cloth_solver.hpp"
+#include "swish/bake/cloth/cloth_solver.hpp"
 #include "swish/io/character_import.hpp"
-#include "unit/test_cloth_fixture.hpp"
+#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;

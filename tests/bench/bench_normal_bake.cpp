@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "swish/bake/laplacian_smoothing.hpp"
-#include "swish/bake/mesh_transfer.hpp"
-#include "swish/bake/normal_map_baker.hpp"
+#include "swish/bake/transfer/laplacian_smoothing.hpp"
+#include "swish/bake/transfer/mesh_transfer.hpp"
+#include "swish/bake/transfer/normal_map_baker.hpp"
 
 using namespace swish;
 using namespace swish::bake;

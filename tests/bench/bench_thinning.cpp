@@ -9,8 +9,8 @@
 #include <iostream>
 
 #include "support/paths.hpp"
-#include "swish/bake/default_character.hpp"
-#include "swish/bake/pose_thinning.hpp"
+#include "swish/bake/character/default_character.hpp"
+#include "swish/bake/poses/pose_thinning.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/io/animation_import.hpp"
 

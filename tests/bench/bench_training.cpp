@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "swish/bake/mlp_trainer.hpp"
+#include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/core/rng.hpp"
 
 using namespace swish;

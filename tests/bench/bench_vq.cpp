@@ -6,9 +6,9 @@
 
 #include <cmath>
 
-#include "swish/bake/bc5_baseline.hpp"
-#include "swish/bake/normal_map_metrics.hpp"
-#include "swish/bake/vq_codebook.hpp"
+#include "swish/bake/compression/bc5_baseline.hpp"
+#include "swish/bake/compression/normal_map_metrics.hpp"
+#include "swish/bake/compression/vq_codebook.hpp"
 #include "swish/core/rng.hpp"
 
 using namespace swish;

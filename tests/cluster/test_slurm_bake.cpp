@@ -26,7 +26,7 @@
 
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/bake/simulated_pose_file.hpp"
+#include "swish/bake/cloth/simulated_pose_file.hpp"
 #include "swish/cluster/process.hpp"
 
 using namespace swish;

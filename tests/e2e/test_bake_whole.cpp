@@ -5,7 +5,7 @@
 // and reference frame (and on the GPU path when a Vulkan device is there), and a re-run must redo
 // nothing. Sized to run in well under a minute on two cores.
 //
-// The default character simulates since the limb clearance (bake/limb_clearance.hpp) turns hanging
+// The default character simulates since the limb clearance (bake/poses/limb_clearance.hpp) turns hanging
 // arms out of the mannequin's torso and the solver's top band stays on the trunk; before that every
 // pose failed and these tests were disabled.
 #include <gtest/gtest.h>
@@ -19,8 +19,8 @@
 #include "support/gpu_test.hpp"
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/bake/bake_pipeline.hpp"
-#include "swish/bake/dataset_io.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
+#include "swish/bake/dataset/dataset_io.hpp"
 #include "swish/core/error.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"

@@ -43,7 +43,7 @@ class ReplayE2E : public test::GpuTest {
     spec.normalMaps = 4;
     spec.mapSize = 16;
     model_ = test::makeRandomModel(rng, spec);
-    // What the bake records of its evaluation on held-out poses (bake_training.cpp).
+    // What the bake records of its evaluation on held-out poses (part2_training.cpp).
     model_.metadata = R"({"errors": {"held_out_poses": 7, "vertex_total": {"mean_mm": 1.5, "p95_mm": 3, "max_mm": 4}}})";
     saveModel(model_, dir_ / "m.swish");
     writeStream("walk.json", rng, 6, {});

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "swish/core/error.hpp"
-#include "swish/model/crc32.hpp"
+#include "swish/files/crc32.hpp"
 #include "swish/model/model_file.hpp"
 
 namespace {

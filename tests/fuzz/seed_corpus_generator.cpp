@@ -8,9 +8,9 @@
 #include <string>
 
 #include "support/random_model.hpp"
-#include "swish/model/atomic_write.hpp"
-#include "swish/model/byte_writer.hpp"
-#include "swish/model/crc32.hpp"
+#include "swish/files/atomic_write.hpp"
+#include "swish/files/byte_writer.hpp"
+#include "swish/files/crc32.hpp"
 #include "swish/model/model_file.hpp"
 
 namespace {

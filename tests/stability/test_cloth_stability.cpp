@@ -9,11 +9,11 @@
 #include <limits>
 
 #include "support/paths.hpp"
-#include "swish/bake/cloth_constraints.hpp"
-#include "swish/bake/cloth_solver.hpp"
-#include "swish/bake/default_character.hpp"
+#include "swish/bake/cloth/cloth_constraints.hpp"
+#include "swish/bake/cloth/cloth_solver.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/io/character_import.hpp"
-#include "unit/test_cloth_fixture.hpp"
+#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;

@@ -1,4 +1,4 @@
-// swish bake CONFIG: runs the bake described by a JSON recipe (bake/bake_config.hpp) end to end and
+// swish bake CONFIG: runs the bake described by a JSON recipe (bake/pipeline/bake_config.hpp) end to end and
 // writes <output>/<name>.swish and <output>/report/. The config is validated before any work. Part 1
 // (character + clips -> simulated poses -> dataset) and part 2 (dataset -> model) are both resumable:
 // interrupt it and run the same command again.
@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <string>
 
-#include "swish/bake/bake_config.hpp"
-#include "swish/bake/bake_pipeline.hpp"
-#include "swish/bake/default_character.hpp"
+#include "swish/bake/pipeline/bake_config.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/cluster/pose_list_file.hpp"
 #include "swish/cluster/slurm_bake.hpp"
 #include "swish/io/gltf_export.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "swish/bake/default_character.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/character_import.hpp"

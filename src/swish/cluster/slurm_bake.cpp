@@ -15,16 +15,16 @@
 
 #include <tbb/global_control.h>
 
-#include "swish/bake/bake_pipeline.hpp"
-#include "swish/bake/dataset_builder.hpp"
-#include "swish/bake/pose_shape.hpp"
-#include "swish/bake/pose_simulation.hpp"
-#include "swish/bake/simulated_pose_file.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
+#include "swish/bake/pipeline/part1_dataset.hpp"
+#include "swish/bake/pipeline/pose_shape.hpp"
+#include "swish/bake/cloth/pose_driver.hpp"
+#include "swish/bake/cloth/simulated_pose_file.hpp"
 #include "swish/cluster/pose_list_file.hpp"
 #include "swish/cluster/process.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
-#include "swish/model/atomic_write.hpp"
+#include "swish/files/atomic_write.hpp"
 
 namespace swish::cluster {
 

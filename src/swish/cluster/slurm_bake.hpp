@@ -6,7 +6,7 @@
 //                                  with its fingerprint; seconds per pose measured; shards sized; the
 //                                  job scripts written to <work>/slurm/; three sbatch calls
 //   job 1, an array (part1.sbatch) task k simulates the poses [k P, (k+1) P) into <work>/simulation,
-//                                  one resumable file per pose (bake/pose_simulation.hpp): a task
+//                                  one resumable file per pose (bake/cloth/pose_driver.hpp): a task
 //                                  killed, pre-empted or re-queued loses only the poses in flight, a
 //                                  re-run skips the finished ones
 //   job 2, afterok:1 (dataset.sbatch)  transfer, smoothing, normal maps, the dataset folder: part 1 as
@@ -29,7 +29,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/bake_config.hpp"
+#include "swish/bake/pipeline/bake_config.hpp"
 
 namespace swish::cluster {
 

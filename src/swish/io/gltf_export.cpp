@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "swish/core/error.hpp"
-#include "swish/model/atomic_write.hpp"
+#include "swish/files/atomic_write.hpp"
 
 namespace swish::io {
 namespace {

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "swish/core/error.hpp"
-#include "swish/model/crc32.hpp"
+#include "swish/files/crc32.hpp"
 
 // stb in static mode: its symbols stay private to this file, so another file of the project may use
 // stb too without duplicate-symbol clashes.

@@ -11,10 +11,10 @@
 #include <set>
 
 #include "swish/core/error.hpp"
-#include "swish/model/atomic_write.hpp"
-#include "swish/model/byte_reader.hpp"
-#include "swish/model/byte_writer.hpp"
-#include "swish/model/crc32.hpp"
+#include "swish/files/atomic_write.hpp"
+#include "swish/files/byte_reader.hpp"
+#include "swish/files/byte_writer.hpp"
+#include "swish/files/crc32.hpp"
 #include "swish/model/model_sections.hpp"
 
 namespace swish {

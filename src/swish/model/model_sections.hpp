@@ -5,8 +5,8 @@
 #include <string_view>
 #include <vector>
 
-#include "swish/model/byte_reader.hpp"
-#include "swish/model/byte_writer.hpp"
+#include "swish/files/byte_reader.hpp"
+#include "swish/files/byte_writer.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::model_sections {

@@ -7,7 +7,7 @@
 
 #include "swish/core/error.hpp"
 #include "swish/io/gltf_export.hpp"
-#include "swish/model/atomic_write.hpp"
+#include "swish/files/atomic_write.hpp"
 
 namespace swish::replay {
 

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "swish/core/error.hpp"
-#include "swish/model/atomic_write.hpp"
-#include "swish/runtime/json_file.hpp"
+#include "swish/files/atomic_write.hpp"
+#include "swish/files/json_file.hpp"
 
 namespace swish::replay {
 
@@ -28,7 +28,7 @@ json number(float f) { return std::isfinite(f) ? json(f) : json(nullptr); }
 
 PoseStream readPoseStream(const std::filesystem::path& file) {
   const std::string src = file.string();
-  const json j = runtime::readJsonFile(file, "pose stream");
+  const json j = readJsonFile(file, "pose stream");
   if (!j.is_object() || j.value("format", "") != "swish-pose-stream")
     throw Error(src + ": format: must be \"swish-pose-stream\"");
   if (j.value("version", 0) != 1) throw Error(src + ": version: only version 1 is supported");

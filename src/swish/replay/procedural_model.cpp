@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "swish/bake/vq_codebook.hpp"
+#include "swish/bake/compression/vq_codebook.hpp"
 #include "swish/core/character.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/mesh_frames.hpp"

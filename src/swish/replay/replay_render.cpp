@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "swish/bake/default_character.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/core/error.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/render/body_from_character.hpp"

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "swish/bake/svg_plot.hpp"
-#include "swish/model/atomic_write.hpp"
+#include "swish/io/svg_plot.hpp"
+#include "swish/files/atomic_write.hpp"
 #include "swish/runtime/scene_file.hpp"
 
 namespace swish::replay {
@@ -90,7 +90,7 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
                            {"meshComponents", m.meshComponents()}, {"normalMaps", m.normalMaps.mapCount()},
                            {"mapSize", m.normalMaps.width}});
     // The bake measures the model on its held-out poses through the runtime path (metadata "errors",
-    // see bake_training.cpp): the ground-truth error of this model, quoted beside the run times.
+    // see part2_training.cpp): the ground-truth error of this model, quoted beside the run times.
     const json meta = json::parse(m.metadata, nullptr, false);
     if (!meta.is_discarded() && meta.is_object() && meta.contains("errors") && meta["errors"].is_object())
       j["models"].back()["heldOutErrors"] = meta["errors"];
@@ -283,7 +283,7 @@ std::string reportMarkdown(const json& j) {
 void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, const ModelLibrary& models, const ReplayResult& r) {
   const json j = reportJson(scene, models, r);
   std::filesystem::create_directories(dir / "plots");
-  using bake::PlotSeries;
+  using io::PlotSeries;
   PlotSeries cpu{"CPU total", {}, {}, ""}, gpu{"GPU total", {}, {}, ""}, wall{"submit to fence", {}, {}, ""};
   PlotSeries pos{"positions (mm)", {}, {}, ""}, deg{"normals (deg)", {}, {}, ""}, vsTime{"checked frames", {}, {}, ""};
   vsTime.markers = true;
@@ -317,7 +317,7 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
     }
   }
   auto plot = [](const char* title, const char* xLabel, const char* yLabel, std::vector<PlotSeries> series) {
-    bake::SvgPlot p;
+    io::SvgPlot p;
     p.title = title, p.xLabel = xLabel, p.yLabel = yLabel;
     p.yFromZero = true;
     p.width = 720, p.height = 360;
@@ -340,7 +340,7 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
                         plot("Run time against ground truth (source simulation), per truth frame", "scene frame",
                              "vertex error (mm); normal maps (deg)", ts));
   }
-  bake::SvgBarChart stages;
+  io::SvgBarChart stages;
   stages.title = "Median time per stage", stages.unit = "ms";
   for (const auto& st : stageColumns()) {
     stages.labels.push_back(st.label);

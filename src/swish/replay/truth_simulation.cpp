@@ -8,9 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/bake_config.hpp"
-#include "swish/bake/bake_evaluation.hpp"
-#include "swish/bake/dataset_builder.hpp"
+#include "swish/bake/pipeline/bake_config.hpp"
+#include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/bake/pipeline/part1_dataset.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 

@@ -1,12 +1,12 @@
 #pragma once
 // Ground truth for `swish replay --truth-every N`: on every Nth frame each on-screen character's pose is
-// simulated as the model's bake simulated its training poses (bake/pose_shape.hpp: limb clearance,
+// simulated as the model's bake simulated its training poses (bake/pipeline/pose_shape.hpp: limb clearance,
 // cloth solve from the A-pose, transfer + Laplacian smoothing, normal-map bake), and the run time's
 // GPU output of that frame is measured against it: per-vertex distance (mm) and per-texel normal-map
 // angle (degrees, every texel, as the bake's evaluation measures its held-out poses).
 //
 // What is simulated is what the bake simulates: the pose with the root joint at its rest rotation and
-// translation (the shape is a function of the other joints alone, bake/dataset_builder.hpp). The
+// translation (the shape is a function of the other joints alone, bake/pipeline/part1_dataset.hpp). The
 // truth's pre-skin shape is then skinned with the frame's whole pose and the model's skin weights,
 // exactly as the run time skins the model's prediction, so the error is that of the predicted shape.
 // Both sides are in CHARACTER space: the placement, however far from the origin, never enters it.
@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "swish/bake/normal_map_metrics.hpp"
-#include "swish/bake/pose_shape.hpp"
+#include "swish/bake/compression/normal_map_metrics.hpp"
+#include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/runtime/reference_normal_blend.hpp"
 

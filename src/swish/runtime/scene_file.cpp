@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "swish/core/error.hpp"
-#include "swish/runtime/json_file.hpp"
+#include "swish/files/json_file.hpp"
 
 namespace swish::runtime {
 

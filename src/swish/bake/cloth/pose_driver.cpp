@@ -1,0 +1,114 @@
+#include "swish/bake/cloth/pose_driver.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <mutex>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "swish/core/error.hpp"
+#include "swish/core/hash.hpp"
+
+namespace swish::bake {
+
+uint64_t poseFingerprint(const ClothSolver& solver, const Pose& pose) {
+  Fnv1a f(solver.fingerprint() ^ 0x9E3779B97F4A7C15ull);
+  for (const Quatf& q : pose.local) f.matrix(q.coeffs());
+  // The root translation is ignored by the solve, so it is not part of the fingerprint.
+  return f.h;
+}
+
+std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path& dir, uint32_t poseId,
+                                                    uint64_t fingerprint) {
+  const std::filesystem::path file = simulatedPosePath(dir, poseId);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return std::nullopt;
+  try {
+    SimulatedPoseRecord rec = readSimulatedPose(file);
+    if (rec.poseId != poseId || rec.fingerprint != fingerprint) return std::nullopt;
+    return rec;
+  } catch (const Error&) {
+    return std::nullopt;  // unreadable leftovers are simply simulated again (and overwritten)
+  }
+}
+
+PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
+                                const std::filesystem::path& dir, const PoseSimulationProgress& progress,
+                                int maxThreads) {
+  std::vector<uint32_t> all(poses.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+  return simulatePoses(solver, poses, all, dir, progress, maxThreads);
+}
+
+PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
+                                const std::vector<uint32_t>& ids, const std::filesystem::path& dir,
+                                const PoseSimulationProgress& progress, int maxThreads) {
+  for (uint32_t id : ids)
+    if (id >= poses.size())
+      throw Error("simulatePoses: pose id " + std::to_string(id) + " is past the " + std::to_string(poses.size()) +
+                  " poses");
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw Error(dir.string() + ": cannot create the simulation output folder: " + ec.message());
+
+  PoseSimulationRun run;
+  const size_t total = ids.size();
+  const size_t nv = solver.mesh().vertexCount();
+  std::vector<uint64_t> fingerprints(poses.size());
+  std::vector<uint32_t> todo;
+  std::vector<std::pair<uint32_t, std::string>> failures;
+  for (uint32_t i : ids) {
+    fingerprints[i] = poseFingerprint(solver, poses[i]);
+    auto rec = loadFinishedPose(dir, i, fingerprints[i]);
+    if (rec && (!rec->result.ok || size_t(rec->result.positions.rows()) == nv)) {
+      ++run.reused;
+      if (!rec->result.ok) failures.push_back({i, rec->result.failure});
+    } else {
+      todo.push_back(i);
+    }
+  }
+
+  std::mutex mutex;  // guards the counters below and serialises the callback
+  size_t done = run.reused;
+  double solveSeconds = 0.0;
+  std::atomic<bool> stop = false;
+  const auto start = std::chrono::steady_clock::now();
+  if (progress && !progress(done, total, 0.0)) stop = true;
+
+  auto work = [&] {
+    tbb::parallel_for(size_t(0), todo.size(), size_t(1), [&](size_t k) {
+      if (stop.load()) return;
+      const uint32_t id = todo[k];
+      SimulatedPoseRecord rec;
+      rec.poseId = id;
+      rec.fingerprint = fingerprints[id];
+      rec.result = solver.simulate(poses[id]);
+      writeSimulatedPose(simulatedPosePath(dir, id), rec);
+      std::lock_guard<std::mutex> lock(mutex);
+      ++done;
+      ++run.simulated;
+      solveSeconds += rec.result.residuals.seconds;
+      if (!rec.result.ok) failures.push_back({id, rec.result.failure});
+      // Time left from the wall-clock rate of this run (it already includes the parallelism).
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double left = elapsed / double(run.simulated) * double(total - done);
+      if (progress && !progress(done, total, left)) stop = true;
+    });
+  };
+  if (maxThreads > 0) {
+    tbb::task_arena arena(maxThreads);
+    arena.execute(work);
+  } else {
+    work();
+  }
+  run.stopped = done < total;
+  std::sort(failures.begin(), failures.end());
+  run.failed = failures.size();
+  run.failures = std::move(failures);
+  return run;
+}
+
+}  // namespace swish::bake

@@ -1,0 +1,80 @@
+#pragma once
+// The `swish bake CONFIG` recipe: a JSON file, validated completely before any work starts. Unknown
+// keys and out-of-range values are errors naming the key ("train.codebook_size: 70000 is outside
+// 1..65536"). Paths are relative to the config file's folder.
+//
+//   {
+//     "name": "default_jersey",          model file <output>/<name>.swish, report <output>/report/
+//     "output": "out",
+//     "work": "out/work",                intermediate files (default <output>/work): the per-pose
+//                                        simulation results (<work>/simulation) and, unless "dataset"
+//                                        says otherwise, the dataset (<work>/dataset)
+//     "dataset": "out/work/dataset",     the dataset folder (bake/dataset/dataset_io.hpp): part 1 writes it,
+//                                        part 2 reads it
+//     "part1": {                         part 1 (bake/pipeline/part1_dataset.hpp); absent: the dataset must exist
+//       "character": "default" | {"recipe": "recipe.json"} |
+//                    {"file": "x.glb", "body_mesh": [..], "garment_mesh": [..], "simulation_mesh": [..]},
+//       "clips": ["a.bvh", {"file": "b.fbx", "naming": "auto|same|mixamo|unreal",
+//                           "joint_map": {"clip joint": "character joint"}, "fps": 0}],
+//       "input_joints": ["LowerBack", ...],
+//       "sampling": {"characters", "seconds_per_character", "sample_rate", "mirror_odd_characters",
+//                    "speed_jitter", "seed"},
+//       "thinning": {"tolerance": 0.1} | {"target_poses": 200}, plus "include_rest_pose" (default true:
+//                   the rest pose joins the kept poses and is always trained on),
+//       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
+//                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
+//                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
+//                      "attach_band" (top share of the garment's height held on the body)},
+//       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
+//       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
+//       "preview": {"poses", "size"}
+//     },
+//     "train": {                         part 2 settings (every key optional; defaults in part2_training.hpp)
+//       "mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
+//       "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation",
+//       "learning_rate", "batch_size", "max_epochs", "patience", "validation_fraction",
+//       "normal_code_weight" (the normal code's share of the MLP loss, 1: the mesh's),
+//       "mesh_weight_floor" (0..1, default 0: the mesh weights' loss follows the vertex error; a floor
+//       shares that much of it evenly over the components), "max_training_seconds", "test_fraction", "temporal_time_constant", "seed", "bc5_baseline",
+//       "input_joints" (the network's Theta joints; absent: part1.input_joints, the thinning joints;
+//                       checked against the character before part 1 simulates anything)
+//     }
+//   }
+// Files named in part1 (character, recipe, clips) must exist when the config is loaded.
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "swish/bake/pipeline/part2_training.hpp"
+#include "swish/bake/pipeline/part1_dataset.hpp"
+
+namespace swish::bake {
+
+struct BakeConfig {
+  std::string name = "model";
+  std::filesystem::path output;
+  std::filesystem::path work;
+  std::filesystem::path dataset;
+  std::optional<DatasetBuildSettings> part1;  // absent: the dataset folder must already exist
+  BakeTrainSettings train;
+
+  std::filesystem::path modelPath() const { return output / (name + ".swish"); }
+  std::filesystem::path reportDir() const { return output / "report"; }
+  std::filesystem::path simulationDir() const { return work / "simulation"; }
+  std::filesystem::path previewDir() const { return reportDir() / "dataset_preview"; }
+};
+
+// `source` names the config in error messages; `baseDir` resolves relative paths.
+BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source, const std::filesystem::path& baseDir);
+BakeConfig loadBakeConfig(const std::filesystem::path& file);
+
+// The pose-shape settings back from the JSON form DatasetBuildSettings::toJson writes (its
+// "simulation", "transfer" and "normal_maps" objects, the same keys and ranges as a config's part1),
+// which a dataset's part1_settings.json and a baked model's metadata ("dataset_settings") carry. Absent
+// keys keep their defaults. Throws Error naming `what` and the key ("meta.simulation.substeps: ...")
+// for an unknown key, a value of the wrong type or out of range, or an unknown cloth preset.
+PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSettings, const std::string& what);
+
+}  // namespace swish::bake

@@ -1,0 +1,129 @@
+#include "swish/bake/pipeline/bake_pipeline.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
+#include "swish/bake/report/bake_report.hpp"
+#include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/core/error.hpp"
+#include "swish/files/atomic_write.hpp"
+#include "swish/model/model_file.hpp"
+
+namespace swish::bake {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+// The dataset's content and the train settings. The manifest's per-pose solve times are left out: they
+// are measurements of the run that made the dataset, not content, and would make the model's bytes
+// differ between two bakes of the same recipe (another machine, another load, a cluster's nodes).
+std::string fingerprint(const BakeConfig& cfg) {
+  std::ifstream in(cfg.dataset / "manifest.json");
+  std::string manifest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  try {
+    nlohmann::json m = nlohmann::json::parse(manifest);
+    if (m.contains("poses") && m["poses"].is_array())
+      for (auto& p : m["poses"])
+        if (p.is_object() && p.contains("residuals") && p["residuals"].is_object()) p["residuals"].erase("seconds");
+    manifest = m.dump();
+  } catch (const nlohmann::json::exception&) {
+    // not JSON: hashed as it is (reading the dataset reports the problem)
+  }
+  return std::to_string(std::hash<std::string>{}(manifest)) + "/" + cfg.train.toJson().dump();
+}
+
+// The model file already holds the result of this dataset + settings?
+bool part2Current(const BakeConfig& cfg) {
+  if (!std::filesystem::exists(cfg.modelPath()) || !std::filesystem::exists(cfg.reportDir() / "report.json")) return false;
+  try {
+    const Model m = loadModel(cfg.modelPath());
+    const auto meta = nlohmann::json::parse(m.metadata);
+    return meta.value("bake_fingerprint", std::string()) == fingerprint(cfg);
+  } catch (const std::exception&) {
+    return false;  // unreadable or foreign: bake again
+  }
+}
+}  // namespace
+
+BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
+  const auto t0 = Clock::now();
+  auto log = [&](const std::string& s) {
+    if (opt.log) opt.log(s);
+  };
+  BakeRunResult res;
+  res.model = cfg.modelPath();
+  res.report = cfg.reportDir() / "report.md";
+
+  // Part 1: the dataset folder (resumable: finished simulations and poses are kept).
+  if (cfg.part1 && opt.part1) {
+    const auto t1 = Clock::now();
+    log("part 1: building the dataset " + cfg.dataset.string());
+    DatasetBuildSettings part1Settings = *cfg.part1;
+    part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
+    part1Settings.simulatedPoseList = opt.simulatedPoseList;
+    const DatasetBuildResult part1 = buildDataset(part1Settings, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
+    res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+    res.part1 = part1.toJson();
+    res.part1["seconds"] = res.part1Seconds;
+    std::filesystem::create_directories(cfg.reportDir());
+    writeTextFileAtomic(cfg.reportDir() / "part1.json", res.part1.dump(2) + "\n");
+    char line[256];
+    std::snprintf(line, sizeof line, "part 1: done in %.1f s: %zu poses in the dataset, %zu left out", res.part1Seconds,
+                  part1.transferred + part1.transfersReused, part1.failed.size());
+    log(line);
+  } else if (!std::filesystem::exists(cfg.dataset / "manifest.json")) {
+    if (cfg.part1)
+      throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() + " (no manifest.json): part 1 has not run");
+    throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
+                " (no manifest.json) and no \"part1\" section to make one");
+  } else if (cfg.part1) {
+    log("part 1: not run here; using the dataset " + cfg.dataset.string() + " as it is");
+  } else {
+    log("part 1: no \"part1\" section; using the dataset " + cfg.dataset.string() + " as it is");
+  }
+  if (!opt.part2) {
+    res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return res;
+  }
+
+  // Part 2.
+  if (!opt.force && part2Current(cfg)) {
+    res.part2Skipped = true;
+    log("part 2: " + res.model.string() + " is current (same dataset and settings); use --force to re-train");
+    return res;
+  }
+  log("part 2: reading the dataset");
+  const Dataset ds = readDataset(cfg.dataset);
+  log("part 2: " + std::to_string(ds.poses.size()) + " poses, " + std::to_string(ds.character.garment.vertexCount()) +
+      " game-mesh vertices");
+  const auto t2 = Clock::now();
+  const BakeTrainOutput out = trainBake(ds, cfg.train, [&](const std::string& stage, double f) {
+    const double el = std::chrono::duration<double>(Clock::now() - t2).count();
+    char line[256];
+    if (f > 0.0 && f < 1.0)
+      std::snprintf(line, sizeof line, "part 2: %3.0f%% %-32s %6.1f s elapsed, about %6.1f s left", 100.0 * f,
+                    stage.c_str(), el, el / f - el);
+    else
+      std::snprintf(line, sizeof line, "part 2: %3.0f%% %-32s %6.1f s elapsed", 100.0 * f, stage.c_str(), el);
+    log(line);
+  });
+  Model model = out.model;
+  nlohmann::json meta = nlohmann::json::parse(model.metadata);
+  meta["bake_fingerprint"] = fingerprint(cfg);
+  meta["name"] = cfg.name;
+  model.metadata = meta.dump();
+  std::filesystem::create_directories(cfg.output);
+  writeBakeReport(out, ds, cfg.reportDir());
+  saveModel(model, cfg.modelPath());  // last: its presence marks part 2 done
+  res.part2Seconds = std::chrono::duration<double>(Clock::now() - t2).count();
+  res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  char line[256];
+  std::snprintf(line, sizeof line, "done in %.1f s: model %s, report %s; held-out vertex error mean %.2f mm, p95 %.2f mm",
+                res.seconds, res.model.string().c_str(), res.report.string().c_str(), out.evaluation.totalMm.mean,
+                out.evaluation.totalMm.p95);
+  log(line);
+  return res;
+}
+
+}  // namespace swish::bake

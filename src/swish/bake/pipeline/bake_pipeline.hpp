@@ -1,0 +1,35 @@
+#pragma once
+// `swish bake`: the whole bake from a validated BakeConfig.
+//   part 1 (character + clips -> thinned poses -> simulation -> transfer -> normal maps -> dataset folder)
+//   part 2 (dataset folder -> PCA, database, VQ, MLP -> <output>/<name>.swish + <output>/report/)
+// Resumable: part 1 keeps finished poses in the dataset folder (dataset_io.hpp); part 2 is skipped when
+// the model file exists and was made from the same dataset manifest and the same train settings.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "swish/bake/pipeline/bake_config.hpp"
+
+namespace swish::bake {
+
+struct BakeRunOptions {
+  bool force = false;                                  // redo part 2 even if its output is current
+  // Run one part only (a cluster bake runs them as separate jobs, swish/cluster/): without part 1 the
+  // dataset must exist; without part 2 the run ends when the dataset is written.
+  bool part1 = true, part2 = true;
+  // Nonzero: part 1's simulations were made by a cluster's array tasks for this pose list
+  // (DatasetBuildSettings::simulatedPoseList); part 1 then only checks, transfers and writes the dataset.
+  uint64_t simulatedPoseList = 0;
+  std::function<void(const std::string& line)> log;    // progress lines (stage, %, time left)
+};
+
+struct BakeRunResult {
+  std::filesystem::path model, report;
+  bool part2Skipped = false;
+  double seconds = 0.0, part1Seconds = 0.0, part2Seconds = 0.0;
+  nlohmann::json part1;  // DatasetBuildResult::toJson + "seconds" (also <report>/part1.json); null without part 1
+};
+
+BakeRunResult runBake(const BakeConfig& config, const BakeRunOptions& options = {});
+
+}  // namespace swish::bake

@@ -1,0 +1,464 @@
+#include "swish/bake/pipeline/part1_dataset.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "swish/bake/character/default_character.hpp"
+#include "swish/bake/dataset/dataset_preview.hpp"
+#include "swish/bake/cloth/pose_driver.hpp"
+#include "swish/bake/poses/pose_thinning.hpp"
+#include "swish/runtime/theta.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/hash.hpp"
+#include "swish/io/animation_import.hpp"
+#include "swish/io/character_import.hpp"
+#include "swish/files/atomic_write.hpp"
+
+namespace swish::bake {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// "simulation  40% (80/200)  12.0 s elapsed, about 18.0 s left" - the same shape for every long step.
+std::string progressLine(const std::string& step, size_t done, size_t total, double elapsed, double left) {
+  char line[256];
+  std::snprintf(line, sizeof line, "part 1: %-10s %3.0f%% (%zu/%zu) %7.1f s elapsed, about %7.1f s left",
+                step.c_str(), total ? 100.0 * double(done) / double(total) : 100.0, done, total, elapsed, left);
+  return line;
+}
+
+// Throttles progress lines: at most one per `interval` seconds, plus the last one.
+struct ProgressThrottle {
+  double interval = 2.0;
+  Clock::time_point last = Clock::now() - std::chrono::hours(1);
+  bool due(size_t done, size_t total) {
+    if (done < total && std::chrono::duration<double>(Clock::now() - last).count() < interval) return false;
+    last = Clock::now();
+    return true;
+  }
+};
+
+std::string namingName(io::JointNaming n) { return io::jointNamingName(n); }
+
+// A digest of the thinned pose list: a different list means different pose ids.
+uint64_t poseListDigest(const std::vector<Pose>& poses) {
+  Fnv1a f;
+  for (const Pose& p : poses) {
+    f.vec(p.local);
+    f.matrix(p.rootTranslation);
+  }
+  return f.h;
+}
+
+// Deletes the dataset's pose files when they were made with other settings; returns true if it did.
+bool resetDatasetIfStale(const fs::path& dir, const nlohmann::json& settings,
+                         const std::function<void(const std::string&)>& log) {
+  const fs::path marker = dir / "part1_settings.json";
+  bool stale = false;
+  if (fs::exists(marker)) {
+    nlohmann::json old;
+    try {
+      old = nlohmann::json::parse(std::ifstream(marker));
+    } catch (const nlohmann::json::exception&) {
+      old = nullptr;  // unreadable: treat as other settings
+    }
+    stale = old != settings;
+  } else {
+    stale = fs::exists(dir / "poses") && !fs::is_empty(dir / "poses");  // poses of unknown settings
+  }
+  if (stale) {
+    if (log) log("part 1: the dataset in " + dir.string() + " was made with other settings; rebuilding its poses");
+    std::error_code ec;
+    for (const char* sub : {"poses", "normal_maps"}) fs::remove_all(dir / sub, ec);
+    for (const char* f : {"manifest.json", "character.bin"}) fs::remove(dir / f, ec);
+  }
+  fs::create_directories(dir);
+  writeTextFileAtomic(marker, settings.dump(2));
+  return stale;
+}
+
+}  // namespace
+
+Character loadDatasetCharacter(const DatasetBuildSettings& s) {
+  if (!s.characterFile.empty()) {
+    io::CharacterImportOptions o;
+    if (!s.bodyMeshNames.empty()) o.bodyNames = s.bodyMeshNames;
+    if (!s.garmentMeshNames.empty()) o.garmentNames = s.garmentMeshNames;
+    if (!s.simulationMeshNames.empty()) o.simulationMeshNames = s.simulationMeshNames;
+    o.requiredJoints = s.inputJoints;
+    return io::importCharacter(s.characterFile, o);
+  }
+  if (!s.characterRecipe.empty()) return makeDefaultCharacter(loadDefaultCharacterRecipe(s.characterRecipe));
+  return makeDefaultCharacter();
+}
+
+PoseShapeSettings DatasetBuildSettings::poseShape() const {
+  PoseShapeSettings p;
+  p.simulationVertices = simulationVertices;
+  p.simulation = simulation;
+  p.limbClearance = limbClearance;
+  p.transfer = transfer;
+  return p;
+}
+
+nlohmann::json DatasetBuildSettings::toJson() const {
+  nlohmann::json clipList = nlohmann::json::array();
+  for (const ClipSource& c : clips) {
+    nlohmann::json m = nlohmann::json::object();
+    for (const auto& [a, b] : c.jointMap) m[a] = b;
+    clipList.push_back({{"file", c.file.string()}, {"naming", namingName(c.naming)}, {"joint_map", m},
+                        {"fps", c.framesPerSecond}});
+  }
+  const ClothSimSettings& m = simulation;
+  return {
+      {"character",
+       {{"file", characterFile.string()}, {"recipe", characterRecipe.string()}, {"body_mesh", bodyMeshNames},
+        {"garment_mesh", garmentMeshNames}, {"simulation_mesh", simulationMeshNames}}},
+      {"clips", clipList},
+      {"input_joints", inputJoints},
+      {"sampling",
+       {{"characters", sampling.characters}, {"seconds_per_character", sampling.secondsPerCharacter},
+        {"sample_rate", sampling.sampleRate}, {"mirror_odd_characters", sampling.mirrorOddCharacters},
+        {"speed_jitter", sampling.speedJitter}, {"seed", sampling.seed}}},
+      {"thinning", {{"tolerance", thinningTolerance}, {"target_poses", targetPoses}, {"include_rest_pose", includeRestPose}}},
+      {"simulation",
+       {{"preset", m.material.name}, {"vertices", simulationVertices}, {"thickness", m.thickness},
+        {"transition_seconds", m.transitionSeconds}, {"settle_seconds", m.settleSeconds},
+        {"frame_rate", m.frameRate}, {"substeps", m.substeps}, {"iterations", m.iterations},
+        {"gravity", -m.gravity.y()}, {"limb_clearance", limbClearance.clearance}, {"attach_band", m.attachTopFraction}}},
+      {"transfer",
+       {{"smoothing_strength", transfer.smoothing.strength}, {"smoothing_iterations", transfer.smoothing.iterations},
+        {"smoothing_weights", transfer.smoothing.weights == LaplacianWeights::Cotangent ? "cotangent" : "uniform"}}},
+      {"normal_maps",
+       {{"size", transfer.normalMap.width}, {"max_distance", transfer.normalMap.maxDistance},
+        {"dilation_rings", transfer.normalMap.dilationRings}, {"bit_depth", normalMapBitDepth}}},
+  };
+}
+
+nlohmann::json DatasetBuildResult::toJson() const {
+  nlohmann::json f = nlohmann::json::array();
+  for (const FailedPose& p : failed) f.push_back({{"pose", p.id}, {"reason", p.reason}});
+  nlohmann::json st = nlohmann::json::array();
+  for (const DatasetBuildStep& s : steps) st.push_back({{"step", s.name}, {"seconds", s.seconds}});
+  return {{"clip_frames", clipFrames},     {"samples", samples},
+          {"kept_poses", keptPoses},       {"rest_pose_added", restPoseAdded},
+          {"tolerance", tolerance},
+          {"poses_corrected", posesCorrected}, {"max_correction_degrees", maxCorrectionDegrees},
+          {"max_correction_towards_rest", maxTowardsRest},
+          {"simulation_vertices", simulationVertices},
+          {"simulated", simulated},        {"simulations_reused", simulationsReused},
+          {"transferred", transferred},    {"transfers_reused", transfersReused},
+          {"failed", f},                   {"rebuilt", rebuilt},
+          {"steps", st}};
+}
+
+std::vector<uint64_t> DatasetPosePlan::poseFingerprints() const {
+  std::vector<uint64_t> f(toSimulate.size());
+  for (size_t i = 0; i < f.size(); ++i) f[i] = poseFingerprint(shapes->solver(), toSimulate[i]);
+  return f;
+}
+
+uint64_t DatasetPosePlan::fingerprint() const {
+  Fnv1a f;
+  const std::string settings = settingsJson.dump();
+  f.bytes(settings.data(), settings.size());
+  f.vec(poseFingerprints());
+  return f.h;
+}
+
+DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  DatasetPosePlan plan;
+  DatasetBuildResult& res = plan.result;
+  auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
+  if (s.clips.empty()) throw Error("bake part 1: no animation clips");
+  if ((s.thinningTolerance > 0.f) == (s.targetPoses > 0))
+    throw Error("bake part 1: give exactly one of a thinning tolerance and a target pose count");
+  s.simulation.validate();
+
+  // Character and clips.
+  auto t = Clock::now();
+  plan.character = std::make_unique<const Character>(loadDatasetCharacter(s));
+  const Character& character = *plan.character;
+  std::vector<uint32_t>& inputJoints = plan.inputJoints;
+  for (const std::string& name : s.inputJoints) {
+    const int j = character.skeleton.find(name);
+    if (j < 0) throw Error("bake part 1: input joint '" + name + "' is not in character '" + character.name + "'");
+    inputJoints.push_back(uint32_t(j));
+  }
+  for (const std::string& name : s.alsoRequiredJoints)
+    if (character.skeleton.find(name) < 0)
+      throw Error("bake: train.input_joints: joint '" + name + "' is not in character '" + character.name + "'");
+  log("part 1: character '" + character.name + "': " + std::to_string(character.skeleton.size()) + " joints, body " +
+      std::to_string(character.body.vertexCount()) + " vertices, game mesh " +
+      std::to_string(character.garment.vertexCount()) + " vertices");
+  step("character", t);
+
+  t = Clock::now();
+  std::vector<AnimationClip> clips;
+  for (const ClipSource& c : s.clips) {
+    io::AnimationImportOptions o;
+    o.retarget.jointMap.naming = c.naming;
+    o.retarget.jointMap.explicitPairs = c.jointMap;
+    o.retarget.requiredJoints = s.inputJoints;
+    o.framesPerSecond = c.framesPerSecond;
+    clips.push_back(io::importAnimation(c.file, character.skeleton, o));
+    res.clipFrames += clips.back().frames.size();
+    log("part 1: clip " + c.file.string() + ": " + std::to_string(clips.back().frames.size()) + " frames at " +
+        std::to_string(int(clips.back().framesPerSecond)) + " fps");
+  }
+  step("clips", t);
+
+  // Poses: sample, thin, back to full-skeleton poses.
+  t = Clock::now();
+  PoseSamplingOptions so = s.sampling;
+  so.joints = s.inputJoints;
+  const PoseSamples samples = samplePoses(character.skeleton, clips, so);
+  res.samples = samples.size();
+  const ThinningResult thin =
+      s.targetPoses > 0 ? thinPosesToCount(samples, s.targetPoses) : thinPoses(samples, s.thinningTolerance);
+  res.tolerance = thin.tolerance;
+  std::vector<Pose>& poses = plan.toSimulate;
+  for (uint32_t k : thin.kept)
+    poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, samples.origins[k])));
+  {
+    char line[200];
+    std::snprintf(line, sizeof line, "part 1: %zu samples thinned to %zu poses (tolerance %.4f, %d passes) in %.2f s",
+                  res.samples, poses.size(), double(thin.tolerance), thin.passes, since(t));
+    log(line);
+  }
+  if (s.includeRestPose) {
+    const Pose rest = canonicalPose(character.skeleton, character.skeleton.restPose());
+    const float nearest = nearestKeptDistance(samples, thin.kept, runtime::computeTheta(inputJoints, rest.local));
+    if (nearest > thin.tolerance) {
+      poses.push_back(rest);
+      res.restPoseAdded = true;
+    }
+    char line[200];
+    std::snprintf(line, sizeof line, "part 1: the rest pose is %.4f from the nearest kept pose: ", double(nearest));
+    log(line + (res.restPoseAdded ? "added as pose " + std::to_string(poses.size() - 1) : std::string("already covered")));
+  }
+  res.keptPoses = poses.size();
+  step("sampling + thinning", t);
+
+  // Clearance, simulation and transfer of one pose are PoseShapeSimulator's steps (pose_shape.hpp),
+  // shared with `swish replay --truth-every`; here each step runs over all poses in turn.
+  t = Clock::now();
+  plan.shapes = std::make_unique<const PoseShapeSimulator>(character, s.poseShape());
+  const PoseShapeSimulator& shapes = *plan.shapes;
+  step("simulation setup", t);
+
+  // Limbs out of the trunk: the corrected poses are simulated; the dataset keeps the recorded poses,
+  // which are what the model sees at run time (see the transfer below).
+  plan.recorded = poses;
+  const std::vector<Pose>& recorded = plan.recorded;
+  if (shapes.clearance()) {
+    t = Clock::now();
+    const LimbClearance& clearance = *shapes.clearance();
+    std::vector<std::vector<LimbCorrection>> corrections(poses.size());
+    tbb::parallel_for(size_t(0), poses.size(),
+                      [&](size_t i) { poses[i] = shapes.poseToSimulate(recorded[i], &corrections[i]); });
+    size_t stillInside = 0;
+    for (const auto& c : corrections) {
+      if (!c.empty()) ++res.posesCorrected;
+      for (const LimbCorrection& x : c) {
+        res.maxCorrectionDegrees = std::max(res.maxCorrectionDegrees, x.degrees);
+        if (x.depthAfter > 0.f) ++stillInside;
+      }
+    }
+    if (!clearance.skipped().empty()) log("part 1: limb clearance skipped: " + clearance.skipped());
+    char line[240];
+    if (clearance.limbCount() > 0) std::snprintf(line, sizeof line,
+                  "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk (%zu limbs of the body "
+                  "checked); turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
+                  1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
+                  double(res.maxCorrectionDegrees), stillInside, since(t));
+    if (clearance.limbCount() > 0) log(line);
+    if (clearance.checksHead()) {
+      for (const auto& c : corrections)
+        for (const LimbCorrection& x : c) res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);
+      std::snprintf(line, sizeof line,
+                    "part 1: head clearance (one-surface body, %zu head vertices checked): %zu of %zu poses had the "
+                    "head inside the body; neck turned back towards rest by up to %.0f %% (%.0f degrees), %zu still "
+                    "inside, in %.2f s",
+                    clearance.headVertexCount(), res.posesCorrected, poses.size(), 100.0 * res.maxTowardsRest,
+                    double(res.maxCorrectionDegrees), stillInside, since(t));
+      log(line);
+      for (size_t i = 0; i < corrections.size(); ++i)
+        for (const LimbCorrection& x : corrections[i]) {
+          std::snprintf(line, sizeof line,
+                        "part 1: head clearance: pose %zu: head %.1f mm inside, neck turned %.0f %% back to rest "
+                        "(%s %.1f degrees), %.1f mm after",
+                        i, 1000.0 * x.depthBefore, 100.0 * x.towardsRest, x.joint.c_str(), double(x.degrees),
+                        1000.0 * x.depthAfter);
+          log(line);
+        }
+    }
+    step("limb clearance", t);
+  }
+
+  // What the dataset folder records of the settings and the pose list.
+  nlohmann::json& settingsJson = plan.settingsJson;
+  settingsJson = s.toJson();
+  settingsJson["pose_list_digest"] = std::to_string(poseListDigest(poses));
+  settingsJson["kept_poses"] = poses.size();
+  settingsJson["thinning_tolerance_used"] = thin.tolerance;
+  // Part 2 keeps this pose in its training split (part2_training.cpp); -1: none was added.
+  settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
+  return plan;
+}
+
+DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
+                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  DatasetPosePlan plan = planDatasetPoses(s, logFn);
+  if (s.simulatedPoseList != 0 && plan.fingerprint() != s.simulatedPoseList) {
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "bake part 1: this recipe now thins to the pose list %016llx, not the %016llx the cluster's array "
+                  "tasks simulated: the recipe, its clips or swish changed after `swish bake --slurm`; submit again",
+                  static_cast<unsigned long long>(plan.fingerprint()),
+                  static_cast<unsigned long long>(s.simulatedPoseList));
+    throw Error(line);
+  }
+  DatasetBuildResult res = std::move(plan.result);
+  auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
+  const Character& character = *plan.character;
+  const PoseShapeSimulator& shapes = *plan.shapes;
+  const std::vector<Pose>& poses = plan.toSimulate;
+  const std::vector<Pose>& recorded = plan.recorded;
+  const nlohmann::json& settingsJson = plan.settingsJson;
+
+  // Dataset folder: reset when its poses were made with other settings or another pose list.
+  res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
+  const DatasetWriter writer(datasetDir, character, plan.inputJoints, settingsJson, s.normalMapBitDepth);
+
+  // Simulation (resumable per pose; failures are recorded in their files and left out).
+  auto t = Clock::now();
+  const ClothSolver& solver = shapes.solver();
+  res.simulationVertices = solver.mesh().vertexCount();
+  log("part 1: simulation mesh " + std::to_string(res.simulationVertices) + " vertices, " +
+      std::to_string(solver.mesh().triangles.rows()) + " triangles, preset '" + s.simulation.material.name + "'");
+  if (s.simulatedPoseList != 0) {
+    // Made by a cluster's array tasks: every pose must be there; none is simulated here.
+    std::vector<uint32_t> missing;
+    for (uint32_t id = 0; id < poses.size(); ++id)
+      if (!loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]))) missing.push_back(id);
+    if (!missing.empty()) {
+      std::string ids;
+      for (size_t k = 0; k < missing.size() && k < 10; ++k) ids += (k ? ", " : "") + std::to_string(missing[k]);
+      throw Error("bake part 1: " + std::to_string(missing.size()) + " of " + std::to_string(poses.size()) +
+                  " poses have no finished simulation in " + simulationDir.string() + " (pose " + ids +
+                  (missing.size() > 10 ? ", ..." : "") + "); the array tasks that own them did not finish");
+    }
+  }
+  ProgressThrottle simThrottle;
+  const auto simStart = Clock::now();
+  const PoseSimulationRun sim = simulatePoses(
+      solver, poses, simulationDir,
+      [&](size_t done, size_t total, double left) {
+        if (simThrottle.due(done, total)) log(progressLine("simulation", done, total, since(simStart), left));
+        return true;
+      },
+      s.threads);
+  res.simulated = sim.simulated;
+  res.simulationsReused = sim.reused;
+  for (const auto& [id, reason] : sim.failures) {
+    res.failed.push_back({id, "simulation: " + reason});
+    log("part 1: pose " + std::to_string(id) + " left out: simulation failed: " + reason);
+  }
+  step("simulation", t);
+
+  // Transfer + smoothing + normal map per pose, in parallel, each pose written when done.
+  t = Clock::now();
+  std::vector<uint32_t> todo;
+  for (uint32_t id = 0; id < poses.size(); ++id) {
+    const bool failed = std::any_of(sim.failures.begin(), sim.failures.end(), [&](const auto& f) { return f.first == id; });
+    if (failed) continue;
+    if (writer.hasPose(id))
+      ++res.transfersReused;
+    else
+      todo.push_back(id);
+  }
+  std::mutex mutex;
+  std::atomic<size_t> done{0};
+  ProgressThrottle transferThrottle;
+  const auto transferStart = Clock::now();
+  const size_t total = todo.size();
+  auto one = [&](size_t k) {
+    const uint32_t id = todo[k];
+    std::string failure;
+    try {
+      const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
+      if (!rec || !rec->result.ok) {
+        failure = "simulation result missing or not usable";
+      } else {
+        // The pre-skin shape from the corrected simulation, the world shape skinned with the
+        // recorded pose (pose_shape.hpp); the dataset keeps the recorded pose.
+        TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], rec->result.positions);
+        DatasetPose dp;
+        dp.id = id;
+        dp.pose = recorded[id];
+        dp.gameMeshWorld = std::move(tp.gameMeshWorld);
+        dp.gameMeshPreSkin = std::move(tp.gameMeshPreSkin);
+        dp.normalMap = std::move(tp.normalMap);
+        dp.residuals = rec->result.residuals;
+        writer.writePose(dp);
+      }
+    } catch (const Error& e) {
+      failure = std::string("transfer: ") + e.what();
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    const size_t n = ++done;
+    if (!failure.empty()) {
+      res.failed.push_back({id, failure});
+      log("part 1: pose " + std::to_string(id) + " left out: " + failure);
+    } else {
+      ++res.transferred;
+    }
+    if (transferThrottle.due(n, total)) {
+      const double el = since(transferStart);
+      log(progressLine("transfer", n, total, el, el / double(n) * double(total - n)));
+    }
+  };
+  if (s.threads > 0) {
+    tbb::task_arena arena(s.threads);
+    arena.execute([&] { tbb::parallel_for(size_t(0), total, size_t(1), one); });
+  } else {
+    tbb::parallel_for(size_t(0), total, size_t(1), one);
+  }
+  std::sort(res.failed.begin(), res.failed.end(), [](const FailedPose& a, const FailedPose& b) { return a.id < b.id; });
+  nlohmann::json source = {{"tool", "swish bake (part 1)"}, {"samples", res.samples}, {"kept_poses", res.keptPoses},
+                           {"simulation_vertices", res.simulationVertices}};
+  writer.writeManifest(res.failed, source);
+  step("transfer + normal maps", t);
+  if (res.transferred + res.transfersReused == 0)
+    throw Error("bake part 1: every pose failed; nothing to train on (see the failures above)");
+
+  // Preview images of a few poses, for a person to look at.
+  if (!previewDir.empty() && s.previewPoses > 0) {
+    t = Clock::now();
+    const Dataset ds = readDataset(datasetDir);
+    res.previews = writeDatasetPreview(ds, previewDir, s.previewPoses, s.previewSize);
+    log("part 1: " + std::to_string(res.previews.size()) + " preview files in " + previewDir.string());
+    step("preview", t);
+  }
+  return res;
+}
+
+}  // namespace swish::bake

@@ -1,0 +1,226 @@
+#include "swish/bake/pipeline/part2_training.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "swish/bake/compression/bc5_baseline.hpp"
+#include "swish/bake/training/model_builder.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/rng.hpp"
+#include "swish/runtime/theta.hpp"
+
+namespace swish::bake {
+
+nlohmann::json BakeTrainSettings::toJson() const {
+  nlohmann::json j = {{"mesh_components", meshComponents},
+          {"mesh_variance", meshVariance},
+          {"normal_code_dims", normalCodeDims},
+          {"database_size", databaseSize},
+          {"codebook_size", vq.codebookSize},
+          {"vq_training_blocks", vq.trainingBlocks},
+          {"vq_iterations", vq.iterations},
+          {"hidden_layers", mlp.hiddenLayers},
+          {"hidden_width", mlp.hiddenWidth},
+          {"activation", activationName(mlp.activation)},
+          {"learning_rate", mlp.learningRate},
+          {"batch_size", mlp.batchSize},
+          {"max_epochs", mlp.maxEpochs},
+          {"patience", mlp.patience},
+          {"validation_fraction", mlp.validationFraction},
+          {"normal_code_weight", normalCodeWeight},
+          {"mesh_weight_floor", meshWeightFloor},
+          {"max_training_seconds", mlp.maxSeconds},
+          {"test_fraction", testFraction},
+          {"temporal_time_constant", temporalTimeConstant},
+          {"seed", seed}};
+  if (!inputJoints.empty()) j["input_joints"] = inputJoints;  // absent: the dataset's (older fingerprints stay)
+  return j;
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+}  // namespace
+
+std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSettings& st) {
+  if (st.inputJoints.empty()) return ds.inputJoints;
+  std::vector<uint32_t> out;
+  for (const std::string& name : st.inputJoints) {
+    const int j = ds.character.skeleton.find(name);
+    if (j < 0) throw Error("bake: train.input_joints: the character '" + ds.character.name + "' has no joint '" + name + "'");
+    if (std::find(out.begin(), out.end(), uint32_t(j)) != out.end())
+      throw Error("bake: train.input_joints: joint '" + name + "' is named twice");
+    out.push_back(uint32_t(j));
+  }
+  return out;
+}
+
+BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress) {
+  auto report = [&](const std::string& s, double f) {
+    if (progress) progress(s, f);
+  };
+  const size_t poses = ds.poses.size();
+  if (poses < 3) throw Error("bake: the dataset has " + std::to_string(poses) + " poses; training needs at least 3");
+  if (ds.inputJoints.empty()) throw Error("bake: the dataset names no input joints (Theta)");
+  const std::vector<uint32_t> thetaJoints = networkInputJoints(ds, st);
+  const size_t n = ds.character.garment.vertexCount();
+  for (const auto& p : ds.poses)
+    if (size_t(p.gameMeshPreSkin.rows()) != n || size_t(p.gameMeshWorld.rows()) != n)
+      throw Error("bake: pose " + std::to_string(p.id) + " has " + std::to_string(p.gameMeshPreSkin.rows()) +
+                  " game-mesh vertices, the character's game mesh has " + std::to_string(n));
+  if (!(st.testFraction >= 0.0 && st.testFraction < 0.5)) throw Error("bake: test fraction must be in [0, 0.5)");
+
+  BakeTrainOutput out;
+  auto t = Clock::now();
+  auto stage = [&](const std::string& name) {
+    const auto now = Clock::now();
+    out.stages.push_back({name, std::chrono::duration<double>(now - t).count()});
+    t = now;
+  };
+
+  // Held-out split (seeded shuffle, sorted back so results do not depend on dataset order quirks).
+  // The rest pose part 1 added (part1_dataset.hpp) is always trained on, never held out: it is
+  // there so that the network knows the A-pose, not to be measured.
+  std::vector<uint32_t>& pinned = out.pinnedPoses;
+  const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") && ds.settings["rest_pose_id"].is_number_integer();
+  const int64_t restId = hasRest ? ds.settings["rest_pose_id"].get<int64_t>() : int64_t(-1);
+  for (size_t i = 0; i < poses; ++i)
+    if (restId >= 0 && int64_t(ds.poses[i].id) == restId) pinned.push_back(uint32_t(i));
+  Rng rng(st.seed);
+  IndexSplit split = seededSplit(poses, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
+  out.testPoses = std::move(split.held);
+  out.trainingPoses = std::move(split.kept);
+  const size_t nTrain = out.trainingPoses.size();
+
+  // 1. Mesh PCA in pre-skinning space.
+  report("mesh PCA", 0.0);
+  MatXf shapes(Eigen::Index(3 * n), Eigen::Index(nTrain));
+  for (size_t i = 0; i < nTrain; ++i)
+    shapes.col(Eigen::Index(i)) =
+        Eigen::Map<const VecXf>(ds.poses[out.trainingPoses[i]].gameMeshPreSkin.data(), Eigen::Index(3 * n));
+  PcaOptions po;
+  po.maxComponents = st.meshComponents;
+  po.varianceToKeep = st.meshVariance;
+  po.seed = st.seed + 1;
+  out.meshPca = fitPca(shapes, po, "mesh PCA");
+  const MatXf meshCodes = out.meshPca.project(shapes);
+  stage("mesh PCA");
+
+  // 2. Normal maps: PCA codes, k-means database, VQ.
+  const bool maps = st.normalCodeDims > 0;
+  NormalMapDatabase db;
+  MatXf normalCodes;
+  if (maps) {
+    report("normal-map PCA", 0.1);
+    std::vector<const NormalMapImage*> trainMaps;
+    for (uint32_t i : out.trainingPoses) trainMaps.push_back(&ds.poses[i].normalMap);
+    out.normalPca = fitNormalMapPca(trainMaps, st.normalCodeDims, st.seed + 2);
+    normalCodes = out.normalPca.codes;
+    stage("normal-map PCA");
+    report("normal-map database (k-means)", 0.25);
+    out.database = selectDatabaseMaps(normalCodes, st.databaseSize, st.seed + 3);
+    for (uint32_t m : out.database.mapIndices) out.databaseMaps.push_back(trainMaps[m]);
+    db.keys = out.database.keys;
+    stage("normal-map database");
+    report("VQ codebook", 0.3);
+    VqOptions vq = st.vq;
+    vq.seed = st.seed + 4;
+    out.vq = encodeVq(out.databaseMaps, vq, db);
+    AngularErrorAccumulator vqAcc, bc5Acc;
+    for (uint32_t m = 0; m < db.mapCount(); ++m) vqAcc.addMaps(*out.databaseMaps[m], decodeVqMap(db, m));
+    out.vqVsUncompressed = vqAcc.stats();
+    out.uncompressedBytes = uint64_t(db.mapCount()) * db.width * db.height * 2 * sizeof(float);
+    stage("VQ");
+    if (st.bc5Baseline) {
+      for (const NormalMapImage* m : out.databaseMaps) bc5Acc.addMaps(*m, bc5RoundTrip(*m));
+      out.bc5VsUncompressed = bc5Acc.stats();
+      out.bc5Bytes = uint64_t(db.mapCount()) * bc5Bytes(db.width, db.height);
+      const auto [w, h] = bc5SizeWithin(db.width, db.height, size_t(out.vq.totalBytes() / std::max<size_t>(1, db.mapCount())));
+      if (w > 0) {
+        AngularErrorAccumulator equalAcc;
+        for (const NormalMapImage* m : out.databaseMaps) equalAcc.addMaps(*m, bc5RoundTripResized(*m, w, h));
+        out.bc5AtVqMemoryVsUncompressed = equalAcc.stats();
+        out.bc5AtVqMemoryWidth = w, out.bc5AtVqMemoryHeight = h;
+        out.bc5AtVqMemoryBytes = uint64_t(db.mapCount()) * bc5Bytes(w, h);
+      }
+      stage("BC5 baseline");
+    }
+  }
+
+  // 3. MLP Theta -> Lambda = [mesh weights, normal code].
+  report("MLP training", 0.5);
+  const int K = out.meshPca.components(), C = maps ? int(normalCodes.rows()) : 0;
+  MatXf theta(Eigen::Index(6 * thetaJoints.size()), Eigen::Index(nTrain)), lambda(K + C, Eigen::Index(nTrain));
+  for (size_t i = 0; i < nTrain; ++i) {
+    const std::vector<float> th = runtime::computeTheta(thetaJoints, ds.poses[out.trainingPoses[i]].pose.local);
+    theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
+  }
+  lambda.topRows(K) = meshCodes;
+  if (C) lambda.bottomRows(C) = normalCodes;
+  MlpTrainOptions mo = st.mlp;
+  mo.seed = st.seed + 5;
+  for (uint32_t p : pinned)  // its column among the training poses
+    mo.alwaysTrain.push_back(
+        uint32_t(std::lower_bound(out.trainingPoses.begin(), out.trainingPoses.end(), p) - out.trainingPoses.begin()));
+  if (mo.outputWeights.empty()) {
+    // Mesh weights by their share of the shape variance (the loss then follows the vertex error),
+    // mixed with st.meshWeightFloor of a uniform weight; the normal code as one block of
+    // normalCodeWeight times the mesh's total weight.
+    const VecXd var = out.meshPca.singularValues.head(K).cwiseAbs2();
+    const double sum = std::max(var.sum(), 1e-300), uniform = st.meshWeightFloor;
+    for (int k = 0; k < K; ++k) mo.outputWeights.push_back((1.0 - uniform) * var[k] / sum + uniform / K);
+    for (int c = 0; c < C; ++c) mo.outputWeights.push_back(st.normalCodeWeight / C);
+  }
+  out.regressor = trainMlp(theta, lambda, mo);
+  stage("MLP training");
+
+  // 4. Model, then evaluation on the held-out poses through the runtime path.
+  report("model + evaluation", 0.9);
+  out.metadata = {{"generator", "swish bake"},
+                  {"character", ds.character.name},
+                  {"settings", st.toJson()},
+                  {"dataset_settings", ds.settings},
+                  {"poses", {{"training", nTrain}, {"held_out", out.testPoses.size()}}}};
+  ModelParts parts;
+  parts.character = &ds.character;
+  parts.inputJoints = thetaJoints;
+  parts.regressor = &out.regressor;
+  parts.meshPca = &out.meshPca;
+  parts.normalMaps = db;
+  parts.temporalFilter.timeConstantSeconds = st.temporalTimeConstant;
+  parts.metadata = out.metadata;
+  out.model = buildModel(parts);
+
+  std::vector<const DatasetPose*> held;
+  for (uint32_t i : out.testPoses) held.push_back(&ds.poses[i]);
+  out.evaluation = evaluateModel(out.model, held, out.databaseMaps, maps ? &out.normalPca.pca : nullptr);
+  stage("evaluation");
+
+  const auto& ev = out.evaluation;
+  out.metadata["errors"] = {
+      {"held_out_poses", ev.poses},
+      {"vertex_total", toJson(ev.totalMm)},
+      {"vertex_pca_truncation", toJson(ev.truncationMm)},
+      {"vertex_regression", toJson(ev.regressionMm)},
+      {"mesh_components", K},
+      {"mesh_explained_variance", out.meshPca.explainedVariance[K]},
+      // No timings here (the report has them): the model's bytes are a function of the recipe alone.
+      {"mlp", {{"best_epoch", out.regressor.bestEpoch}, {"epochs", out.regressor.epochsRun},
+               {"validation_loss", out.regressor.bestValidationLoss}}}};
+  if (maps) {
+    out.metadata["errors"]["normal_database"] = toJson(ev.normalDatabase);
+    out.metadata["errors"]["normal_selection"] = toJson(ev.normalSelection);
+    out.metadata["errors"]["normal_total"] = toJson(ev.normalTotal);
+    out.metadata["errors"]["normal_vq_added"] = toJson(ev.normalVqAdded);
+    out.metadata["errors"]["vq_vs_uncompressed"] = toJson(out.vqVsUncompressed);
+    out.metadata["errors"]["bc5_vs_uncompressed"] = toJson(out.bc5VsUncompressed);
+    out.metadata["errors"]["bc5_at_vq_memory_vs_uncompressed"] = toJson(out.bc5AtVqMemoryVsUncompressed);
+    out.metadata["memory"] = {{"vq_bytes", out.vq.totalBytes()}, {"bc5_bytes", out.bc5Bytes},
+                              {"database_maps", db.mapCount()}, {"codebook_entries", db.codebookSize}};
+  }
+  out.model.metadata = out.metadata.dump();
+  report("done", 1.0);
+  return out;
+}
+
+}  // namespace swish::bake

@@ -1,0 +1,88 @@
+#pragma once
+// Part 2 of the bake (paper 2.2 from the training data on): Dataset -> mesh PCA, normal-map PCA,
+// k-means database, VQ, MLP -> validated Model, plus every measurement the bake report shows.
+// Poses are split once (seeded) into a training set and a held-out test set that nothing is fitted on.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/bake/dataset/dataset.hpp"
+#include "swish/bake/training/mlp_trainer.hpp"
+#include "swish/bake/compression/normal_map_database.hpp"
+#include "swish/bake/compression/normal_map_pca.hpp"
+#include "swish/bake/compression/vq_codebook.hpp"
+#include "swish/model/model.hpp"
+
+namespace swish::bake {
+
+struct BakeTrainSettings {
+  int meshComponents = 24;         // K upper bound
+  double meshVariance = 0.0;       // if > 0: smallest K reaching this explained variance (<= meshComponents)
+  int normalCodeDims = 8;          // C (0: no normal maps in the model)
+  int databaseSize = 128;
+  VqOptions vq;
+  bool bc5Baseline = true;
+  MlpTrainOptions mlp;
+  // The normal code's share of the MLP loss against the mesh weights' (1: the two blocks weigh the
+  // same). The network is shared, so capacity spent on the code is taken from the mesh.
+  double normalCodeWeight = 1.0;
+  // The mesh weights' loss weights: (1 - floor) x each component's share of the shape variance + floor
+  // / K. 0: the loss is the vertex error (the components are orthonormal), what the evaluation
+  // measures; a floor makes the small components count for more. On the default character (1397
+  // poses, K = 48, 5x192) a floor of 0.5, the earlier default, gave 3.61 mm held-out against 3.05 mm
+  // with 0 (seed 2: 3.39 against 2.94; docs/baking.md).
+  double meshWeightFloor = 0.0;
+  double testFraction = 0.1;       // held out for the report
+  float temporalTimeConstant = 0.1f;
+  uint64_t seed = 1;
+  // The network's input joints (Theta), by name; empty: the dataset's, the joints part 1 thinned the
+  // poses over. The cloth also answers to joints the thinning need not spread poses over: on the
+  // default character, adding the forearms and thighs to its 7 thinning joints took the held-out
+  // regression error from 4.09 to 3.40 mm (docs/baking.md).
+  std::vector<std::string> inputJoints;
+
+  nlohmann::json toJson() const;
+};
+
+struct StageTime {
+  std::string stage;
+  double seconds = 0.0;
+};
+
+struct BakeTrainOutput {
+  Model model;
+  PcaResult meshPca;
+  NormalMapPca normalPca;
+  DatabaseSelection database;
+  std::vector<const NormalMapImage*> databaseMaps;  // uncompressed, pointing into the dataset
+  VqReport vq;
+  AngularErrorStats vqVsUncompressed, bc5VsUncompressed;
+  uint64_t bc5Bytes = 0, uncompressedBytes = 0;
+  // BC5 at equal memory: the maps at the largest size whose BC5 fits in the VQ database's bytes
+  // (bc5RoundTripResized), sampled back up. 0x0 when no database or no baseline.
+  AngularErrorStats bc5AtVqMemoryVsUncompressed;
+  uint32_t bc5AtVqMemoryWidth = 0, bc5AtVqMemoryHeight = 0;
+  uint64_t bc5AtVqMemoryBytes = 0;
+  MlpTrainResult regressor;
+  BakeEvaluation evaluation;
+  std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
+  std::vector<uint32_t> pinnedPoses;  // indices into dataset.poses always trained on (the rest pose part 1 added)
+  std::vector<StageTime> stages;
+  nlohmann::json metadata;                          // what went into Model::metadata
+};
+
+// Progress: (stage, fraction of part 2 done in [0, 1]).
+using BakeProgress = std::function<void(const std::string& stage, double fraction)>;
+
+// The dataset must outlive the output (databaseMaps points into it). Throws Error for datasets it
+// cannot train on (fewer than 3 poses, mismatched mesh sizes, maps of mixed sizes, ...).
+// The skeleton indices of the network's input joints: settings.inputJoints resolved on the dataset's
+// character (throws Error naming a joint it lacks, or one named twice), or the dataset's.
+std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSettings& settings);
+
+BakeTrainOutput trainBake(const Dataset& dataset, const BakeTrainSettings& settings, const BakeProgress& progress = {});
+
+}  // namespace swish::bake

@@ -1,0 +1,82 @@
+#include "swish/bake/pipeline/pose_shape.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "swish/core/error.hpp"
+#include "swish/core/skinning.hpp"
+
+namespace swish::bake {
+
+namespace {
+
+std::optional<LimbClearance> makeClearance(const Character& c, const LimbClearanceSettings& s) {
+  if (s.clearance > 0.f) return std::optional<LimbClearance>(std::in_place, c, s);
+  return std::nullopt;
+}
+
+bool samePose(const Pose& a, const Pose& b) {
+  return a.local.size() == b.local.size() &&
+         std::equal(a.local.begin(), a.local.end(), b.local.begin(),
+                    [](const Quatf& x, const Quatf& y) { return x.coeffs() == y.coeffs(); });
+}
+
+}  // namespace
+
+Pose canonicalPose(const Skeleton& skeleton, Pose p) {
+  p.local[0] = skeleton.joints[0].rest.rotation;
+  p.rootTranslation = skeleton.joints[0].rest.translation;
+  return p;
+}
+
+PoseShapeSimulator::PoseShapeSimulator(const Character& character, const PoseShapeSettings& settings)
+    : character_(&character),
+      settings_(settings),
+      clearance_(makeClearance(character, settings.limbClearance)),
+      solver_(character, buildSimulationMesh(character, settings.simulationVertices), settings.simulation),
+      transfer_(character, solver_.mesh().restPositions, solver_.mesh().triangles, settings.transfer) {}
+
+Pose PoseShapeSimulator::poseToSimulate(const Pose& recorded, std::vector<LimbCorrection>* corrections) const {
+  Pose p = recorded;
+  if (clearance_) {
+    std::vector<LimbCorrection> c = clearance_->apply(p);
+    if (corrections) corrections->insert(corrections->end(), c.begin(), c.end());
+  }
+  return p;
+}
+
+TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const Pose& recorded,
+                                                  const Points3f& simulationPositions) const {
+  TransferredPose tp = transfer_.transfer(simulated, simulationPositions);
+  // A pose whose limbs were turned out of the trunk: the shape before skinning comes from the
+  // corrected simulation; the world shape is that shape skinned as the run time will skin it with
+  // the recorded pose. The model so learns its real inputs, and the sleeves of a hanging arm pass
+  // into the torso with the arm, as the body does.
+  if (!samePose(simulated, recorded))
+    tp.gameMeshWorld = skinPositions(tp.gameMeshPreSkin, character_->garment.skin,
+                                     character_->skeleton.skinningMatrices(recorded));
+  return tp;
+}
+
+PoseShape PoseShapeSimulator::simulate(const Pose& recorded) const {
+  PoseShape out;
+  out.simulatedPose = poseToSimulate(recorded, &out.corrections);
+  PoseSimulation sim = solver_.simulate(out.simulatedPose);
+  out.residuals = sim.residuals;
+  if (!sim.ok) {
+    out.failure = "simulation: " + sim.failure;
+    return out;
+  }
+  try {
+    TransferredPose tp = gameMeshShape(out.simulatedPose, recorded, sim.positions);
+    out.gameMeshWorld = std::move(tp.gameMeshWorld);
+    out.gameMeshPreSkin = std::move(tp.gameMeshPreSkin);
+    out.normalMap = std::move(tp.normalMap);
+    out.ok = true;
+  } catch (const Error& e) {
+    out.failure = std::string("transfer: ") + e.what();
+  }
+  return out;
+}
+
+}  // namespace swish::bake

@@ -1,0 +1,345 @@
+#include "swish/bake/poses/limb_clearance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "swish/bake/cloth/body_collider.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/rotation.hpp"
+#include "swish/core/skinning.hpp"
+#include "swish/io/joint_map.hpp"
+
+namespace swish::bake {
+namespace {
+
+// Farthest a limb vertex is looked for inside the trunk (m); deeper is beyond any pose we meet.
+constexpr float kSearch = 0.25f;
+// Grid cell of the trunk collider (m).
+constexpr float kCell = 0.05f;
+// A limb this little inside its clearance is left alone (m).
+constexpr float kTolerance = 0.001f;
+
+// The smallest whole number of steps in [1, most] after which depthAt(steps) <= kTolerance, `before`
+// being the depth at 0: 5-step strides, then bisection; `most` when none clears. `after` gets the depth
+// at the answer, and p (which depthAt sets) is left holding the answer's pose. Shared by the limbs
+// (steps: degrees) and the head (steps: percent of the way back to rest).
+template <class DepthAt>
+int smallestClearing(int most, float before, DepthAt&& depthAt, float& after) {
+  int tried = 0;  // the steps the pose holds
+  auto at = [&](int steps) {
+    tried = steps;
+    return depthAt(steps);
+  };
+  int lo = 0, hi = 0;
+  after = before;
+  while (after > kTolerance && hi < most) {
+    lo = hi;
+    hi = std::min(most, hi + 5);
+    after = at(hi);
+  }
+  while (after <= kTolerance && hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    const float d = at(mid);
+    if (d <= kTolerance) hi = mid, after = d;
+    else lo = mid;
+  }
+  if (tried != hi) after = at(hi);
+  return hi;
+}
+
+int depthOf(const Skeleton& s, int j) {
+  int d = 0;
+  while (s.joints[size_t(j)].parent >= 0) j = s.joints[size_t(j)].parent, ++d;
+  return d;
+}
+
+}  // namespace
+
+LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings)
+    : skeleton_(ch.skeleton), body_(ch.body), settings_(settings) {
+  const std::string what = "body of character '" + ch.name + "'";
+  auto check = [&](bool ok, const char* msg) {
+    if (!ok) throw Error(std::string("limb clearance: ") + msg);
+  };
+  check(std::isfinite(settings_.clearance) && settings_.clearance >= 0.f && settings_.clearance < 0.2f,
+        "clearance must be in [0, 0.2) m");
+  check(std::isfinite(settings_.rootRadius) && settings_.rootRadius >= 0.f, "rootRadius must be >= 0");
+  check(std::isfinite(settings_.maxDegrees) && settings_.maxDegrees > 0.f && settings_.maxDegrees <= 180.f,
+        "maxDegrees must be in (0, 180]");
+  body_.validate(what, skeleton_.size());
+  if (body_.skin.vertexCount() != body_.vertexCount()) throw Error(what + " has no skin weights: limbs cannot be posed");
+  if (skeleton_.inverseBind.empty()) skeleton_.computeInverseBindFromRest();
+
+  // Parts of the surface, seam copies welded (a glTF body is split at its UV seams, which are not
+  // where its limbs begin); the trunk is the part with the most triangles.
+  body_.triangles = trianglesWeldedByPosition(body_.positions, body_.triangles);
+  const std::vector<uint32_t> part = connectedParts(body_.triangles, body_.vertexCount());
+  std::vector<size_t> triangleCount(body_.vertexCount(), 0);
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t) ++triangleCount[part[body_.triangles(t, 0)]];
+  const uint32_t trunk = uint32_t(std::max_element(triangleCount.begin(), triangleCount.end()) - triangleCount.begin());
+  Mesh trunkMesh = body_;
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t)
+    if (part[body_.triangles(t, 0)] == trunk) keep.push_back(t);
+  trunkMesh.triangles.resize(Eigen::Index(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) trunkMesh.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
+  if (keep.size() == size_t(body_.triangles.rows())) {
+    skipped_ = "the body is one connected mesh: no limbs to keep apart";
+    setUpHead();
+    return;
+  }
+  // Inside and outside need a closed trunk: near the openings of an open one (a torso whose head and
+  // hands are separate meshes) the sign of the distance means nothing.
+  trunk_.emplace(trunkMesh, kCell, what + " (trunk)");
+  if (trunk_->openEdges() > 0) {
+    skipped_ = "the body's trunk is not a closed surface (" + std::to_string(trunk_->openEdges()) +
+               " edges not shared by two triangles): inside and outside are undefined";
+    return;
+  }
+  const Pose rest = skeleton_.restPose();
+  BodyCollider trunkCollider = *trunk_;
+  trunkCollider.pose(skeleton_.skinningMatrices(rest));
+  const auto g = skeleton_.globalTransforms(rest);
+  const int n = body_.skin.influences;
+  std::vector<uint32_t> parts;
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v)
+    if (triangleCount[v] > 0 && v != trunk) parts.push_back(v);
+  for (uint32_t p : parts) {
+    // The root: the shallowest joint carrying a tenth of the part's skin weight (a blend that reaches
+    // the neck from a shoulder must not make the shoulder the root of the head).
+    Limb limb;
+    std::vector<double> weightOf(skeleton_.size(), 0.0);
+    double total = 0.0;
+    for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+      if (part[v] != p) continue;
+      for (int k = 0; k < n; ++k) {
+        weightOf[body_.skin.joints[size_t(v) * n + k]] += body_.skin.weights[size_t(v) * n + k];
+        total += body_.skin.weights[size_t(v) * n + k];
+      }
+    }
+    for (int j = 0; j < int(skeleton_.size()); ++j)
+      if (weightOf[size_t(j)] >= 0.1 * total &&
+          (limb.rootJoint < 0 || depthOf(skeleton_, j) < depthOf(skeleton_, limb.rootJoint)))
+        limb.rootJoint = j;
+    // A part that moves with the root of the skeleton cannot be rotated away from anything.
+    if (limb.rootJoint <= 0) continue;
+    const Vec3f head = g[size_t(limb.rootJoint)].translation;
+    for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+      if (part[v] != p) continue;
+      const Vec3f x = body_.positions.row(v);
+      if ((x - head).norm() <= settings_.rootRadius) continue;
+      const BodyCollider::Hit hit = trunkCollider.closest(x, kSearch);
+      const float d = hit.found ? hit.signedDistance : std::numeric_limits<float>::infinity();
+      if (!(d > 0.f)) continue;  // inside the trunk at rest: the part's root, meant to overlap
+      limb.vertices.push_back(v);
+      limb.restDistance.push_back(d);
+    }
+    if (!limb.vertices.empty()) limbs_.push_back(std::move(limb));
+  }
+}
+
+std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
+  std::vector<LimbCorrection> out;
+  if ((limbs_.empty() && !head_) || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return out;
+  for (const Quatf& q : pose.local)
+    if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
+  // Measured with the root at rest, as the solver simulates it (the shape ignores the root).
+  Pose p = pose;
+  p.local[0] = skeleton_.joints[0].rest.rotation;
+  p.rootTranslation = skeleton_.joints[0].rest.translation;
+  if (head_) {
+    if (std::optional<LimbCorrection> c = applyHead(pose, std::move(p))) out.push_back(*c);
+    return out;
+  }
+
+  // The trunk is posed once: turning a limb moves only the few trunk vertices its blends reach, near
+  // its root, where nothing is checked.
+  BodyCollider trunk = *trunk_;
+  trunk.pose(skeleton_.skinningMatrices(p));
+  for (const Limb& limb : limbs_) {
+    // How far the limb is inside its clearance, the trunk's outward direction there and the centre of
+    // the offending vertices.
+    Vec3f push = Vec3f::Zero(), centre = Vec3f::Zero();
+    auto measure = [&] {
+      const std::vector<Mat4f> m = skeleton_.skinningMatrices(p);
+      float worst = 0.f, total = 0.f;
+      push.setZero();
+      centre.setZero();
+      for (size_t i = 0; i < limb.vertices.size(); ++i) {
+        const uint32_t v = limb.vertices[i];
+        const Mat4f b = blendedSkinMatrix(body_.skin, v, m);
+        const Vec3f x = b.topLeftCorner<3, 3>() * body_.positions.row(v).transpose() + b.topRightCorner<3, 1>();
+        const float want = std::min(settings_.clearance, limb.restDistance[i]);
+        const BodyCollider::Hit hit = trunk.closest(x, want + kSearch);
+        if (!hit.found) continue;
+        const float d = want - hit.signedDistance;
+        if (!(d > 0.f)) continue;
+        worst = std::max(worst, d);
+        total += d;
+        push += d * hit.normal;
+        centre += d * x;
+      }
+      if (total > 0.f) centre /= total;
+      return worst;
+    };
+    const float before = measure();
+    if (before <= kTolerance) continue;
+    const std::vector<RigidTransform> g = skeleton_.globalTransforms(p);
+    const int j = limb.rootJoint, parent = skeleton_.joints[size_t(j)].parent;
+    const Vec3f head = g[size_t(j)].translation;
+    Vec3f axis = (centre - head).cross(push);
+    LimbCorrection c{skeleton_.joints[size_t(j)].name, 0.f, before, before};
+    if (!(axis.norm() > 1e-9f)) {  // pushed straight along the limb: no rotation helps
+      out.push_back(c);
+      continue;
+    }
+    axis.normalize();
+    const Quatf global = g[size_t(j)].rotation, parentInv = g[size_t(parent)].rotation.conjugate();
+    // The smallest whole number of degrees that clears the limb.
+    auto depthAt = [&](int degrees) {
+      const Quatf turn(Eigen::AngleAxisf(float(degrees) * float(M_PI) / 180.f, axis));
+      p.local[size_t(j)] = (parentInv * turn * global).normalized();
+      return measure();
+    };
+    float after = before;
+    const int degrees = smallestClearing(int(settings_.maxDegrees), before, depthAt, after);
+    pose.local[size_t(j)] = p.local[size_t(j)];
+    c.degrees = float(degrees);
+    c.depthAfter = after > kTolerance ? after : 0.f;
+    out.push_back(c);
+  }
+  return out;
+}
+
+void LimbClearance::setUpHead() {
+  const std::string what = "body";
+  // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
+  int headJoint = -1;
+  for (int j = 1; j < int(skeleton_.size()); ++j)
+    if (io::normaliseJointName(skeleton_.joints[size_t(j)].name).ends_with("head") &&
+        (headJoint < 0 || depthOf(skeleton_, j) < depthOf(skeleton_, headJoint)))
+      headJoint = j;
+  if (headJoint < 0) {
+    skipped_ += "; no joint named 'Head': the head is not checked either";
+    return;
+  }
+  Head h;
+  h.joint = headJoint;
+  h.chain.push_back(headJoint);
+  for (int a = skeleton_.joints[size_t(headJoint)].parent;
+       a > 0 && io::normaliseJointName(skeleton_.joints[size_t(a)].name).find("neck") != std::string::npos;
+       a = skeleton_.joints[size_t(a)].parent)
+    h.chain.push_back(a);
+  std::vector<char> inHead(skeleton_.size(), 0);
+  for (size_t j = 0; j < skeleton_.size(); ++j)
+    for (int a = int(j); a >= 0; a = skeleton_.joints[size_t(a)].parent)
+      if (a == headJoint) {
+        inHead[j] = 1;
+        break;
+      }
+  // Head vertices: dominant skin joint in the head joint's subtree.
+  const int n = body_.skin.influences;
+  std::vector<char> isHead(body_.vertexCount(), 0);
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+    int best = 0;
+    for (int k = 1; k < n; ++k)
+      if (body_.skin.weights[size_t(v) * n + k] > body_.skin.weights[size_t(v) * n + best]) best = k;
+    isHead[v] = inHead[body_.skin.joints[size_t(v) * n + best]];
+  }
+  // The rest of the body: the triangles with fewer than two head vertices.
+  Mesh others = body_;
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t) {
+    const int heads = isHead[body_.triangles(t, 0)] + isHead[body_.triangles(t, 1)] + isHead[body_.triangles(t, 2)];
+    if (heads < 2) keep.push_back(t);
+  }
+  if (keep.size() == size_t(body_.triangles.rows()) || keep.empty()) {
+    skipped_ += "; the head has no triangles of its own: it is not checked";
+    return;
+  }
+  others.triangles.resize(Eigen::Index(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) others.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
+  h.whole.emplace(body_, kCell, what);
+  if (h.whole->openEdges() > 0) {
+    skipped_ += "; the body is not a closed surface (" + std::to_string(h.whole->openEdges()) +
+                " open edges): the head is not checked";
+    return;
+  }
+  h.rest.emplace(others, kCell, what + " (without the head)");
+  const Pose rest = skeleton_.restPose();
+  const std::vector<Mat4f> m = skeleton_.skinningMatrices(rest);
+  BodyCollider restPosed = *h.rest, wholePosed = *h.whole;
+  restPosed.pose(m);
+  wholePosed.pose(m);
+  std::vector<char> used(body_.vertexCount(), 0);
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t)
+    for (int c = 0; c < 3; ++c) used[body_.triangles(t, c)] = 1;
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+    if (!isHead[v] || !used[v]) continue;
+    const Vec3f x = body_.positions.row(v);
+    if (h.vertices.empty()) h.wholePart = wholePosed.closest(x, kCell).part;
+    if (restPosed.closest(x, settings_.headBorder).found) continue;  // near the neck seam or the jaw
+    h.vertices.push_back(v);
+  }
+  if (h.vertices.empty()) {
+    skipped_ += "; no head vertex lies " + std::to_string(settings_.headBorder) + " m from the rest of the body";
+    return;
+  }
+  skipped_.clear();
+  head_ = std::move(h);
+}
+
+std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const {
+  const Head& h = *head_;
+  // How far the deepest checked head vertex is inside the rest of the body: the closest of the other
+  // triangles (an open surface: its sign is trusted only where the whole body's winding number
+  // confirms the vertex lies inside another layer of it, 1.5 against 0.5 on the surface alone).
+  auto measure = [&] {
+    const std::vector<Mat4f> m = skeleton_.skinningMatrices(p);
+    BodyCollider others = *h.rest;
+    others.pose(m);
+    std::optional<BodyCollider> whole;
+    float worst = 0.f;
+    for (const uint32_t v : h.vertices) {
+      const Mat4f b = blendedSkinMatrix(body_.skin, v, m);
+      const Vec3f x = b.topLeftCorner<3, 3>() * body_.positions.row(v).transpose() + b.topRightCorner<3, 1>();
+      const BodyCollider::Hit hit = others.closest(x, kSearch);
+      if (!hit.found || !(-hit.signedDistance > std::max(worst, kTolerance))) continue;
+      if (!whole) {
+        whole.emplace(*h.whole);
+        whole->pose(m);
+      }
+      if (whole->windingNumber(x, h.wholePart) < 1.f) continue;
+      worst = -hit.signedDistance;
+    }
+    return worst;
+  };
+  const float before = measure();
+  if (before <= kTolerance) return std::nullopt;
+  const Pose recorded = p;
+  // The head joint in the frame of its chain's parent, to tell how far the head turned.
+  const int top = skeleton_.joints[size_t(h.chain.back())].parent;
+  auto headInChain = [&](const Pose& q) {
+    const std::vector<RigidTransform> g = skeleton_.globalTransforms(q);
+    return Quatf(g[size_t(top)].rotation.conjugate() * g[size_t(h.joint)].rotation);
+  };
+  // The smallest whole percentage of the way back to rest that clears the head.
+  auto depthAt = [&](int percent) {
+    for (int j : h.chain)
+      p.local[size_t(j)] = slerpShortest(recorded.local[size_t(j)], skeleton_.joints[size_t(j)].rest.rotation,
+                                         float(percent) / 100.f)
+                               .normalized();
+    return measure();
+  };
+  float after = before;
+  const int percent = smallestClearing(100, before, depthAt, after);
+  for (int j : h.chain) pose.local[size_t(j)] = p.local[size_t(j)];
+  LimbCorrection c{skeleton_.joints[size_t(h.joint)].name, 0.f, before, after > kTolerance ? after : 0.f,
+                   float(percent) / 100.f};
+  const float dot = std::min(1.f, std::abs(headInChain(recorded).dot(headInChain(p))));
+  c.degrees = 2.f * std::acos(dot) * 180.f / float(M_PI);
+  return c;
+}
+
+}  // namespace swish::bake

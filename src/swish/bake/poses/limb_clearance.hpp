@@ -1,0 +1,102 @@
+#pragma once
+// Limb clearance: keeps a pose's limbs out of the trunk before the garment is simulated on it.
+//
+// A body made of separate closed parts (the embedded mannequin's torso, head, arm and leg tubes) and
+// driven by motion capture of a real person intersects itself: in the CMU clips the upper arms hang
+// straight down, and the mannequin's arm tubes then pass 4-7 cm into its torso. Cloth cannot be
+// outside both: a sleeve around an arm that is inside the torso is necessarily inside the body, and
+// the solver tears it trying. So before simulating, each limb that has moved into the trunk is
+// rotated about its root joint, away from the trunk, by the smallest whole number of degrees that
+// leaves a clearance, just as datasets of simulated clothing filter or correct self-intersecting
+// body poses. The bake simulates the corrected pose and stores the recorded one (part1_dataset.cpp).
+//
+// Parts are the body's connected components; the trunk is the one with the most triangles. A limb's
+// root joint is the shallowest joint carrying a tenth of its skin weight. Only limb vertices that lie
+// outside the trunk in the rest pose and farther than rootRadius from the root joint are checked:
+// the root of a tube starts inside the trunk by construction. A body that is one connected mesh has
+// no parts to separate, and a trunk that is not a closed surface has no inside; the limbs of either
+// are left unchanged (skipped() says why).
+//
+// Head clearance. A body that is ONE closed surface (a glTF character) has no limb parts, but its head
+// can still pass into its own chest: a clip that bows the head further than the body's skinning
+// allows puts the skinned chin centimetres inside the chest, and the collar between them has nowhere
+// to be (the shared T-shirt's runaway at the neckline, docs/baking.md). So for such a body the head
+// (vertices whose dominant skin joint is the joint named "Head", or ending in "Head", or below it;
+// names compared as the importer compares them, io::normaliseJointName) is
+// checked against the rest of the body (the other triangles, posed with it): a pose that puts a head
+// vertex inside it by more than the tolerance has its neck chain (that joint and the ancestors named
+// "...Neck...") turned back towards rest, every joint by the same smallest whole percentage of the
+// way (slerp) that leaves no head vertex inside. Head vertices within headBorder of the rest of the
+// body at rest (under the jaw, the neck seam) are not checked: skinning creases them into the neck in
+// ordinary bends. A body of separate parts never gets this step: its head is a part that limb
+// clearance already keeps out of the trunk (the embedded mannequin's is).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "swish/bake/cloth/body_collider.hpp"
+#include "swish/core/character.hpp"
+
+namespace swish::bake {
+
+struct LimbClearanceSettings {
+  float clearance = 0.015f;   // m between a limb and the trunk: room for two layers of cloth
+  float rootRadius = 0.10f;   // m: limb vertices this close to their root joint are not checked
+  float maxDegrees = 60.f;    // the largest correction; a limb still inside after it is reported
+  float headBorder = 0.03f;   // m: one-surface bodies' head vertices this close to the rest of the body at rest are not checked
+};
+
+struct LimbCorrection {
+  std::string joint;       // the root joint that was rotated
+  float degrees = 0.f;     // by how much
+  float depthBefore = 0.f;  // m: how far the limb was inside the clearance before
+  float depthAfter = 0.f;   // after (0 when cleared)
+  // Head clearance only (joint: the head joint): the fraction of the way back to rest the neck chain
+  // was turned (0.2: 20 %); `degrees` is then how far that turned the head joint in its chain's frame.
+  float towardsRest = 0.f;
+};
+
+class LimbClearance {
+ public:
+  // Throws Error on a body without skin weights or settings out of range.
+  LimbClearance(const Character& character, LimbClearanceSettings settings = {});
+
+  // Rotates limbs of `pose` out of the trunk in place; returns what it changed (empty: nothing).
+  // Deterministic; non-finite poses are left alone for the solver to reject.
+  std::vector<LimbCorrection> apply(Pose& pose) const;
+
+  size_t limbCount() const { return limbs_.size(); }
+  // Why no limb is checked (empty when some are).
+  const std::string& skipped() const { return skipped_; }
+  // Whether the head of a one-surface body is checked (see above), and how many of its vertices.
+  bool checksHead() const { return head_.has_value(); }
+  size_t headVertexCount() const { return head_ ? head_->vertices.size() : 0; }
+
+ private:
+  struct Limb {
+    int rootJoint = -1;
+    std::vector<uint32_t> vertices;  // checked vertices
+    std::vector<float> restDistance;  // their signed distance to the trunk at rest
+  };
+  Skeleton skeleton_;
+  Mesh body_;
+  std::optional<BodyCollider> trunk_;  // the trunk alone, unposed: copied and posed per pose
+  LimbClearanceSettings settings_;
+  std::vector<Limb> limbs_;
+  std::string skipped_;
+
+  struct Head {
+    int joint = -1;               // the head joint
+    std::vector<int> chain;       // the joints turned back to rest: the head joint and its neck ancestors
+    std::vector<uint32_t> vertices;  // checked head vertices
+    std::optional<BodyCollider> rest;   // the body without the head's triangles, unposed
+    std::optional<BodyCollider> whole;  // the whole closed body, unposed: its winding number confirms inside
+    int wholePart = 0;
+  };
+  std::optional<Head> head_;
+  void setUpHead();
+  // `p`: `pose` checked and with its root at rest (as apply measures it).
+  std::optional<LimbCorrection> applyHead(Pose& pose, Pose p) const;
+};
+
+}  // namespace swish::bake

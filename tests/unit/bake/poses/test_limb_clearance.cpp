@@ -1,0 +1,249 @@
+// Limb clearance (bake/poses/limb_clearance.hpp): limbs that a recorded pose puts inside the trunk of a body
+// made of parts are turned out of it before the garment is simulated.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "swish/bake/cloth/body_collider.hpp"
+#include "swish/bake/character/default_character.hpp"
+#include "swish/bake/poses/limb_clearance.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/rotation.hpp"
+#include "swish/core/skinning.hpp"
+#include "support/cloth_fixture.hpp"
+
+using namespace swish;
+using namespace swish::bake;
+
+namespace {
+
+const Character& mannequin() {
+  static const Character c = makeDefaultCharacter();
+  return c;
+}
+
+// The upper arm `joint` pointing straight down (the mannequin's rest is an A-pose with the arm
+// 50 degrees below horizontal, so this turns it about +-Z by 40 degrees), tilted `inward` radians
+// towards the body, as in the CMU clips where arms hang against the sides.
+Pose armsHanging(const Skeleton& s, float inward) {
+  Pose p = s.restPose();
+  const float down = 40.f * float(M_PI) / 180.f + inward;
+  p.local[size_t(s.find("LeftArm"))] = Quatf(Eigen::AngleAxisf(-down, Vec3f::UnitZ()));
+  p.local[size_t(s.find("RightArm"))] = Quatf(Eigen::AngleAxisf(down, Vec3f::UnitZ()));
+  return p;
+}
+
+// Smallest signed distance from the arm tubes' vertices (farther than 0.1 m from the shoulder joint,
+// as the clearance checks them) to the torso, measured independently with a collider over the
+// torso alone (the part in front of the chest).
+float armToTorso(const Character& c, const Pose& pose) {
+  const Mesh& b = c.body;
+  Mesh torso = b;
+  std::vector<Eigen::Index> keep;
+  BodyCollider whole(b, 0.05f);
+  whole.pose(c.skeleton.skinningMatrices(c.skeleton.restPose()));
+  const int torsoPart = whole.closest(Vec3f(0.f, 1.2f, 0.2f), 0.5f).part;
+  for (Eigen::Index t = 0; t < b.triangles.rows(); ++t) {
+    const BodyCollider::Hit h = whole.closest(b.positions.row(b.triangles(t, 0)), 1e-4f, torsoPart);
+    if (h.found) keep.push_back(t);
+  }
+  torso.triangles.resize(Eigen::Index(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) torso.triangles.row(Eigen::Index(i)) = b.triangles.row(keep[i]);
+  BodyCollider col(torso, 0.05f);
+  const auto m = c.skeleton.skinningMatrices(pose);
+  col.pose(m);
+  const auto rest = c.skeleton.globalTransforms(c.skeleton.restPose());
+  float worst = INFINITY;
+  for (uint32_t v = 0; v < b.vertexCount(); ++v) {
+    const Vec3f x0 = b.positions.row(v);
+    if (std::abs(x0.x()) < 0.2f || x0.y() < 0.9f) continue;  // the arms only
+    const int shoulder = c.skeleton.find(x0.x() > 0 ? "LeftArm" : "RightArm");
+    if ((x0 - rest[size_t(shoulder)].translation).norm() <= 0.1f) continue;
+    const Mat4f k = blendedSkinMatrix(b.skin, v, m);
+    const Vec3f x = k.topLeftCorner<3, 3>() * x0 + k.topRightCorner<3, 1>();
+    const BodyCollider::Hit h = col.closest(x, 0.3f);
+    if (h.found) worst = std::min(worst, h.signedDistance);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(LimbClearance, RestPoseOfTheMannequinNeedsNoCorrection) {
+  const LimbClearance lc(mannequin());
+  EXPECT_EQ(lc.limbCount(), 7u);  // head, two arms, two legs, two feet
+  EXPECT_TRUE(lc.skipped().empty()) << lc.skipped();
+  Pose p = mannequin().skeleton.restPose();
+  EXPECT_TRUE(lc.apply(p).empty());
+}
+
+TEST(LimbClearance, HangingArmsAreTurnedOutOfTheTorsoAndNothingElseMoves) {
+  const Character& c = mannequin();
+  const Skeleton& s = c.skeleton;
+  const Pose recorded = armsHanging(s, 0.07f);
+  // Measured: the hanging arm tubes are 4-6 cm inside the torso.
+  ASSERT_LT(armToTorso(c, recorded), -0.03f);
+
+  LimbClearanceSettings settings;
+  const LimbClearance lc(c, settings);
+  Pose p = recorded;
+  const std::vector<LimbCorrection> fixes = lc.apply(p);
+  ASSERT_EQ(fixes.size(), 2u);
+  for (const LimbCorrection& f : fixes) {
+    EXPECT_TRUE(f.joint == "LeftArm" || f.joint == "RightArm") << f.joint;
+    EXPECT_GT(f.depthBefore, 0.03f);
+    EXPECT_EQ(f.depthAfter, 0.f);
+    EXPECT_GT(f.degrees, 5.f);
+    EXPECT_LT(f.degrees, settings.maxDegrees);
+  }
+  // Out of the torso by the clearance, less the 1 mm the search leaves (checked with another collider).
+  EXPECT_GT(armToTorso(c, p), settings.clearance - 0.0011f);
+  // Only the two upper arms changed; the spine (the model's inputs) is untouched.
+  for (size_t j = 0; j < s.size(); ++j) {
+    const bool arm = s.joints[j].name == "LeftArm" || s.joints[j].name == "RightArm";
+    EXPECT_EQ(arm, !p.local[j].coeffs().isApprox(recorded.local[j].coeffs())) << s.joints[j].name;
+  }
+  // The smallest turn: one degree less leaves the arm inside the clearance.
+  for (const LimbCorrection& f : fixes) {
+    Pose less = p;
+    const int j = s.find(f.joint);
+    less.local[size_t(j)] = recorded.local[size_t(j)].slerp(1.f - 1.f / f.degrees, p.local[size_t(j)]);
+    EXPECT_FALSE(lc.apply(less).empty()) << f.joint;
+  }
+  // Deterministic.
+  Pose again = recorded;
+  lc.apply(again);
+  for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(again.local[j].coeffs(), p.local[j].coeffs());
+}
+
+TEST(LimbClearance, OnePartBodiesAndBadPosesAreLeftAlone) {
+  const Character capsule = test::capsuleCharacter();
+  const LimbClearance lc(capsule);
+  EXPECT_EQ(lc.limbCount(), 0u);
+  EXPECT_FALSE(lc.checksHead());  // no joint named Head
+  EXPECT_NE(lc.skipped().find("one connected mesh"), std::string::npos) << lc.skipped();
+  // A trunk with a hole has no inside: nothing is checked.
+  Character open = mannequin();
+  open.body.triangles.conservativeResize(open.body.triangles.rows(), 3);
+  open.body.triangles.row(0) = open.body.triangles.row(1);  // one torso triangle doubled, one gone
+  const LimbClearance holed(open);
+  EXPECT_EQ(holed.limbCount(), 0u);
+  EXPECT_NE(holed.skipped().find("not a closed surface"), std::string::npos) << holed.skipped();
+  Pose p = capsule.skeleton.restPose();
+  p.local[2] = Quatf(Eigen::AngleAxisf(1.2f, Vec3f::UnitX()));
+  EXPECT_TRUE(lc.apply(p).empty());
+
+  Pose bad = armsHanging(mannequin().skeleton, 0.f);
+  bad.local[3].x() = NAN;
+  const Pose before = bad;
+  EXPECT_TRUE(LimbClearance(mannequin()).apply(bad).empty());
+  EXPECT_TRUE(bad.local[5].coeffs() == before.local[5].coeffs());
+
+  LimbClearanceSettings wrong;
+  wrong.clearance = -1.f;
+  EXPECT_THROW(LimbClearance(mannequin(), wrong), Error);
+}
+
+namespace {
+
+// A one-surface body with a head: the capsule stretched to 1.2 m, its joints renamed Hips, LowerBack,
+// Neck, Head (0.75 m): the top 0.45 m of the tube and its cap are the head, the rest the body.
+struct HeadedCapsule {
+  test::CapsuleSpec spec;
+  Character character;
+  HeadedCapsule() {
+    spec.axisHigh = 1.2f;
+    spec.rows = 48;
+    spec.garmentHigh = 0.6f;
+    character = test::capsuleCharacter(spec);
+    character.skeleton.joints[2].name = "Neck";
+    character.skeleton.joints[3].name = "Head";
+  }
+};
+
+Pose headBowed(const Skeleton& s, float degrees) {
+  Pose p = s.restPose();
+  p.local[3] = Quatf(Eigen::AngleAxisf(degrees * float(M_PI) / 180.f, Vec3f::UnitX()));
+  return p;
+}
+
+// Deepest a head vertex (rest height above 0.81 m: off the blended neck) is inside the body's
+// unblended lower tube (below 0.69 m), analytically.
+float headInsideBody(const HeadedCapsule& h, const Pose& pose) {
+  const Mesh& b = h.character.body;
+  const auto m = h.character.skeleton.skinningMatrices(pose);
+  float worst = 0.f;
+  for (uint32_t v = 0; v < b.vertexCount(); ++v) {
+    const Vec3f x0 = b.positions.row(v);
+    if (x0.y() < 0.81f) continue;
+    const Mat4f k = blendedSkinMatrix(b.skin, v, m);
+    const Vec3f x = k.topLeftCorner<3, 3>() * x0 + k.topRightCorner<3, 1>();
+    if (x.y() > 0.69f || x.y() < 0.f) continue;
+    worst = std::max(worst, h.spec.radius - Vec3f(x.x(), 0.f, x.z()).norm());
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(LimbClearance, OneSurfaceHeadBowedIntoTheBodyIsTurnedBackTowardsRest) {
+  const HeadedCapsule h;
+  const Skeleton& s = h.character.skeleton;
+  const LimbClearance lc(h.character);
+  ASSERT_TRUE(lc.checksHead()) << lc.skipped();
+  EXPECT_TRUE(lc.skipped().empty()) << lc.skipped();
+  EXPECT_EQ(lc.limbCount(), 0u);
+  EXPECT_GT(lc.headVertexCount(), 100u);
+
+  // At rest and slightly bowed the head is clear: untouched.
+  for (float deg : {0.f, 8.f}) {
+    Pose p = headBowed(s, deg);
+    const Pose before = p;
+    EXPECT_TRUE(lc.apply(p).empty()) << deg;
+    for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(p.local[j].coeffs(), before.local[j].coeffs());
+  }
+
+  // Folded down along the body the head is centimetres inside it.
+  const Pose recorded = headBowed(s, 170.f);
+  ASSERT_GT(headInsideBody(h, recorded), 0.03f);
+  Pose p = recorded;
+  const std::vector<LimbCorrection> fixes = lc.apply(p);
+  ASSERT_EQ(fixes.size(), 1u);
+  const LimbCorrection& f = fixes[0];
+  EXPECT_EQ(f.joint, "Head");
+  EXPECT_GT(f.depthBefore, 0.03f);
+  EXPECT_EQ(f.depthAfter, 0.f);
+  EXPECT_GT(f.towardsRest, 0.f);
+  EXPECT_LT(f.towardsRest, 1.f);
+  // The head turned back by that fraction of its 170 degrees, about the same axis.
+  EXPECT_NEAR(f.degrees, 170.f * f.towardsRest, 0.5f);
+  const Eigen::AngleAxisf turned(p.local[3]);
+  EXPECT_NEAR(turned.angle() * 180.f / float(M_PI), 170.f - f.degrees, 0.5f);
+  EXPECT_GT(turned.axis().x(), 0.999f);
+  // Out of the body (measured analytically, 1 mm tolerance), and only the head chain moved.
+  EXPECT_LT(headInsideBody(h, p), 0.0011f);
+  for (size_t j = 0; j < 3; ++j) EXPECT_EQ(p.local[j].coeffs(), recorded.local[j].coeffs()) << s.joints[j].name;
+  // The smallest correction: a percent less leaves the head inside.
+  Pose less = recorded;
+  less.local[3] = slerpShortest(recorded.local[3], s.joints[3].rest.rotation, f.towardsRest - 0.01f);
+  EXPECT_FALSE(lc.apply(less).empty());
+  // Corrected poses need no more; deterministic.
+  Pose again = p;
+  EXPECT_TRUE(lc.apply(again).empty());
+  Pose twice = recorded;
+  lc.apply(twice);
+  for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(twice.local[j].coeffs(), p.local[j].coeffs());
+}
+
+TEST(LimbClearance, BodiesOfPartsNeverGetTheHeadStep) {
+  // The mannequin's head is a part of its own, kept out of the torso by limb clearance: the one-surface
+  // head step (which would change the default bake's simulated poses) is not set up.
+  const LimbClearance lc(mannequin());
+  EXPECT_FALSE(lc.checksHead());
+  EXPECT_EQ(lc.headVertexCount(), 0u);
+  Pose p = mannequin().skeleton.restPose();
+  const int neck = mannequin().skeleton.find("Neck");
+  ASSERT_GE(neck, 0);
+  p.local[size_t(neck)] = Quatf(Eigen::AngleAxisf(1.4f, Vec3f::UnitX()));
+  for (const LimbCorrection& f : lc.apply(p)) EXPECT_EQ(f.towardsRest, 0.f) << f.joint;
+}
