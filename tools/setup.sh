@@ -17,6 +17,7 @@ PACKAGES=(
   libcli11-dev                                     # command line
   libsquish-dev                                    # BC5 baseline for the VQ normal maps
   libembree-dev libtbb-dev                         # ray casts for normal-map baking; parallel loops
+  slurm-wlm slurm-client munge                     # `swish bake --slurm`; the cluster tests' one-node Slurm
 )
 
 missing=()

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite: install what is missing, build, run every CTest test (unit, conformance,
-# stability, e2e, fuzz). GPU tests run on the Vulkan device chosen by SWISH_DEVICE (name substring or
+# stability, e2e, fuzz, cluster: the last starts a one-node Slurm cluster of its own, as root). GPU tests run on the Vulkan device chosen by SWISH_DEVICE (name substring or
 # index; default: the first discrete GPU, else lavapipe). Writes a JUnit report to build/junit.xml.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -2,6 +2,10 @@
 // writes <output>/<name>.swish and <output>/report/. The config is validated before any work. Part 1
 // (character + clips -> simulated poses -> dataset) and part 2 (dataset -> model) are both resumable:
 // interrupt it and run the same command again.
+//
+// With --slurm the same bake is submitted to a Slurm cluster instead (swish/cluster/slurm_bake.hpp):
+// part 1's simulations as a job array, the dataset and part 2 as jobs that depend on it; --status
+// prints its progress. The jobs run this program with --slurm-task, an option for the jobs only.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +16,8 @@
 #include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/character/default_character.hpp"
 #include "swish/core/error.hpp"
+#include "swish/cluster/pose_list_file.hpp"
+#include "swish/cluster/slurm_bake.hpp"
 #include "swish/io/gltf_export.hpp"
 #include "swish/command.hpp"
 
@@ -21,6 +27,10 @@ swish::cli::RunFn setup(CLI::App& sub) {
   struct Opts {
     std::string config, defaultCharacterGlb;
     bool force = false, checkOnly = false, readClips = false;
+    bool slurm = false, status = false;
+    swish::cluster::SlurmSubmitOptions submit;
+    std::string task, poseList;
+    size_t shardSize = 0;
   };
   auto o = std::make_shared<Opts>();
   sub.add_option("config", o->config,
@@ -36,6 +46,58 @@ swish::cli::RunFn setup(CLI::App& sub) {
   sub.add_flag("--read-clips", o->readClips,
                "validate the config, read and retarget every clip of part1.clips onto the character (in parallel; "
                "a bad file stops it, named), print frames per subject and the time taken, and stop");
+
+  const std::string cl = "Cluster (Slurm; docs/cluster.md)";
+  sub.add_flag("--slurm", o->slurm,
+               "submit the bake to the Slurm cluster that sbatch reaches instead of running it here: part 1's "
+               "simulations as a job array of shards (resumable per pose), then the dataset and part 2 as jobs "
+               "that depend on it (afterok). The work and output folders must be on a file system every node sees")
+      ->group(cl);
+  sub.add_flag("--status", o->status,
+               "print the progress of the bake submitted with --slurm: poses done, failed, running, waiting, the "
+               "jobs' states and the time left")
+      ->group(cl);
+  sub.add_option("--partition", o->submit.partition, "sbatch --partition for every job")->group(cl);
+  sub.add_option("--account", o->submit.account, "sbatch --account for every job")->group(cl);
+  sub.add_option("--time", o->submit.timeLimit,
+                 "time limit of each array task (Slurm format, e.g. 30, 2:00:00, 1-00:00:00); the shards are sized "
+                 "so a task needs at most 80 % of it")
+      ->capture_default_str()
+      ->group(cl);
+  sub.add_option("--final-time", o->submit.finalTimeLimit,
+                 "time limit of the dataset and part 2 jobs (default: the partition's)")
+      ->group(cl);
+  sub.add_option("--cpus-per-task", o->submit.cpusPerTask,
+                 "CPUs of every job; an array task simulates that many poses at once")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096))
+      ->group(cl);
+  sub.add_option("--max-running", o->submit.maxRunning, "array tasks running at once (--array=...%N); 0: no limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000))
+      ->group(cl);
+  sub.add_option("--sbatch-arg", o->submit.sbatchArgs,
+                 "one more argument for every sbatch call, e.g. --sbatch-arg=--qos=low (repeat for more)")
+      ->group(cl);
+  sub.add_option("--seconds-per-pose", o->submit.secondsPerPose,
+                 "one pose's simulation on one core, for sizing the shards (default: the median of poses already "
+                 "simulated, else one pose simulated and timed before submitting)")
+      ->check(CLI::PositiveNumber)
+      ->group(cl);
+  sub.add_option("--poses-per-task", o->submit.posesPerTask,
+                 "poses per array task, instead of sizing from the seconds per pose and the time limit")
+      ->check(CLI::PositiveNumber)
+      ->group(cl);
+  sub.add_flag("--dry-run", o->submit.dryRun,
+               "with --slurm: write the pose list and job scripts and print the sbatch lines, submit nothing")
+      ->group(cl);
+  sub.add_option("--swish-binary", o->submit.swishExecutable,
+                 "the swish program the jobs run (default: this one; it must be at that path on every node)")
+      ->group(cl);
+  // Run by the jobs that --slurm submits, not by people: no group, so --help does not list them.
+  sub.add_option("--slurm-task", o->task, "")->group("");
+  sub.add_option("--pose-list", o->poseList, "")->group("");
+  sub.add_option("--shard-size", o->shardSize, "")->group("");
   return [o]() -> int {
     if (!o->defaultCharacterGlb.empty()) {
       swish::io::writeCharacterGlb(o->defaultCharacterGlb, swish::bake::makeDefaultCharacter());
@@ -82,12 +144,30 @@ swish::cli::RunFn setup(CLI::App& sub) {
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       return 0;
     }
-    swish::bake::BakeRunOptions run;
-    run.force = o->force;
-    run.log = [](const std::string& line) {
+    auto log = [](const std::string& line) {
       std::fprintf(stderr, "%s\n", line.c_str());
       std::fflush(stderr);
     };
+    if (int(o->slurm) + int(o->status) + int(!o->task.empty()) > 1) {
+      std::fprintf(stderr, "swish bake: give one of --slurm, --status and --slurm-task\n");
+      return 2;
+    }
+    if (o->status) {
+      std::fputs(swish::cluster::slurmBakeStatus(cfg).c_str(), stdout);
+      return 0;
+    }
+    if (o->slurm) {
+      o->submit.log = log;
+      swish::cluster::submitSlurmBake(cfg, o->config, o->submit);
+      return 0;
+    }
+    if (!o->task.empty()) {
+      swish::cluster::runSlurmStage(cfg, o->task, swish::cluster::parseFingerprintHex(o->poseList), o->shardSize, log);
+      return 0;
+    }
+    swish::bake::BakeRunOptions run;
+    run.force = o->force;
+    run.log = log;
     swish::bake::runBake(cfg, run);
     return 0;
   };

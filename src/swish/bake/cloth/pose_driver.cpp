@@ -37,25 +37,37 @@ std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path&
 PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
                                 const std::filesystem::path& dir, const PoseSimulationProgress& progress,
                                 int maxThreads) {
+  std::vector<uint32_t> all(poses.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+  return simulatePoses(solver, poses, all, dir, progress, maxThreads);
+}
+
+PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
+                                const std::vector<uint32_t>& ids, const std::filesystem::path& dir,
+                                const PoseSimulationProgress& progress, int maxThreads) {
+  for (uint32_t id : ids)
+    if (id >= poses.size())
+      throw Error("simulatePoses: pose id " + std::to_string(id) + " is past the " + std::to_string(poses.size()) +
+                  " poses");
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
     throw Error(dir.string() + ": cannot create the simulation output folder: " + ec.message());
 
   PoseSimulationRun run;
-  const size_t total = poses.size();
+  const size_t total = ids.size();
   const size_t nv = solver.mesh().vertexCount();
-  std::vector<uint64_t> fingerprints(total);
+  std::vector<uint64_t> fingerprints(poses.size());
   std::vector<uint32_t> todo;
   std::vector<std::pair<uint32_t, std::string>> failures;
-  for (size_t i = 0; i < total; ++i) {
+  for (uint32_t i : ids) {
     fingerprints[i] = poseFingerprint(solver, poses[i]);
-    auto rec = loadFinishedPose(dir, uint32_t(i), fingerprints[i]);
+    auto rec = loadFinishedPose(dir, i, fingerprints[i]);
     if (rec && (!rec->result.ok || size_t(rec->result.positions.rows()) == nv)) {
       ++run.reused;
-      if (!rec->result.ok) failures.push_back({uint32_t(i), rec->result.failure});
+      if (!rec->result.ok) failures.push_back({i, rec->result.failure});
     } else {
-      todo.push_back(uint32_t(i));
+      todo.push_back(i);
     }
   }
 

@@ -37,6 +37,11 @@ uint64_t poseFingerprint(const ClothSolver& solver, const Pose& pose);
 PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
                                 const std::filesystem::path& dir, const PoseSimulationProgress& progress = {},
                                 int maxThreads = 0);
+// The same for the poses `ids` of `poses` only (a shard of a cluster bake, swish/cluster/): the
+// progress counts those; the others are neither read nor simulated. Throws Error for an id past the list.
+PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
+                                const std::vector<uint32_t>& ids, const std::filesystem::path& dir,
+                                const PoseSimulationProgress& progress = {}, int maxThreads = 0);
 
 // Pose id i's stored result when it is present, readable and made for this solver and pose.
 std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path& dir, uint32_t poseId,

@@ -110,4 +110,24 @@ SimulatedPoseRecord readSimulatedPose(const std::filesystem::path& file) {
   return rec;
 }
 
+std::optional<SimulatedPoseHeader> peekSimulatedPose(const std::filesystem::path& file) {
+  // magic 8 | version 4 | id 4 | fingerprint 8 | ok 4 | vertices 4 | violation 4 | penetration 4 |
+  // converged 4 | iterations 4 | seconds 8
+  constexpr size_t kHead = 56;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::vector<uint8_t> b(kHead);
+  if (!in.read(reinterpret_cast<char*>(b.data()), std::streamsize(kHead))) return std::nullopt;
+  if (std::memcmp(b.data(), kMagic, 8) != 0) return std::nullopt;
+  Reader rd{b, file, 8};
+  if (rd.get<uint32_t>() != kVersion) return std::nullopt;
+  SimulatedPoseHeader h;
+  h.poseId = rd.get<uint32_t>();
+  h.fingerprint = rd.get<uint64_t>();
+  h.ok = rd.get<uint32_t>() != 0;
+  rd.at = 48;
+  h.seconds = rd.get<double>();
+  return h;
+}
+
 }  // namespace swish::bake

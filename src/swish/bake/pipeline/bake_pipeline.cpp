@@ -21,13 +21,27 @@ namespace swish::bake {
 namespace {
 using Clock = std::chrono::steady_clock;
 
-std::string fingerprint(const BakeConfig& cfg) {
-  std::ifstream in(cfg.dataset / "manifest.json");
+// The dataset's content and the train settings. The manifest's per-pose solve times are left out: they
+// are measurements of the run that made the dataset, not content, and would make the model's bytes
+// differ between two bakes of the same recipe (another machine, another load, a cluster's nodes).
+std::string manifestContent(const std::filesystem::path& file) {
+  std::ifstream in(file);
   std::string manifest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {  // the held-out subjects' dataset is evaluated too
-    std::ifstream h(cfg.holdoutDatasetDir() / "manifest.json");
-    manifest += std::string((std::istreambuf_iterator<char>(h)), std::istreambuf_iterator<char>());
+  try {
+    nlohmann::json m = nlohmann::json::parse(manifest);
+    if (m.contains("poses") && m["poses"].is_array())
+      for (auto& p : m["poses"])
+        if (p.is_object() && p.contains("residuals") && p["residuals"].is_object()) p["residuals"].erase("seconds");
+    return m.dump();
+  } catch (const nlohmann::json::exception&) {
+    return manifest;  // not JSON: hashed as it is (reading the dataset reports the problem)
   }
+}
+
+std::string fingerprint(const BakeConfig& cfg) {
+  std::string manifest = manifestContent(cfg.dataset / "manifest.json");
+  if (cfg.part1 && !cfg.part1->holdoutSubjects.empty())  // the held-out subjects' dataset is evaluated too
+    manifest += manifestContent(cfg.holdoutDatasetDir() / "manifest.json");
   return std::to_string(std::hash<std::string>{}(manifest)) + "/" + cfg.train.toJson().dump();
 }
 
@@ -72,17 +86,21 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   res.report = cfg.reportDir() / "report.md";
 
   // Part 1: the dataset folder (resumable: finished simulations and poses are kept).
-  if (cfg.part1) {
+  if (cfg.part1 && opt.part1) {
     const auto t1 = Clock::now();
     log("part 1: building the dataset " + cfg.dataset.string());
     DatasetBuildSettings part1Settings = *cfg.part1;
     part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
+    part1Settings.simulatedPoseList = opt.simulatedPoseList;
     const auto [training, heldOut] = splitHeldOutSubjects(part1Settings);
     const DatasetBuildResult part1 = buildDataset(training, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
     if (!heldOut.clips.empty()) {
       log("part 1: the held-out subjects' frames: " + std::to_string(heldOut.clips.size()) + " clips -> " +
           cfg.holdoutDatasetDir().string());
-      const DatasetBuildResult h = buildDataset(heldOut, cfg.holdoutDatasetDir(), cfg.holdoutSimulationDir(), {}, opt.log);
+      DatasetBuildSettings heldOutSettings = heldOut;
+      heldOutSettings.simulatedPoseList = {};  // a cluster's pose list is the training poses'
+      const DatasetBuildResult h =
+          buildDataset(heldOutSettings, cfg.holdoutDatasetDir(), cfg.holdoutSimulationDir(), {}, opt.log);
       res.holdoutPart1 = h.toJson();
     }
     res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
@@ -96,10 +114,18 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
                   part1.transferred + part1.transfersReused, part1.failed.size());
     log(line);
   } else if (!std::filesystem::exists(cfg.dataset / "manifest.json")) {
+    if (cfg.part1)
+      throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() + " (no manifest.json): part 1 has not run");
     throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
                 " (no manifest.json) and no \"part1\" section to make one");
+  } else if (cfg.part1) {
+    log("part 1: not run here; using the dataset " + cfg.dataset.string() + " as it is");
   } else {
     log("part 1: no \"part1\" section; using the dataset " + cfg.dataset.string() + " as it is");
+  }
+  if (!opt.part2) {
+    res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return res;
   }
 
   // Part 2.

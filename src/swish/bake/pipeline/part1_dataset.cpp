@@ -253,12 +253,26 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"steps", st}};
 }
 
-DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
-                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+std::vector<uint64_t> DatasetPosePlan::poseFingerprints() const {
+  std::vector<uint64_t> f(toSimulate.size());
+  for (size_t i = 0; i < f.size(); ++i) f[i] = poseFingerprint(shapes->solver(), toSimulate[i]);
+  return f;
+}
+
+uint64_t DatasetPosePlan::fingerprint() const {
+  Fnv1a f;
+  const std::string settings = settingsJson.dump();
+  f.bytes(settings.data(), settings.size());
+  f.vec(poseFingerprints());
+  return f.h;
+}
+
+DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::function<void(const std::string&)>& logFn) {
   auto log = [&](const std::string& line) {
     if (logFn) logFn(line);
   };
-  DatasetBuildResult res;
+  DatasetPosePlan plan;
+  DatasetBuildResult& res = plan.result;
   auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
   if (s.clips.empty()) throw Error("bake part 1: no animation clips");
   if (s.evenPoses == 0 && (s.thinningTolerance > 0.f) == (s.targetPoses > 0))
@@ -267,8 +281,9 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
 
   // Character and clips.
   auto t = Clock::now();
-  const Character character = loadDatasetCharacter(s);
-  std::vector<uint32_t> inputJoints;
+  plan.character = std::make_unique<const Character>(loadDatasetCharacter(s));
+  const Character& character = *plan.character;
+  std::vector<uint32_t>& inputJoints = plan.inputJoints;
   for (const std::string& name : s.inputJoints) {
     const int j = character.skeleton.find(name);
     if (j < 0) throw Error("bake part 1: input joint '" + name + "' is not in character '" + character.name + "'");
@@ -303,7 +318,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     thin = s.targetPoses > 0 ? thinPosesToCount(samples, s.targetPoses) : thinPoses(samples, s.thinningTolerance);
   }
   res.tolerance = thin.tolerance;
-  std::vector<Pose> poses;
+  std::vector<Pose>& poses = plan.toSimulate;
   res.origins = nlohmann::json::array();
   for (uint32_t k : thin.kept) {
     const PoseSamples::Origin& o = samples.origins[k];
@@ -335,12 +350,14 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   // Clearance, simulation and transfer of one pose are PoseShapeSimulator's steps (pose_shape.hpp),
   // shared with `swish replay --truth-every`; here each step runs over all poses in turn.
   t = Clock::now();
-  const PoseShapeSimulator shapes(character, s.poseShape());
+  plan.shapes = std::make_unique<const PoseShapeSimulator>(character, s.poseShape());
+  const PoseShapeSimulator& shapes = *plan.shapes;
   step("simulation setup", t);
 
   // Limbs out of the trunk: the corrected poses are simulated; the dataset keeps the recorded poses,
   // which are what the model sees at run time (see the transfer below).
-  const std::vector<Pose> recorded = poses;
+  plan.recorded = poses;
+  const std::vector<Pose>& recorded = plan.recorded;
   if (shapes.clearance()) {
     t = Clock::now();
     const LimbClearance& clearance = *shapes.clearance();
@@ -386,23 +403,64 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     step("limb clearance", t);
   }
 
-  // Dataset folder: reset when its poses were made with other settings or another pose list.
-  nlohmann::json settingsJson = s.toJson();
+  // What the dataset folder records of the settings and the pose list.
+  nlohmann::json& settingsJson = plan.settingsJson;
+  settingsJson = s.toJson();
   settingsJson["pose_list_digest"] = std::to_string(poseListDigest(poses));
   settingsJson["kept_poses"] = poses.size();
   settingsJson["thinning_tolerance_used"] = thin.tolerance;
   // Part 2 keeps this pose in its training split (part2_training.cpp); -1: none was added.
   settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
+  return plan;
+}
+
+DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
+                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  DatasetPosePlan plan = planDatasetPoses(s, logFn);
+  if (s.simulatedPoseList != 0 && plan.fingerprint() != s.simulatedPoseList) {
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "bake part 1: this recipe now thins to the pose list %016llx, not the %016llx the cluster's array "
+                  "tasks simulated: the recipe, its clips or swish changed after `swish bake --slurm`; submit again",
+                  static_cast<unsigned long long>(plan.fingerprint()),
+                  static_cast<unsigned long long>(s.simulatedPoseList));
+    throw Error(line);
+  }
+  DatasetBuildResult res = std::move(plan.result);
+  auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
+  const Character& character = *plan.character;
+  const PoseShapeSimulator& shapes = *plan.shapes;
+  const std::vector<Pose>& poses = plan.toSimulate;
+  const std::vector<Pose>& recorded = plan.recorded;
+  const nlohmann::json& settingsJson = plan.settingsJson;
+
+  // Dataset folder: reset when its poses were made with other settings or another pose list.
   res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
-  const DatasetWriter writer(datasetDir, character, inputJoints, settingsJson, s.normalMapBitDepth);
+  const DatasetWriter writer(datasetDir, character, plan.inputJoints, settingsJson, s.normalMapBitDepth);
   writeTextFileAtomic(datasetDir / "pose_origins.json", res.origins.dump(1) + "\n");
 
   // Simulation (resumable per pose; failures are recorded in their files and left out).
-  t = Clock::now();
+  auto t = Clock::now();
   const ClothSolver& solver = shapes.solver();
   res.simulationVertices = solver.mesh().vertexCount();
   log("part 1: simulation mesh " + std::to_string(res.simulationVertices) + " vertices, " +
       std::to_string(solver.mesh().triangles.rows()) + " triangles, preset '" + s.simulation.material.name + "'");
+  if (s.simulatedPoseList != 0) {
+    // Made by a cluster's array tasks: every pose must be there; none is simulated here.
+    std::vector<uint32_t> missing;
+    for (uint32_t id = 0; id < poses.size(); ++id)
+      if (!loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]))) missing.push_back(id);
+    if (!missing.empty()) {
+      std::string ids;
+      for (size_t k = 0; k < missing.size() && k < 10; ++k) ids += (k ? ", " : "") + std::to_string(missing[k]);
+      throw Error("bake part 1: " + std::to_string(missing.size()) + " of " + std::to_string(poses.size()) +
+                  " poses have no finished simulation in " + simulationDir.string() + " (pose " + ids +
+                  (missing.size() > 10 ? ", ..." : "") + "); the array tasks that own them did not finish");
+    }
+  }
   ProgressThrottle simThrottle;
   const auto simStart = Clock::now();
   const PoseSimulationRun sim = simulatePoses(

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -93,6 +94,12 @@ struct DatasetBuildSettings {
   size_t previewPoses = 4;
   uint32_t previewSize = 384;
 
+  // Not a recipe setting (not in toJson): nonzero when the simulations were made elsewhere, by the
+  // array tasks of `swish bake --slurm` (swish/cluster/), for the pose list of this fingerprint
+  // (DatasetPosePlan::fingerprint). buildDataset then simulates nothing: another pose list, or a pose
+  // without its finished simulation file, is an error.
+  uint64_t simulatedPoseList = 0;
+
   // Every setting as JSON (for the dataset manifest and the rebuild check above).
   nlohmann::json toJson() const;
   // The settings of the one-pose simulation (pose_shape.hpp); poseShapeSettingsFromJson(toJson())
@@ -142,6 +149,29 @@ struct DatasetBuildResult {
   nlohmann::json origins;
   nlohmann::json toJson() const;
 };
+
+// Part 1 up to the simulation: character, clips, sampling, thinning, limb clearance and the solver.
+// What a cluster bake computes once before it submits (the pose list its array tasks share), and
+// what buildDataset starts with.
+struct DatasetPosePlan {
+  std::unique_ptr<const Character> character;    // the shapes below point into it
+  std::vector<uint32_t> inputJoints;
+  std::vector<Pose> recorded;                    // the thinned poses as the clips hold them (the dataset keeps these)
+  std::vector<Pose> toSimulate;                  // the same with limbs turned out of the trunk: what is simulated
+  std::unique_ptr<const PoseShapeSimulator> shapes;
+  nlohmann::json settingsJson;                   // <dataset>/part1_settings.json: settings + pose list digest
+  DatasetBuildResult result;                     // filled up to here (counts, corrections, steps)
+
+  // The simulation file fingerprint of each pose (cloth/pose_driver.hpp), in pose id order.
+  std::vector<uint64_t> poseFingerprints() const;
+  // One number for the whole list: the settings, the pose list and every pose's simulation setup. Two
+  // plans with the same fingerprint simulate the same poses into the same files.
+  uint64_t fingerprint() const;
+};
+
+// Throws Error as buildDataset does for bad input, before any simulation.
+DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& settings,
+                                 const std::function<void(const std::string&)>& log = {});
 
 // Builds (or completes) the dataset folder `datasetDir`; per-pose simulation files go to
 // `simulationDir`, preview images to `previewDir` (empty: none). `log` receives progress lines with

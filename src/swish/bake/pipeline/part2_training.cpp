@@ -217,9 +217,10 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       {"vertex_baseline_mean_skinned", toJson(ev.meanSkinnedMm)},
       {"mesh_components", K},
       {"mesh_explained_variance", out.meshPca.explainedVariance[K]},
+      // No timings here (the report has them): the model's bytes are a function of the recipe alone.
       {"penetration", penetrationJson(ev)},
       {"mlp", {{"best_epoch", out.regressor.bestEpoch}, {"epochs", out.regressor.epochsRun},
-               {"validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds}}}};
+               {"validation_loss", out.regressor.bestValidationLoss}}}};
   if (maps) {
     out.metadata["errors"]["normal_database"] = toJson(ev.normalDatabase);
     out.metadata["errors"]["normal_selection"] = toJson(ev.normalSelection);

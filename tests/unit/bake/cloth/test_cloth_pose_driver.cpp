@@ -148,3 +148,31 @@ TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {
   std::ofstream(file, std::ios::binary) << "not a pose file at all";
   EXPECT_THROW(readSimulatedPose(file), Error);
 }
+
+// A cluster shard simulates only its ids (swish/cluster/): the same bytes as the whole run, nothing else
+// written, and a header-only read (swish bake --status) agrees with the full one.
+TEST(ClothPoseDriver, ShardOfIdsMatchesTheWholeRun) {
+  const Character ch = test::capsuleCharacter();
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), fastSettings());
+  const std::vector<Pose> poses = somePoses(ch.skeleton, 5);
+  const test::TempDir tmp("cloth_shard");
+  simulatePoses(solver, poses, tmp / "whole", {}, 1);
+  const PoseSimulationRun shard = simulatePoses(solver, poses, {1, 3}, tmp / "shard", {}, 1);
+  EXPECT_EQ(shard.simulated, 2u);
+  for (uint32_t id = 0; id < 5; ++id) {
+    const fs::path f = simulatedPosePath(tmp / "shard", id);
+    EXPECT_EQ(fs::exists(f), id == 1 || id == 3) << id;
+    if (!fs::exists(f)) continue;
+    const SimulatedPoseRecord a = readSimulatedPose(f), b = readSimulatedPose(simulatedPosePath(tmp / "whole", id));
+    EXPECT_TRUE(sameBits(a.result.positions, b.result.positions)) << id;
+    const auto head = peekSimulatedPose(f);
+    ASSERT_TRUE(head.has_value());
+    EXPECT_EQ(head->poseId, id);
+    EXPECT_EQ(head->fingerprint, a.fingerprint);
+    EXPECT_EQ(head->ok, a.result.ok);
+    EXPECT_EQ(head->seconds, a.result.residuals.seconds);
+  }
+  EXPECT_EQ(simulatePoses(solver, poses, {1, 3}, tmp / "shard", {}, 1).reused, 2u);
+  EXPECT_THROW(simulatePoses(solver, poses, {5}, tmp / "shard"), Error);
+  EXPECT_FALSE(peekSimulatedPose(tmp / "none.clothsim").has_value());
+}
