@@ -121,7 +121,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
                         {"fps", c.framesPerSecond}});
   }
   const ClothSimSettings& m = simulation;
-  return {
+  nlohmann::json j = {
       {"character",
        {{"file", characterFile.string()}, {"recipe", characterRecipe.string()}, {"body_mesh", bodyMeshNames},
         {"garment_mesh", garmentMeshNames}, {"simulation_mesh", simulationMeshNames}}},
@@ -144,6 +144,9 @@ nlohmann::json DatasetBuildSettings::toJson() const {
        {{"size", transfer.normalMap.width}, {"max_distance", transfer.normalMap.maxDistance},
         {"dilation_rings", transfer.normalMap.dilationRings}, {"bit_depth", normalMapBitDepth}}},
   };
+  // Only when external, so that the settings (and so the datasets) of solver bakes stay as they were.
+  if (external.enabled()) j["simulation"].update(external.toJson());
+  return j;
 }
 
 nlohmann::json DatasetBuildResult::toJson() const {
@@ -163,22 +166,23 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"steps", st}};
 }
 
-DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
-                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+DatasetPoseList listDatasetPoses(const DatasetBuildSettings& s, DatasetBuildResult& res,
+                                 const std::function<void(const std::string&)>& logFn) {
   auto log = [&](const std::string& line) {
     if (logFn) logFn(line);
   };
-  DatasetBuildResult res;
   auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
   if (s.clips.empty()) throw Error("bake part 1: no animation clips");
   if ((s.thinningTolerance > 0.f) == (s.targetPoses > 0))
     throw Error("bake part 1: give exactly one of a thinning tolerance and a target pose count");
   s.simulation.validate();
+  DatasetPoseList out;
 
   // Character and clips.
   auto t = Clock::now();
-  const Character character = loadDatasetCharacter(s);
-  std::vector<uint32_t> inputJoints;
+  out.character = std::make_unique<Character>(loadDatasetCharacter(s));
+  const Character& character = *out.character;
+  std::vector<uint32_t>& inputJoints = out.inputJoints;
   for (const std::string& name : s.inputJoints) {
     const int j = character.skeleton.find(name);
     if (j < 0) throw Error("bake part 1: input joint '" + name + "' is not in character '" + character.name + "'");
@@ -242,7 +246,8 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   // Clearance, simulation and transfer of one pose are PoseShapeSimulator's steps (pose_shape.hpp),
   // shared with `swish replay --truth-every`; here each step runs over all poses in turn.
   t = Clock::now();
-  const PoseShapeSimulator shapes(character, s.poseShape());
+  out.shapes = std::make_unique<PoseShapeSimulator>(character, s.poseShape());
+  const PoseShapeSimulator& shapes = *out.shapes;
   step("simulation setup", t);
 
   // Limbs out of the trunk: the corrected poses are simulated; the dataset keeps the recorded poses,
@@ -293,41 +298,92 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     step("limb clearance", t);
   }
 
+  out.thinningTolerance = thin.tolerance;
+  out.digest = poseListDigest(poses);
+  out.recorded = recorded;
+  out.simulated = std::move(poses);
+  return out;
+}
+
+DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
+                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  DatasetBuildResult res;
+  auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
+  const DatasetPoseList list = listDatasetPoses(s, res, logFn);
+  const Character& character = *list.character;
+  const std::vector<uint32_t>& inputJoints = list.inputJoints;
+  const std::vector<Pose>& recorded = list.recorded;
+  const std::vector<Pose>& poses = list.simulated;
+  const PoseShapeSimulator& shapes = *list.shapes;
+  auto t = Clock::now();
+
+  // External shapes: read (and checked against the pose list) before the dataset is touched.
+  std::unique_ptr<ExternalShapeSource> external;
+  if (s.external.enabled()) {
+    t = Clock::now();
+    const TransitionClipSettings clip = clipSettingsOf(s.simulation);
+    std::vector<TransitionMarker> markers;
+    buildTransitionFrames(character.skeleton, poses, clip, markers);
+    std::vector<uint32_t> targetFrames;
+    for (const TransitionMarker& m : markers) targetFrames.push_back(m.targetFrame);
+    external = std::make_unique<ExternalShapeSource>(s.external, shapes.solver().mesh().restPositions,
+                                                     shapes.solver().mesh().triangles, targetFrames, list.digest);
+    log("part 1: " + external->description());
+    if (external->maxBindingDistance() > 0.f) {
+      char line[160];
+      std::snprintf(line, sizeof line, "part 1: re-meshed garment bound to the simulation mesh: farthest vertex %.2f mm "
+                    "from the re-meshed rest surface", 1000.0 * external->maxBindingDistance());
+      log(line);
+    }
+    step("external simulation setup", t);
+  }
+
   // Dataset folder: reset when its poses were made with other settings or another pose list.
   nlohmann::json settingsJson = s.toJson();
-  settingsJson["pose_list_digest"] = std::to_string(poseListDigest(poses));
+  settingsJson["pose_list_digest"] = std::to_string(list.digest);
   settingsJson["kept_poses"] = poses.size();
-  settingsJson["thinning_tolerance_used"] = thin.tolerance;
+  settingsJson["thinning_tolerance_used"] = list.thinningTolerance;
+  // A changed result file of an external tool changes the shapes: rebuild the dataset's poses.
+  if (external) settingsJson["external_files_digest"] = std::to_string(external->digest());
   // Part 2 keeps this pose in its training split (bake_training.cpp); -1: none was added.
   settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
   res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
   const DatasetWriter writer(datasetDir, character, inputJoints, settingsJson, s.normalMapBitDepth);
 
-  // Simulation (resumable per pose; failures are recorded in their files and left out).
+  // Simulation (resumable per pose; failures are recorded in their files and left out), unless the
+  // shapes come from an external tool's files.
   t = Clock::now();
   const ClothSolver& solver = shapes.solver();
+  PoseSimulationRun sim;
   res.simulationVertices = solver.mesh().vertexCount();
   log("part 1: simulation mesh " + std::to_string(res.simulationVertices) + " vertices, " +
-      std::to_string(solver.mesh().triangles.rows()) + " triangles, preset '" + s.simulation.material.name + "'");
-  ProgressThrottle simThrottle;
-  const auto simStart = Clock::now();
-  const PoseSimulationRun sim = simulatePoses(
-      solver, poses, simulationDir,
-      [&](size_t done, size_t total, double left) {
-        if (simThrottle.due(done, total)) log(progressLine("simulation", done, total, since(simStart), left));
-        return true;
-      },
-      s.threads);
-  res.simulated = sim.simulated;
-  res.simulationsReused = sim.reused;
-  for (const auto& [id, reason] : sim.failures) {
-    res.failed.push_back({id, "simulation: " + reason});
-    log("part 1: pose " + std::to_string(id) + " left out: simulation failed: " + reason);
+      std::to_string(solver.mesh().triangles.rows()) + " triangles" +
+      (external ? std::string(", shapes from the external simulation") : ", preset '" + s.simulation.material.name + "'"));
+  if (!external) {
+    ProgressThrottle simThrottle;
+    const auto simStart = Clock::now();
+    sim = simulatePoses(
+        solver, poses, simulationDir,
+        [&](size_t done, size_t total, double left) {
+          if (simThrottle.due(done, total)) log(progressLine("simulation", done, total, since(simStart), left));
+          return true;
+        },
+        s.threads);
+    res.simulated = sim.simulated;
+    res.simulationsReused = sim.reused;
+    for (const auto& [id, reason] : sim.failures) {
+      res.failed.push_back({id, "simulation: " + reason});
+      log("part 1: pose " + std::to_string(id) + " left out: simulation failed: " + reason);
+    }
+    step("simulation", t);
   }
-  step("simulation", t);
 
   // Transfer + smoothing + normal map per pose, in parallel, each pose written when done.
   t = Clock::now();
+  std::mutex mutex;
   std::vector<uint32_t> todo;
   for (uint32_t id = 0; id < poses.size(); ++id) {
     const bool failed = std::any_of(sim.failures.begin(), sim.failures.end(), [&](const auto& f) { return f.first == id; });
@@ -337,7 +393,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     else
       todo.push_back(id);
   }
-  std::mutex mutex;
   std::atomic<size_t> done{0};
   ProgressThrottle transferThrottle;
   const auto transferStart = Clock::now();
@@ -346,8 +401,35 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     const uint32_t id = todo[k];
     std::string failure;
     try {
-      const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
-      if (!rec || !rec->result.ok) {
+      if (external) {
+        // Another tool's shape: read, matched to the simulation mesh, then the same transfer.
+        Points3f positions;
+        try {
+          positions = external->shape(id);
+        } catch (const Error& e) {
+          failure = std::string("external simulation: ") + e.what();
+        }
+        if (failure.empty()) {
+          TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], positions);
+          DatasetPose dp;
+          dp.id = id;
+          dp.pose = recorded[id];
+          dp.gameMeshWorld = std::move(tp.gameMeshWorld);
+          dp.gameMeshPreSkin = std::move(tp.gameMeshPreSkin);
+          dp.normalMap = std::move(tp.normalMap);
+          dp.residuals = solver.measure(poses[id], positions);
+          if (dp.residuals.maxPenetration > s.simulation.failPenetration) {
+            char line[200];
+            std::snprintf(line, sizeof line, "part 1: pose %u (external): the garment ends %.1f mm inside the body "
+                          "(the solver's bound is %.1f mm); kept, as the external tool made it", id,
+                          1000.0 * dp.residuals.maxPenetration, 1000.0 * s.simulation.failPenetration);
+            std::lock_guard<std::mutex> lock(mutex);
+            log(line);
+          }
+          writer.writePose(dp);
+        }
+      } else if (const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
+                 !rec || !rec->result.ok) {
         failure = "simulation result missing or not usable";
       } else {
         // The pre-skin shape from the corrected simulation, the world shape skinned with the
@@ -387,6 +469,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   std::sort(res.failed.begin(), res.failed.end(), [](const FailedPose& a, const FailedPose& b) { return a.id < b.id; });
   nlohmann::json source = {{"tool", "swish bake (part 1)"}, {"samples", res.samples}, {"kept_poses", res.keptPoses},
                            {"simulation_vertices", res.simulationVertices}};
+  if (external) source["simulation"] = external->description();
   writer.writeManifest(res.failed, source);
   step("transfer + normal maps", t);
   if (res.transferred + res.transfersReused == 0)

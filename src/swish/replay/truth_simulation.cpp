@@ -115,6 +115,11 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     return;
   }
   const json& ds = meta["dataset_settings"];
+  if (ds.contains("simulation") && ds["simulation"].is_object() && ds["simulation"].value("source", "") == "external") {
+    note_ = "the model was baked from an external cloth tool's shapes (" + ds["simulation"].value("path", std::string()) +
+            "): swish's own solver is not its source simulation, so there is no truth to run";
+    return;
+  }
   const json chj = ds.value("character", json::object());
   bake::DatasetBuildSettings s;
   std::string how = "the embedded default character, rebuilt by code";
