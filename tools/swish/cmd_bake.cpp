@@ -1,7 +1,8 @@
 // swish bake CONFIG: runs the bake described by a JSON recipe (bake/pipeline/bake_config.hpp) end to end and
 // writes <output>/<name>.swish and <output>/report/. The config is validated before any work. Part 1
 // (character + clips -> simulated poses -> dataset) and part 2 (dataset -> model) are both resumable:
-// interrupt it and run the same command again.
+// interrupt it and run the same command again. --export-poses writes part 1's poses for an external
+// cloth tool instead (bake/cloth/pose_export.hpp); part1.simulation "source": "external" reads its results.
 //
 // With --slurm the same bake is submitted to a Slurm cluster instead (swish/cluster/slurm_bake.hpp):
 // part 1's simulations as a job array, the dataset and part 2 as jobs that depend on it; --status
@@ -15,6 +16,7 @@
 #include "swish/bake/pipeline/bake_config.hpp"
 #include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/character/default_character.hpp"
+#include "swish/bake/cloth/pose_export.hpp"
 #include "swish/core/error.hpp"
 #include "swish/cluster/pose_list_file.hpp"
 #include "swish/cluster/slurm_bake.hpp"
@@ -25,7 +27,7 @@ namespace {
 
 swish::cli::RunFn setup(CLI::App& sub) {
   struct Opts {
-    std::string config, defaultCharacterGlb;
+    std::string config, defaultCharacterGlb, exportPoses;
     bool force = false, checkOnly = false, readClips = false;
     bool slurm = false, status = false;
     swish::cluster::SlurmSubmitOptions submit;
@@ -98,6 +100,22 @@ swish::cli::RunFn setup(CLI::App& sub) {
   sub.add_option("--slurm-task", o->task, "")->group("");
   sub.add_option("--pose-list", o->poseList, "")->group("");
   sub.add_option("--shard-size", o->shardSize, "")->group("");
+
+  sub.add_option("--export-poses", o->exportPoses,
+                 "write part 1's thinned poses for your own cloth tool to DIR (clip as BVH + glTF, target-frame "
+                 "sidecar, body + garment OBJ, README for the artist) and stop")
+      ->type_name("DIR");
+  sub.footer(
+      "Bring your own simulation (Marvelous Designer, Houdini, Maya...):\n"
+      "  1. swish bake recipe.json --export-poses poses/   writes poses/poses.bvh, poses.glb (the clip: per pose\n"
+      "     A-pose -> pose, then a hold), poses.json (the frame to export per pose), body.obj, garment.obj and\n"
+      "     README.md (what to simulate and send back).\n"
+      "  2. Simulate each pose; save the garment at its target frame as poses/results/pose_<id>.obj (or .glb,\n"
+      "     .gltf, .fbx; one multi-frame .glb/.fbx also works; a re-meshed garment adds results/rest.obj).\n"
+      "  3. In the recipe: \"part1\": {\"simulation\": {\"source\": \"external\", \"path\": \"poses/results\"}}\n"
+      "     (\"space\": \"world\" with \"units_per_metre\", \"up_axis\", \"origin\" for a tool's own scene),\n"
+      "     then swish bake recipe.json as usual. Missing or broken results are reported per pose and left out.\n"
+      "See docs/baking.md, 'Simulating in your own cloth tool'.");
   return [o]() -> int {
     if (!o->defaultCharacterGlb.empty()) {
       swish::io::writeCharacterGlb(o->defaultCharacterGlb, swish::bake::makeDefaultCharacter());
@@ -109,9 +127,19 @@ swish::cli::RunFn setup(CLI::App& sub) {
       return 2;
     }
     const swish::bake::BakeConfig cfg = swish::bake::loadBakeConfig(o->config);
+    if (!o->exportPoses.empty()) {
+      if (!cfg.part1) throw swish::Error(o->config + ": --export-poses needs a \"part1\" section (the poses come from it)");
+      const auto log = [](const std::string& l) { std::fprintf(stderr, "%s\n", l.c_str()); };
+      const auto r = swish::bake::exportPoses(*cfg.part1, o->exportPoses, log);
+      std::printf("exported %zu poses to %s; read %s/README.md\n", r.poses, o->exportPoses.c_str(), o->exportPoses.c_str());
+      return 0;
+    }
     if (o->checkOnly) {
       std::printf("%s: valid; model -> %s, report -> %s\n", o->config.c_str(), cfg.modelPath().string().c_str(),
                   cfg.reportDir().string().c_str());
+      if (cfg.part1 && cfg.part1->external.enabled())
+        std::printf("part 1: simulated shapes from the external tool's results in %s (%s space)\n",
+                    cfg.part1->external.path.string().c_str(), cfg.part1->external.worldSpace ? "world" : "character");
       if (cfg.part1)
         std::printf("part 1: %zu clip(s) -> %s poses%s -> simulation (%zu vertices, preset '%s') in %s -> dataset %s\n",
                     cfg.part1->clips.size(),

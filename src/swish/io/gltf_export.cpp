@@ -100,6 +100,49 @@ class GltfBuilder {
 nlohmann::json quatJson(const Quatf& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 nlohmann::json vecJson(const Vec3f& v) { return {v.x(), v.y(), v.z()}; }
 
+// Joint j is node j (buildScene writes the joints first). One sampler per joint rotation (and per
+// root translation), all on one shared time accessor.
+void addAnimation(GltfBuilder& b, const GltfScene& scene, const GltfAnimation& a) {
+  const Skeleton* sk = scene.skeleton;
+  if (!sk) throw Error("glTF export: animation '" + a.name + "' needs the scene's skeleton");
+  if (!a.frames || a.frames->empty()) throw Error("glTF export: animation '" + a.name + "' has no frames");
+  if (!(a.framesPerSecond > 0.f)) throw Error("glTF export: animation '" + a.name + "': frames per second must be positive");
+  const std::vector<Pose>& frames = *a.frames;
+  const size_t n = frames.size();
+  std::vector<float> times(n);
+  for (size_t f = 0; f < n; ++f) {
+    if (frames[f].local.size() != sk->size())
+      throw Error("glTF export: animation '" + a.name + "' frame " + std::to_string(f) + " has " +
+                  std::to_string(frames[f].local.size()) + " rotations for " + std::to_string(sk->size()) + " joints");
+    times[f] = float(double(f) / double(a.framesPerSecond));
+  }
+  const int input = b.accessor(times.data(), n, kFloat, 4, "SCALAR", 1, std::nullopt, true);
+  nlohmann::json samplers = nlohmann::json::array(), channels = nlohmann::json::array();
+  auto channel = [&](const std::vector<float>& values, const char* type, int components, size_t node, const char* path) {
+    const int output = b.accessor(values.data(), n, kFloat, 4, type, components, std::nullopt);
+    samplers.push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
+    channels.push_back({{"sampler", samplers.size() - 1}, {"target", {{"node", node}, {"path", path}}}});
+  };
+  for (size_t j = 0; j < sk->size(); ++j) {
+    std::vector<float> q(n * 4);
+    Quatf previous = Quatf::Identity();
+    for (size_t f = 0; f < n; ++f) {
+      Quatf r = frames[f].local[j].normalized();
+      if (f > 0 && r.dot(previous) < 0.f) r.coeffs() = -r.coeffs();  // no long way round between keys
+      previous = r;
+      for (int c = 0; c < 4; ++c) q[f * 4 + size_t(c)] = r.coeffs()[c];  // x, y, z, w as glTF
+    }
+    channel(q, "VEC4", 4, j, "rotation");
+    if (sk->joints[j].parent < 0) {
+      std::vector<float> t(n * 3);
+      for (size_t f = 0; f < n; ++f)
+        for (int c = 0; c < 3; ++c) t[f * 3 + size_t(c)] = frames[f].rootTranslation[c];
+      channel(t, "VEC3", 3, j, "translation");
+    }
+  }
+  b.json["animations"] = nlohmann::json::array({{{"name", a.name}, {"samplers", samplers}, {"channels", channels}}});
+}
+
 void buildScene(GltfBuilder& b, const GltfScene& scene) {
   b.json["asset"] = {{"version", "2.0"}, {"generator", scene.generator}};
   b.json["scene"] = 0;
@@ -200,6 +243,7 @@ void buildScene(GltfBuilder& b, const GltfScene& scene) {
     b.json["nodes"].push_back(node);
     roots.push_back(b.json["nodes"].size() - 1);
   }
+  if (scene.animation) addAnimation(b, scene, *scene.animation);
   b.json["scenes"] = nlohmann::json::array({{{"nodes", roots}}});
 }
 

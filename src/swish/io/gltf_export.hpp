@@ -37,9 +37,18 @@ struct GltfMeshEntry {
   std::optional<Eigen::Vector3d> preciseTranslation = std::nullopt;
 };
 
+// A skeletal animation of GltfScene::skeleton: frame f at time f / framesPerSecond, every joint's
+// local rotation and the root joints' translations (Pose::rootTranslation), linearly interpolated.
+struct GltfAnimation {
+  std::string name = "animation";
+  float framesPerSecond = 30.f;
+  const std::vector<Pose>* frames = nullptr;
+};
+
 struct GltfScene {
   const Skeleton* skeleton = nullptr;  // optional
   std::vector<GltfMeshEntry> meshes;
+  std::optional<GltfAnimation> animation;  // needs the skeleton
   std::vector<GltfMaterial> materials;
   std::string generator = "swish";
 };

@@ -120,6 +120,17 @@ std::unique_ptr<Character> rebuildBakeCharacter(const ModelEntry& entry, std::st
 }
 
 void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
+  {
+    const json meta = json::parse(entry.model.metadata, nullptr, false);
+    const json ds = meta.is_object() ? meta.value("dataset_settings", json::object()) : json::object();
+    if (ds.is_object() && ds.contains("simulation") && ds["simulation"].is_object() &&
+        ds["simulation"].value("source", "") == "external") {
+      note_ = "the model was baked from an external cloth tool's shapes (" +
+              ds["simulation"].value("path", std::string()) +
+              "): swish's own solver is not its source simulation, so there is no truth to run";
+      return;
+    }
+  }
   std::string how;
   character_ = rebuildBakeCharacter(entry, note_, &how);
   if (!character_) return;

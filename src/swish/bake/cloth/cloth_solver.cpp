@@ -270,6 +270,22 @@ float ClothSolver::penetrationOf(const BodyCollider& body, const Vec3f& p) const
   return 0.f;
 }
 
+SimResiduals ClothSolver::measure(const Pose& target, const Points3f& positions) const {
+  SimResiduals r;
+  if (size_t(positions.rows()) != mesh_.vertexCount() || target.local.size() != skeleton_.size() || !positions.allFinite())
+    throw Error("cloth residuals: the shape or the pose does not fit the simulation mesh and skeleton");
+  const Points3f x = positions.rowwise() - origin_.transpose();
+  for (const DistanceConstraint& c : constraints_.stretch)
+    r.maxConstraintViolation = std::max(r.maxConstraintViolation, ((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
+  r.converged = r.maxConstraintViolation < settings_.convergedStrain;
+  Pose goal = skeleton_.restPose();  // the root at rest, as simulate() poses the body
+  for (size_t j = 0; j < skeleton_.size(); ++j) goal.local[j] = target.local[j].normalized();
+  BodyCollider body = colliderPrototype_;
+  body.pose(localSkinMatrices(goal));
+  for (Eigen::Index v = 0; v < x.rows(); ++v) r.maxPenetration = std::max(r.maxPenetration, penetrationOf(body, x.row(v)));
+  return r;
+}
+
 PoseSimulation ClothSolver::simulate(const Pose& target) const {
   const auto start = std::chrono::steady_clock::now();
   PoseSimulation out;

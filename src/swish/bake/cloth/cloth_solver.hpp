@@ -81,6 +81,11 @@ class ClothSolver {
   // (wrong joint count, non-finite rotations) and failed solves come back as !ok, never throw.
   PoseSimulation simulate(const Pose& target) const;
 
+  // The residuals simulate() reports, measured on a shape made elsewhere (an external cloth tool's
+  // result for `target`, simulation-mesh positions in character space): the worst edge stretch and
+  // the depth inside the posed body; converged when the stretch is within convergedStrain.
+  SimResiduals measure(const Pose& target, const Points3f& positions) const;
+
   const SimulationMesh& mesh() const { return mesh_; }
   const ClothSimSettings& settings() const { return settings_; }
   const std::vector<uint32_t>& attachedVertices() const { return attached_; }

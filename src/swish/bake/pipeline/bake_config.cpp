@@ -94,6 +94,38 @@ void parseCharacter(const Checker& c, const nlohmann::json& v, const std::filesy
   s.simulationMeshNames = c.strings(v, p, "simulation_mesh", {});
 }
 
+// part1.simulation "source": "solver" (the default) or "external" with "path" and the space keys
+// (external_simulation.hpp). The path is resolved by parsePart1 (a dataset's or model's settings
+// carry it as it was resolved then).
+void parseSimulationSource(const Checker& c, const nlohmann::json& sim, const std::string& p, DatasetBuildSettings& s) {
+  const std::string source = c.string(sim, "source", "solver", p);
+  if (source != "solver" && source != "external") c.fail(p + ".source", "'" + source + "' is not one of solver, external");
+  const bool external = source == "external";
+  for (const char* k : {"path", "space", "units_per_metre", "up_axis", "origin"})
+    if (!external && sim.contains(k)) c.fail(p + "." + k, "applies to \"source\": \"external\" only");
+  if (!external) return;
+  if (!sim.contains("path"))
+    c.fail(p + ".path", "is required with \"source\": \"external\" (the folder of pose_<id>.obj files, or one "
+                        "multi-frame .glb/.gltf/.fbx)");
+  ExternalSimulationSettings& e = s.external;
+  e.path = c.string(sim, "path", "", p);
+  const std::string space = c.string(sim, "space", "character", p);
+  if (space != "character" && space != "world") c.fail(p + ".space", "'" + space + "' is not one of character, world");
+  e.worldSpace = space == "world";
+  for (const char* k : {"units_per_metre", "up_axis", "origin"})
+    if (!e.worldSpace && sim.contains(k)) c.fail(p + "." + k, "applies to \"space\": \"world\" only");
+  e.unitsPerMetre = c.number(sim, p, "units_per_metre", 1e-6, 1e6, 1.0);
+  const std::string up = c.string(sim, "up_axis", "y", p);
+  if (up != "y" && up != "z") c.fail(p + ".up_axis", "'" + up + "' is not one of y, z");
+  e.upAxis = up[0];
+  if (sim.contains("origin")) {
+    const auto& o = sim.at("origin");
+    if (!o.is_array() || o.size() != 3 || !o[0].is_number() || !o[1].is_number() || !o[2].is_number())
+      c.fail(p + ".origin", "must be [x, y, z] (the character's origin in the world, in its units)");
+    e.origin = Vec3d(o[0].get<double>(), o[1].get<double>(), o[2].get<double>());
+  }
+}
+
 // The "simulation", "transfer" and "normal_maps" objects of `j` (named `prefix` in errors): a bake
 // config's part1, or the settings a dataset and a baked model carry (DatasetBuildSettings::toJson).
 void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::string& prefix, DatasetBuildSettings& s) {
@@ -101,7 +133,9 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   std::string p = prefix + ".simulation";
   c.onlyKeys(sim, p,
              {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
-              "iterations", "threads", "gravity", "limb_clearance", "attach_band"});
+              "iterations", "threads", "gravity", "limb_clearance", "attach_band", "source", "path", "space",
+              "units_per_metre", "up_axis", "origin"});
+  parseSimulationSource(c, sim, p, s);
   ClothSimSettings& cs = s.simulation;
   if (sim.contains("preset")) {
     try {
@@ -207,6 +241,12 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
   s.includeRestPose = c.boolean(thin, p, "include_rest_pose", s.includeRestPose);
 
   parseShapeSections(c, j, "part1", s);
+  if (s.external.enabled()) {
+    s.external.path = baseDir / s.external.path;
+    std::error_code ec;
+    if (!std::filesystem::exists(s.external.path, ec))
+      c.fail("part1.simulation.path", s.external.path.string() + " does not exist (the external simulation's results)");
+  }
 
   const nlohmann::json pv = j.value("preview", nlohmann::json::object());
   p = "part1.preview";

@@ -28,7 +28,12 @@
 //       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
-//                      "attach_band" (top share of the garment's height held on the body)},
+//                      "attach_band" (top share of the garment's height held on the body),
+//                      "source": "solver" (default) | "external" with "path" (a folder of pose_<id>.obj/
+//                      .glb/.gltf/.fbx results, or one multi-frame .glb/.gltf/.fbx) and "space":
+//                      "character" (default) | "world" with "units_per_metre", "up_axis" (y|z), "origin"
+//                      (external_simulation.hpp; `swish bake CONFIG --export-poses DIR` writes what
+//                      the external tool needs)},
 //       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}

@@ -233,6 +233,8 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   // Set only where used, so that recipes without them keep their datasets.
   if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
   if (evenPoses > 0) out["even_poses"] = evenPoses;
+  // Only when external, so that the settings (and so the datasets) of solver bakes stay as they were.
+  if (external.enabled()) out["simulation"].update(external.toJson());
   return out;
 }
 
@@ -414,6 +416,21 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   return plan;
 }
 
+DatasetPoseList listDatasetPoses(const DatasetBuildSettings& s, DatasetBuildResult& res,
+                                 const std::function<void(const std::string&)>& logFn) {
+  DatasetPosePlan plan = planDatasetPoses(s, logFn);
+  DatasetPoseList out;
+  out.character = std::move(plan.character);
+  out.inputJoints = std::move(plan.inputJoints);
+  out.recorded = std::move(plan.recorded);
+  out.simulated = std::move(plan.toSimulate);
+  out.shapes = std::move(plan.shapes);
+  out.thinningTolerance = plan.result.tolerance;
+  out.digest = poseListDigest(out.simulated);
+  res = std::move(plan.result);
+  return out;
+}
+
 DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
                                 const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
   auto log = [&](const std::string& line) {
@@ -435,20 +452,47 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   const PoseShapeSimulator& shapes = *plan.shapes;
   const std::vector<Pose>& poses = plan.toSimulate;
   const std::vector<Pose>& recorded = plan.recorded;
-  const nlohmann::json& settingsJson = plan.settingsJson;
+  nlohmann::json settingsJson = plan.settingsJson;
+  auto t = Clock::now();
+
+  // External shapes: read (and checked against the pose list) before the dataset is touched.
+  std::unique_ptr<ExternalShapeSource> external;
+  if (s.external.enabled()) {
+    const TransitionClipSettings clip = clipSettingsOf(s.simulation);
+    std::vector<TransitionMarker> markers;
+    buildTransitionFrames(character.skeleton, poses, clip, markers);
+    std::vector<uint32_t> targetFrames;
+    for (const TransitionMarker& m : markers) targetFrames.push_back(m.targetFrame);
+    external = std::make_unique<ExternalShapeSource>(s.external, shapes.solver().mesh().restPositions,
+                                                     shapes.solver().mesh().triangles, targetFrames,
+                                                     poseListDigest(poses));
+    log("part 1: " + external->description());
+    if (external->maxBindingDistance() > 0.f) {
+      char line[160];
+      std::snprintf(line, sizeof line, "part 1: re-meshed garment bound to the simulation mesh: farthest vertex %.2f mm "
+                    "from the re-meshed rest surface", 1000.0 * external->maxBindingDistance());
+      log(line);
+    }
+    // A changed result file of an external tool changes the shapes: rebuild the dataset's poses.
+    settingsJson["external_files_digest"] = std::to_string(external->digest());
+    step("external simulation setup", t);
+  }
 
   // Dataset folder: reset when its poses were made with other settings or another pose list.
   res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
   const DatasetWriter writer(datasetDir, character, plan.inputJoints, settingsJson, s.normalMapBitDepth);
   writeTextFileAtomic(datasetDir / "pose_origins.json", res.origins.dump(1) + "\n");
 
-  // Simulation (resumable per pose; failures are recorded in their files and left out).
-  auto t = Clock::now();
+  // Simulation (resumable per pose; failures are recorded in their files and left out), unless the
+  // shapes come from an external tool's files.
+  t = Clock::now();
   const ClothSolver& solver = shapes.solver();
   res.simulationVertices = solver.mesh().vertexCount();
+  PoseSimulationRun sim;
   log("part 1: simulation mesh " + std::to_string(res.simulationVertices) + " vertices, " +
-      std::to_string(solver.mesh().triangles.rows()) + " triangles, preset '" + s.simulation.material.name + "'");
-  if (s.simulatedPoseList != 0) {
+      std::to_string(solver.mesh().triangles.rows()) + " triangles" +
+      (external ? std::string(", shapes from the external simulation") : ", preset '" + s.simulation.material.name + "'"));
+  if (s.simulatedPoseList != 0 && !external) {
     // Made by a cluster's array tasks: every pose must be there; none is simulated here.
     std::vector<uint32_t> missing;
     for (uint32_t id = 0; id < poses.size(); ++id)
@@ -461,25 +505,28 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
                   (missing.size() > 10 ? ", ..." : "") + "); the array tasks that own them did not finish");
     }
   }
-  ProgressThrottle simThrottle;
-  const auto simStart = Clock::now();
-  const PoseSimulationRun sim = simulatePoses(
-      solver, poses, simulationDir,
-      [&](size_t done, size_t total, double left) {
-        if (simThrottle.due(done, total)) log(progressLine("simulation", done, total, since(simStart), left));
-        return true;
-      },
-      s.threads);
-  res.simulated = sim.simulated;
-  res.simulationsReused = sim.reused;
-  for (const auto& [id, reason] : sim.failures) {
-    res.failed.push_back({id, "simulation: " + reason});
-    log("part 1: pose " + std::to_string(id) + " left out: simulation failed: " + reason);
+  if (!external) {
+    ProgressThrottle simThrottle;
+    const auto simStart = Clock::now();
+    sim = simulatePoses(
+        solver, poses, simulationDir,
+        [&](size_t done, size_t total, double left) {
+          if (simThrottle.due(done, total)) log(progressLine("simulation", done, total, since(simStart), left));
+          return true;
+        },
+        s.threads);
+    res.simulated = sim.simulated;
+    res.simulationsReused = sim.reused;
+    for (const auto& [id, reason] : sim.failures) {
+      res.failed.push_back({id, "simulation: " + reason});
+      log("part 1: pose " + std::to_string(id) + " left out: simulation failed: " + reason);
+    }
+    step("simulation", t);
   }
-  step("simulation", t);
 
   // Transfer + smoothing + normal map per pose, in parallel, each pose written when done.
   t = Clock::now();
+  std::mutex mutex;
   std::vector<uint32_t> todo;
   for (uint32_t id = 0; id < poses.size(); ++id) {
     const bool failed = std::any_of(sim.failures.begin(), sim.failures.end(), [&](const auto& f) { return f.first == id; });
@@ -489,7 +536,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     else
       todo.push_back(id);
   }
-  std::mutex mutex;
   std::atomic<size_t> done{0};
   ProgressThrottle transferThrottle;
   const auto transferStart = Clock::now();
@@ -498,8 +544,35 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     const uint32_t id = todo[k];
     std::string failure;
     try {
-      const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
-      if (!rec || !rec->result.ok) {
+      if (external) {
+        // Another tool's shape: read, matched to the simulation mesh, then the same transfer.
+        Points3f positions;
+        try {
+          positions = external->shape(id);
+        } catch (const Error& e) {
+          failure = std::string("external simulation: ") + e.what();
+        }
+        if (failure.empty()) {
+          TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], positions);
+          DatasetPose dp;
+          dp.id = id;
+          dp.pose = recorded[id];
+          dp.gameMeshWorld = std::move(tp.gameMeshWorld);
+          dp.gameMeshPreSkin = std::move(tp.gameMeshPreSkin);
+          dp.normalMap = std::move(tp.normalMap);
+          dp.residuals = solver.measure(poses[id], positions);
+          if (dp.residuals.maxPenetration > s.simulation.failPenetration) {
+            char line[200];
+            std::snprintf(line, sizeof line, "part 1: pose %u (external): the garment ends %.1f mm inside the body "
+                          "(the solver's bound is %.1f mm); kept, as the external tool made it", id,
+                          1000.0 * dp.residuals.maxPenetration, 1000.0 * s.simulation.failPenetration);
+            std::lock_guard<std::mutex> lock(mutex);
+            log(line);
+          }
+          writer.writePose(dp);
+        }
+      } else if (const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
+                 !rec || !rec->result.ok) {
         failure = "simulation result missing or not usable";
       } else {
         // The pre-skin shape from the corrected simulation, the world shape skinned with the
@@ -539,6 +612,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   std::sort(res.failed.begin(), res.failed.end(), [](const FailedPose& a, const FailedPose& b) { return a.id < b.id; });
   nlohmann::json source = {{"tool", "swish bake (part 1)"}, {"samples", res.samples}, {"kept_poses", res.keptPoses},
                            {"simulation_vertices", res.simulationVertices}};
+  if (external) source["simulation"] = external->description();
   writer.writeManifest(res.failed, source);
   step("transfer + normal maps", t);
   if (res.transferred + res.transfersReused == 0)

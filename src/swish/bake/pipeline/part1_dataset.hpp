@@ -27,6 +27,7 @@
 
 #include "swish/bake/cloth/cloth_solver.hpp"
 #include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/cloth/external_simulation.hpp"
 #include "swish/bake/poses/pose_sampling.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/bake/transfer/pose_transfer.hpp"
@@ -83,6 +84,9 @@ struct DatasetBuildSettings {
 
   size_t simulationVertices = kDefaultSimulationVertices;  // 0: the welded game mesh, not subdivided
   ClothSimSettings simulation;
+  // When enabled, the simulated shapes come from another tool's files (external_simulation.hpp)
+  // instead of the solver; `simulation` then only times the exported clip (transition, settle, rate).
+  ExternalSimulationSettings external;
   // Limbs that pass into the trunk are turned out of it before simulating (limb_clearance.hpp);
   // clearance 0 turns this off.
   LimbClearanceSettings limbClearance;
@@ -171,6 +175,23 @@ struct DatasetPosePlan {
 
 // Throws Error as buildDataset does for bad input, before any simulation.
 DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& settings,
+                                 const std::function<void(const std::string&)>& log = {});
+
+// The poses part 1 simulates, before any simulation: the character, its clips sampled and thinned,
+// the rest pose added, limb clearance applied. `swish bake --export-poses` writes these out for an
+// external cloth tool (pose_export.hpp); buildDataset goes on to simulate them.
+struct DatasetPoseList {
+  std::unique_ptr<const Character> character;     // owned here: `shapes` points into it
+  std::vector<uint32_t> inputJoints;
+  std::vector<Pose> recorded;                     // what the dataset stores (the root canonical)
+  std::vector<Pose> simulated;                    // recorded, limbs turned out of the trunk: what is simulated
+  std::unique_ptr<const PoseShapeSimulator> shapes;  // simulation mesh, solver, transfer
+  float thinningTolerance = 0.f;
+  uint64_t digest = 0;                            // of `simulated`: a different list means other pose ids
+};
+// planDatasetPoses in the shape the pose export reads. Fills res's pose counts and steps as buildDataset
+// does. Throws Error as buildDataset does.
+DatasetPoseList listDatasetPoses(const DatasetBuildSettings& settings, DatasetBuildResult& res,
                                  const std::function<void(const std::string&)>& log = {});
 
 // Builds (or completes) the dataset folder `datasetDir`; per-pose simulation files go to
