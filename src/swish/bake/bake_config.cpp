@@ -133,7 +133,8 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   std::string p = prefix + ".simulation";
   c.onlyKeys(sim, p,
              {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
-              "iterations", "threads", "gravity", "limb_clearance", "attach_band"});
+              "iterations", "threads", "gravity", "limb_clearance", "attach_band", "equilibrium_tolerance",
+              "equilibrium_seconds", "equilibrium_iterations", "retries", "final_projection", "check_poses"});
   ClothSimSettings& cs = s.simulation;
   if (sim.contains("preset")) {
     try {
@@ -156,6 +157,18 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   s.limbClearance.clearance = float(c.number(sim, p, "limb_clearance", 0, 0.1, s.limbClearance.clearance));
   // The top band of the garment held on the body (share of its rest height; cloth_solver.hpp).
   cs.attachTopFraction = float(c.number(sim, p, "attach_band", 0, 0.5, cs.attachTopFraction));
+  // The end condition (cloth_solver.hpp): frames at the goal pose until the residual (the unbalanced
+  // share of gravity's load) is at most the tolerance, for at most equilibrium_seconds, with
+  // equilibrium_iterations sweeps per substep (0: "iterations").
+  cs.equilibriumTolerance = float(c.number(sim, p, "equilibrium_tolerance", 1e-6, 10, cs.equilibriumTolerance));
+  cs.equilibriumSeconds = float(c.number(sim, p, "equilibrium_seconds", 0, 60, cs.equilibriumSeconds));
+  cs.equilibriumIterations = int(c.number(sim, p, "equilibrium_iterations", 0, 1000, cs.equilibriumIterations, true));
+  // Retries of a failed pose along a slower path (twice the substeps and transition each) before it is left out.
+  cs.retries = int(c.number(sim, p, "retries", 0, 4, cs.retries, true));
+  // Vertices left within the thickness of the body at the end are moved out along its normal.
+  cs.finalProjection = c.boolean(sim, p, "final_projection", cs.finalProjection);
+  // Poses sampled for the report's convergence and noise figures (simulation_quality.hpp; 0: none).
+  s.quality.poses = size_t(c.number(sim, p, "check_poses", 0, 1000, double(s.quality.poses), true));
   try {
     cs.validate();
   } catch (const Error& e) {

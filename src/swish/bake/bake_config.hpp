@@ -24,7 +24,10 @@
 //       "simulation": {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds",
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
-//                      "attach_band" (top share of the garment's height held on the body)},
+//                      "attach_band" (top share of the garment's height held on the body),
+//                      "equilibrium_tolerance", "equilibrium_seconds", "equilibrium_iterations" (the
+//                      end condition: cloth_solver.hpp), "retries" (of a failed pose, slower each),
+//                      "check_poses" (sampled for the report's convergence and noise, 0: none)},
 //       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}

@@ -136,6 +136,9 @@ nlohmann::json DatasetBuildSettings::toJson() const {
        {{"preset", m.material.name}, {"vertices", simulationVertices}, {"thickness", m.thickness},
         {"transition_seconds", m.transitionSeconds}, {"settle_seconds", m.settleSeconds},
         {"frame_rate", m.frameRate}, {"substeps", m.substeps}, {"iterations", m.iterations},
+        {"equilibrium_tolerance", m.equilibriumTolerance}, {"equilibrium_seconds", m.equilibriumSeconds},
+        {"equilibrium_iterations", m.equilibriumIterations}, {"retries", m.retries},
+        {"final_projection", m.finalProjection},
         {"gravity", -m.gravity.y()}, {"limb_clearance", limbClearance.clearance}, {"attach_band", m.attachTopFraction}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength}, {"smoothing_iterations", transfer.smoothing.iterations},
@@ -160,39 +163,17 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"simulated", simulated},        {"simulations_reused", simulationsReused},
           {"transferred", transferred},    {"transfers_reused", transfersReused},
           {"failed", f},                   {"rebuilt", rebuilt},
+          {"simulation", simulationReport},
           {"steps", st}};
 }
 
-DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
-                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
-  auto log = [&](const std::string& line) {
-    if (logFn) logFn(line);
-  };
-  DatasetBuildResult res;
+// Clips -> pose samples -> thinned poses (+ the rest pose): the poses part 1 simulates, before limb
+// clearance. Fills res's counts and steps.
+std::vector<Pose> thinnedPoses(const DatasetBuildSettings& s, const Character& character,
+                               const std::vector<uint32_t>& inputJoints, DatasetBuildResult& res,
+                               const std::function<void(const std::string&)>& log) {
   auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
-  if (s.clips.empty()) throw Error("bake part 1: no animation clips");
-  if ((s.thinningTolerance > 0.f) == (s.targetPoses > 0))
-    throw Error("bake part 1: give exactly one of a thinning tolerance and a target pose count");
-  s.simulation.validate();
-
-  // Character and clips.
   auto t = Clock::now();
-  const Character character = loadDatasetCharacter(s);
-  std::vector<uint32_t> inputJoints;
-  for (const std::string& name : s.inputJoints) {
-    const int j = character.skeleton.find(name);
-    if (j < 0) throw Error("bake part 1: input joint '" + name + "' is not in character '" + character.name + "'");
-    inputJoints.push_back(uint32_t(j));
-  }
-  for (const std::string& name : s.alsoRequiredJoints)
-    if (character.skeleton.find(name) < 0)
-      throw Error("bake: train.input_joints: joint '" + name + "' is not in character '" + character.name + "'");
-  log("part 1: character '" + character.name + "': " + std::to_string(character.skeleton.size()) + " joints, body " +
-      std::to_string(character.body.vertexCount()) + " vertices, game mesh " +
-      std::to_string(character.garment.vertexCount()) + " vertices");
-  step("character", t);
-
-  t = Clock::now();
   std::vector<AnimationClip> clips;
   for (const ClipSource& c : s.clips) {
     io::AnimationImportOptions o;
@@ -238,6 +219,39 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   }
   res.keptPoses = poses.size();
   step("sampling + thinning", t);
+  return poses;
+}
+
+DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
+                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  DatasetBuildResult res;
+  auto step = [&](const std::string& name, Clock::time_point t) { res.steps.push_back({name, since(t)}); };
+  if (s.clips.empty()) throw Error("bake part 1: no animation clips");
+  if ((s.thinningTolerance > 0.f) == (s.targetPoses > 0))
+    throw Error("bake part 1: give exactly one of a thinning tolerance and a target pose count");
+  s.simulation.validate();
+
+  // Character and clips.
+  auto t = Clock::now();
+  const Character character = loadDatasetCharacter(s);
+  std::vector<uint32_t> inputJoints;
+  for (const std::string& name : s.inputJoints) {
+    const int j = character.skeleton.find(name);
+    if (j < 0) throw Error("bake part 1: input joint '" + name + "' is not in character '" + character.name + "'");
+    inputJoints.push_back(uint32_t(j));
+  }
+  for (const std::string& name : s.alsoRequiredJoints)
+    if (character.skeleton.find(name) < 0)
+      throw Error("bake: train.input_joints: joint '" + name + "' is not in character '" + character.name + "'");
+  log("part 1: character '" + character.name + "': " + std::to_string(character.skeleton.size()) + " joints, body " +
+      std::to_string(character.body.vertexCount()) + " vertices, game mesh " +
+      std::to_string(character.garment.vertexCount()) + " vertices");
+  step("character", t);
+
+  std::vector<Pose> poses = thinnedPoses(s, character, inputJoints, res, log);
 
   // Clearance, simulation and transfer of one pose are PoseShapeSimulator's steps (pose_shape.hpp),
   // shared with `swish replay --truth-every`; here each step runs over all poses in turn.
@@ -297,7 +311,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   nlohmann::json settingsJson = s.toJson();
   settingsJson["pose_list_digest"] = std::to_string(poseListDigest(poses));
   settingsJson["kept_poses"] = poses.size();
-  settingsJson["thinning_tolerance_used"] = thin.tolerance;
+  settingsJson["thinning_tolerance_used"] = res.tolerance;
   // Part 2 keeps this pose in its training split (bake_training.cpp); -1: none was added.
   settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
   res.rebuilt = resetDatasetIfStale(datasetDir, settingsJson, logFn);
@@ -389,6 +403,70 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
                            {"simulation_vertices", res.simulationVertices}};
   writer.writeManifest(res.failed, source);
   step("transfer + normal maps", t);
+
+  // The simulation's own figures: failures per reason, retries, residuals, seconds per pose per core;
+  // convergence and noise on a seeded sample of the kept poses (cached beside the simulations).
+  {
+    std::vector<std::pair<uint32_t, std::string>> transferFailures;
+    for (const FailedPose& f : res.failed)
+      if (f.reason.rfind("transfer", 0) == 0 || f.reason.rfind("simulation result", 0) == 0)
+        transferFailures.push_back({f.id, f.reason});
+    res.simulationReport = simulationRunJson(sim.poses, s.simulation, transferFailures);
+    for (const SimulatedPoseSummary& p : sim.poses)
+      if (p.attempts > 1)
+        log("part 1: pose " + std::to_string(p.id) + " needed " + std::to_string(p.attempts) + " attempts (" +
+            (p.ok ? "kept" : "left out") + "); first attempt: " + p.firstFailure);
+    if (s.quality.poses > 0) {
+      t = Clock::now();
+      std::vector<uint32_t> okIds;
+      for (const SimulatedPoseSummary& p : sim.poses)
+        if (p.ok) okIds.push_back(p.id);
+      const std::vector<uint32_t> ids = sampleQualityPoses(okIds, s.quality.poses, s.quality.seed);
+      const uint64_t fp = simulationQualityFingerprint(solver, poses, ids, s.quality);
+      const fs::path cache = simulationDir / "quality.json";
+      nlohmann::json quality;
+      try {
+        if (fs::exists(cache)) {
+          nlohmann::json old = nlohmann::json::parse(std::ifstream(cache));
+          if (old.value("fingerprint", std::string()) == std::to_string(fp)) quality = old.at("quality");
+        }
+      } catch (const std::exception&) {
+        quality = nullptr;  // unreadable: measured again
+      }
+      if (quality.is_null()) {
+        std::vector<Points3f> shapes;
+        for (uint32_t id : ids) {
+          const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
+          shapes.push_back(rec ? rec->result.positions : Points3f());
+        }
+        SimulationQualitySettings qs = s.quality;
+        qs.threads = s.threads;
+        log("part 1: measuring the simulation's convergence and noise on " + std::to_string(ids.size()) + " poses");
+        ProgressThrottle qThrottle;
+        const SimulationQuality q = measureSimulationQuality(character, solver, poses, ids, shapes, qs,
+                                                             [&](const std::string& line) {
+                                                               if (qThrottle.due(0, 1)) log("part 1: " + line);
+                                                             });
+        quality = q.toJson();
+        writeTextFileAtomic(cache, nlohmann::json{{"fingerprint", std::to_string(fp)}, {"quality", quality}}.dump(2) + "\n");
+      }
+      res.simulationReport["quality"] = quality;
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "part 1: simulation convergence (2x substeps, half the tolerance) %.2f mm mean, %.2f mm p95; "
+                    "noise (%.0f degree turns) %.2f mm mean, %.2f mm p95",
+                    quality.value("convergence_mean_mm", 0.0), quality.value("convergence_p95_mm", 0.0),
+                    quality.value("noise_turn_degrees", 0.0), quality.value("noise_mean_mm", 0.0),
+                    quality.value("noise_p95_mm", 0.0));
+      log(line);
+      step("simulation quality", t);
+    }
+    char line[200];
+    std::snprintf(line, sizeof line, "part 1: %.2f s per pose per core; %zu poses retried",
+                  res.simulationReport.value("seconds_per_pose_per_core", 0.0),
+                  size_t(res.simulationReport.value("retried_poses", 0)));
+    log(line);
+  }
   if (res.transferred + res.transfersReused == 0)
     throw Error("bake part 1: every pose failed; nothing to train on (see the failures above)");
 
@@ -401,6 +479,99 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     step("preview", t);
   }
   return res;
+}
+
+nlohmann::json checkSimulation(const DatasetBuildSettings& s, size_t poseCount, uint64_t seed,
+                               const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  const auto start = Clock::now();
+  if (s.clips.empty()) throw Error("simulation check: no animation clips");
+  if ((s.thinningTolerance > 0.f) == (s.targetPoses > 0))
+    throw Error("simulation check: give exactly one of a thinning tolerance and a target pose count");
+  s.simulation.validate();
+  const Character character = loadDatasetCharacter(s);
+  std::vector<uint32_t> inputJoints;
+  for (const std::string& name : s.inputJoints) {
+    const int j = character.skeleton.find(name);
+    if (j < 0) throw Error("simulation check: input joint '" + name + "' is not in character '" + character.name + "'");
+    inputJoints.push_back(uint32_t(j));
+  }
+  DatasetBuildResult res;
+  const std::vector<Pose> all = thinnedPoses(s, character, inputJoints, res, log);
+  std::vector<uint32_t> every(all.size());
+  for (uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+  const std::vector<uint32_t> ids = sampleQualityPoses(every, poseCount, seed);
+  const PoseShapeSimulator shapes(character, s.poseShape());
+  const ClothSolver& solver = shapes.solver();
+  log("simulation check: " + std::to_string(ids.size()) + " of the " + std::to_string(all.size()) +
+      " thinned poses (seed " + std::to_string(seed) + "), " + std::to_string(solver.mesh().vertexCount()) +
+      " simulation vertices, preset '" + s.simulation.material.name + "'");
+
+  // The poses as the bake would simulate them (limbs out of the trunk), one solve per pose.
+  std::vector<Pose> poses(all.size());
+  std::vector<PoseSimulation> results(ids.size());
+  std::mutex mutex;
+  size_t done = 0;
+  ProgressThrottle throttle;
+  const auto simStart = Clock::now();
+  auto one = [&](size_t k) {
+    const uint32_t id = ids[k];
+    poses[id] = shapes.poseToSimulate(all[id]);
+    results[k] = solver.simulate(poses[id]);
+    std::lock_guard<std::mutex> lock(mutex);
+    ++done;
+    if (!results[k].ok) log("simulation check: pose " + std::to_string(id) + " failed: " + results[k].failure);
+    else if (results[k].attempts > 1)
+      log("simulation check: pose " + std::to_string(id) + " kept after a retry; first attempt: " + results[k].firstFailure);
+    if (throttle.due(done, ids.size())) {
+      const double el = since(simStart);
+      log(progressLine("simulation", done, ids.size(), el, el / double(done) * double(ids.size() - done)));
+    }
+  };
+  if (s.threads > 0) {
+    tbb::task_arena arena(s.threads);
+    arena.execute([&] { tbb::parallel_for(size_t(0), ids.size(), size_t(1), one); });
+  } else {
+    tbb::parallel_for(size_t(0), ids.size(), size_t(1), one);
+  }
+  std::vector<SimulatedPoseSummary> summaries;
+  std::vector<uint32_t> okIds;
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const PoseSimulation& r = results[k];
+    summaries.push_back({ids[k], r.ok, r.failure, r.attempts, r.firstFailure, r.residuals});
+    if (r.ok) okIds.push_back(ids[k]);
+  }
+  nlohmann::json out = {{"tool", "swish bake --check-simulation"},
+                        {"character", character.name},
+                        {"thinned_poses", all.size()},
+                        {"sampled_poses", ids},
+                        {"seed", seed},
+                        {"simulation_vertices", solver.mesh().vertexCount()},
+                        {"settings", s.toJson()["simulation"]},
+                        {"simulation", simulationRunJson(summaries, s.simulation)}};
+  nlohmann::json failures = nlohmann::json::array();
+  for (const SimulatedPoseSummary& p : summaries)
+    if (!p.ok) failures.push_back({{"pose", p.id}, {"reason", p.failure}});
+  out["simulation"]["failures"] = failures;
+  if (s.quality.poses > 0 && !okIds.empty()) {
+    const std::vector<uint32_t> q = sampleQualityPoses(okIds, s.quality.poses, seed);
+    std::vector<Points3f> qShapes;
+    for (uint32_t id : q)
+      for (size_t k = 0; k < ids.size(); ++k)
+        if (ids[k] == id) qShapes.push_back(results[k].positions);
+    SimulationQualitySettings qs = s.quality;
+    qs.threads = s.threads;
+    qs.seed = seed;
+    log("simulation check: convergence and noise on " + std::to_string(q.size()) + " poses (3 solves each)");
+    ProgressThrottle qThrottle;
+    out["simulation"]["quality"] = measureSimulationQuality(character, solver, poses, q, qShapes, qs, [&](const std::string& l) {
+                                     if (qThrottle.due(0, 1)) log(l);
+                                   }).toJson();
+  }
+  out["seconds"] = since(start);
+  return out;
 }
 
 }  // namespace swish::bake

@@ -31,6 +31,7 @@
 #include "swish/bake/pose_transfer.hpp"
 #include "swish/bake/limb_clearance.hpp"
 #include "swish/bake/simulation_mesh.hpp"
+#include "swish/bake/simulation_quality.hpp"
 #include "swish/io/joint_map.hpp"
 
 namespace swish::bake {
@@ -71,6 +72,9 @@ struct DatasetBuildSettings {
   // clearance 0 turns this off.
   LimbClearanceSettings limbClearance;
   int threads = 0;                 // 0: all cores (TBB's default)
+  // Convergence and noise measured on a seeded sample of the simulated poses (simulation_quality.hpp;
+  // poses 0: not measured). Not part of the dataset's content: changing it rebuilds nothing.
+  SimulationQualitySettings quality;
 
   PoseTransferSettings transfer;
   uint32_t normalMapBitDepth = 16;
@@ -107,6 +111,9 @@ struct DatasetBuildResult {
   size_t simulated = 0, simulationsReused = 0;
   size_t transferred = 0, transfersReused = 0;
   std::vector<FailedPose> failed;  // left out of the dataset, with the reason
+  // The simulation's report (simulation_quality.hpp): failures per reason, retried poses, seconds per
+  // pose per core, equilibrium residuals, and "quality" (convergence, noise) when measured.
+  nlohmann::json simulationReport = nlohmann::json::object();
   bool rebuilt = false;            // settings had changed: the dataset's pose files were deleted first
   std::vector<DatasetBuildStep> steps;
   std::vector<std::filesystem::path> previews;
@@ -120,5 +127,12 @@ struct DatasetBuildResult {
 DatasetBuildResult buildDataset(const DatasetBuildSettings& settings, const std::filesystem::path& datasetDir,
                                 const std::filesystem::path& simulationDir, const std::filesystem::path& previewDir,
                                 const std::function<void(const std::string&)>& log = {});
+
+// `swish bake --check-simulation N CONFIG`: the source simulation's figures on a seeded sample of N of
+// part 1's thinned poses, without building a dataset: failures per reason, retried poses, seconds per
+// pose per core, equilibrium residuals, and convergence and noise on settings.quality.poses of them
+// (simulation_quality.hpp). Run it on a garment and clips of one's own before a long bake.
+nlohmann::json checkSimulation(const DatasetBuildSettings& settings, size_t poses, uint64_t seed,
+                               const std::function<void(const std::string&)>& log = {});
 
 }  // namespace swish::bake
