@@ -666,13 +666,11 @@ TEST(ClothSolver, EndsAtEquilibriumAndRecordsTheResidual) {
   EXPECT_LE(settled.residuals.equilibriumResidual, s.equilibriumTolerance);
   EXPECT_GE(settled.residuals.equilibriumResidual, 0.f);
   EXPECT_GT(settled.residuals.equilibriumFrames, 0);
-  EXPECT_TRUE(settled.residuals.converged);
   s.equilibriumSeconds = 0.f;  // no end phase: the shape after 3 frames of falling
   const PoseSimulation falling = ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(ch.skeleton.restPose());
   ASSERT_TRUE(falling.ok) << falling.failure;
   EXPECT_EQ(falling.residuals.equilibriumFrames, 0);
   EXPECT_GT(falling.residuals.equilibriumResidual, 10.f * s.equilibriumTolerance);
-  EXPECT_FALSE(falling.residuals.converged);
 }
 
 // A failed pose is simulated again along a slower path before it is left out, and the outcome says

@@ -246,6 +246,14 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (!datasetSettings.is_object()) c.fail(what, "the dataset settings must be a JSON object");
   DatasetBuildSettings s;
   parseShapeSections(c, datasetSettings, what, s);
+  // Settings recorded before cloth solver revision 7 have no end phase, retries or final projection:
+  // the truth of such a model (swish replay --truth-every) is its own bake's solve, step for step.
+  const nlohmann::json sim = datasetSettings.value("simulation", nlohmann::json::object());
+  if (sim.is_object() && !sim.contains("equilibrium_seconds")) {
+    s.simulation.equilibriumSeconds = 0.f;
+    s.simulation.retries = 0;
+    s.simulation.finalProjection = false;
+  }
   return s.poseShape();
 }
 
