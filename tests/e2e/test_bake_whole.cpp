@@ -110,7 +110,7 @@ TEST(BakeWhole, DefaultCharacterAndMocapToLoadableModel) {
   EXPECT_GE(q["convergence_poses"].get<size_t>() + q["reference_failures"].size(), 2u);
   if (q["convergence_poses"].get<size_t>() > 0) {
     EXPECT_GT(q["convergence_mean_mm"].get<double>(), 0.0);  // twice the substeps moves something
-    EXPECT_GE(q["convergence_p95_mm"].get<double>(), q["convergence_mean_mm"].get<double>());
+    EXPECT_GT(q["convergence_p95_mm"].get<double>(), 0.0);
   }
   EXPECT_GE(q["noise_mean_mm"].get<double>(), 0.0);
   EXPECT_TRUE(fs::exists(w.config.previewDir() / "preview.json"));
