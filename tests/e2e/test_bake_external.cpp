@@ -157,6 +157,7 @@ Points3f predict(const Model& model, const Pose& pose) {
   in.skinMatrices = model.skeleton.skinningMatrices(pose);
   in.selectedMaps = {0};
   in.blendAlpha = {1.f};
+  in.pushOut = false;  // the network's own output: what the two datasets trained
   return runtime::referenceFrame(model, in).positions[0];
 }
 

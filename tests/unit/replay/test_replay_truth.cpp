@@ -103,6 +103,8 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
   jo.quiet = true;
   jo.engine.context = &ctx();
   jo.engine.truth = cheaperTruth(2);
+  jo.engine.pushOut = true;        // runs where the model has a proxy (the committed one has none)
+  jo.engine.penetrationEvery = 1;  // every frame, every character
   uint32_t progressCalls = 0, lastDone = 0, lastTotal = 0;
   jo.engine.truthProgress = [&](uint32_t done, uint32_t total) { ++progressCalls, lastDone = done, lastTotal = total; };
   const replay::ReplayJobResult job = replay::runReplayJob(s, jo);

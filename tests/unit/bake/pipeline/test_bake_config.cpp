@@ -15,7 +15,7 @@ using namespace swish::bake;
 
 namespace {
 // An existing file for the clip lists (not __FILE__: with CCACHE_BASEDIR the compiler sees a relative path).
-const std::string kThisFile = (test::sourceDir() / "tests/unit/test_bake_config.cpp").string();
+const std::string kThisFile = (test::sourceDir() / "tests/unit/bake/pipeline/test_bake_config.cpp").string();
 std::string errorOf(const nlohmann::json& j) {
   return test::errorOf([&] { parseBakeConfig(j, "recipe.json", "/base"); });
 }
