@@ -39,11 +39,13 @@ struct HostVulkan {  // what the host renderer already has
       std::vector<VkQueueFamilyProperties> fams(nf);
       vkGetPhysicalDeviceQueueFamilyProperties(pd, &nf, fams.data());
       for (uint32_t f = 0; f < nf && !physicalDevice; ++f)
-        if ((fams[f].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) == (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
+        if ((fams[f].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) ==
+            (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
           physicalDevice = pd, family = f;
       if (physicalDevice) break;
     }
-    if (!physicalDevice) throw std::runtime_error("no Vulkan 1.3 device with a graphics+compute queue that can run swish");
+    if (!physicalDevice)
+      throw std::runtime_error("no Vulkan 1.3 device with a graphics+compute queue that can run swish");
     // The host's own features go into the same structs; swish adds what it needs.
     VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
     f13.synchronization2 = VK_TRUE;  // this host uses vkCmdPipelineBarrier2
@@ -79,7 +81,8 @@ int main(int argc, char** argv) {
     constexpr uint32_t kFramesInFlight = 2;
     // Inner scope: every swish object is gone before the host destroys its device.
     {
-      swish::api::Runtime runtime = swish::api::Runtime::adopt({host.instance, host.physicalDevice, host.device, host.queue, host.family});
+      swish::api::Runtime runtime =
+          swish::api::Runtime::adopt({host.instance, host.physicalDevice, host.device, host.queue, host.family});
       swish::api::Model model = runtime.loadModel(argv[1]);
       const swish::api::ModelInfo& info = model.info();
       std::printf("model %s: %u vertices, %zu joints, normal maps %s, on %s\n", info.name.c_str(), info.vertexCount,
@@ -146,9 +149,11 @@ int main(int argc, char** argv) {
       batch.retireFrame(frames - 1);
 
       const swish::api::DeformedMesh mesh = batch.readBackMesh(frames - 1, 0);
-      std::printf("frame %llu, vertex 0: position (%.4f, %.4f, %.4f) normal (%.4f, %.4f, %.4f)\n", (unsigned long long)(frames - 1),
-                  mesh.positions[0], mesh.positions[1], mesh.positions[2], mesh.normals[0], mesh.normals[1], mesh.normals[2]);
-      const float len = std::sqrt(mesh.normals[0] * mesh.normals[0] + mesh.normals[1] * mesh.normals[1] + mesh.normals[2] * mesh.normals[2]);
+      std::printf("frame %llu, vertex 0: position (%.4f, %.4f, %.4f) normal (%.4f, %.4f, %.4f)\n",
+                  (unsigned long long)(frames - 1), mesh.positions[0], mesh.positions[1], mesh.positions[2],
+                  mesh.normals[0], mesh.normals[1], mesh.normals[2]);
+      const float len = std::sqrt(mesh.normals[0] * mesh.normals[0] + mesh.normals[1] * mesh.normals[1] +
+                                  mesh.normals[2] * mesh.normals[2]);
       for (VkFence f : fences) vkDestroyFence(host.device, f, nullptr);
       vkDestroyCommandPool(host.device, pool, nullptr);
       if (!std::isfinite(mesh.positions[0]) || std::abs(len - 1.f) > 1e-3f) {

@@ -30,8 +30,8 @@
 namespace swish::api {
 
 struct RuntimeOptions {
-  std::string device;        // Runtime::create only: device index or name substring; "" = SWISH_DEVICE or automatic
-  bool validation = false;   // Runtime::create only: VK_LAYER_KHRONOS_validation, messages collected
+  std::string device;       // Runtime::create only: device index or name substring; "" = SWISH_DEVICE or automatic
+  bool validation = false;  // Runtime::create only: VK_LAYER_KHRONOS_validation, messages collected
   std::string applicationName = "swish";
 };
 

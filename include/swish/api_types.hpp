@@ -49,10 +49,10 @@ struct CharacterPose {
 struct ModelInfo {
   std::string name;
   std::vector<std::string> jointNames;
-  std::vector<int> jointParents;                        // -1 for a root; parents come first
-  std::vector<Quat> restRotations;                      // the rest (A-)pose, per joint
-  std::vector<std::array<float, 3>> restTranslations;   // per joint, relative to the parent
-  std::vector<uint32_t> inputJoints;                    // joints the network reads (indices)
+  std::vector<int> jointParents;                       // -1 for a root; parents come first
+  std::vector<Quat> restRotations;                     // the rest (A-)pose, per joint
+  std::vector<std::array<float, 3>> restTranslations;  // per joint, relative to the parent
+  std::vector<uint32_t> inputJoints;                   // joints the network reads (indices)
   uint32_t vertexCount = 0;
   uint32_t triangleCount = 0;
   std::vector<float> restPositions;       // 3 per vertex, the rest pose in character space (bounds, culling)
@@ -60,8 +60,8 @@ struct ModelInfo {
   std::vector<float> uvs;                 // 2 per vertex (empty when the model has none)
   bool hasNormalMaps = false;
   uint32_t normalMapWidth = 0, normalMapHeight = 0, normalMapDatabaseSize = 0;
-  float temporalFilterSeconds = 0;        // the normal-map filter's time constant
-  uint32_t bodyCapsules = 0;              // capsules of the body proxy the push-out uses (0: none)
+  float temporalFilterSeconds = 0;  // the normal-map filter's time constant
+  uint32_t bodyCapsules = 0;        // capsules of the body proxy the push-out uses (0: none)
 };
 
 // One vertex attribute of the deformed mesh. Character c's vertices start at
@@ -80,7 +80,7 @@ struct NormalMapOutput {
   VkImage image = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;  // VK_IMAGE_VIEW_TYPE_2D_ARRAY over every layer, for sampling
   VkImageViewType viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
-  VkFormat format = VK_FORMAT_UNDEFINED;            // VK_FORMAT_R16G16_SNORM
+  VkFormat format = VK_FORMAT_UNDEFINED;             // VK_FORMAT_R16G16_SNORM
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;  // VK_IMAGE_LAYOUT_GENERAL, always; never transition it
   VkImageUsageFlags usage = 0;                       // includes SAMPLED
   VkImageSubresourceRange range{};
@@ -95,13 +95,13 @@ struct FrameOutputs {
   uint64_t frameIndex = 0;
   uint32_t characters = 0, vertexCount = 0;
   // Draw with ModelInfo::triangleIndices in an index buffer of your own (uint32, triangle list).
-  VertexStream positions;  // R32G32B32_SFLOAT, world space
-  VertexStream normals;    // R32G32B32_SFLOAT, unit, world space
-  VertexStream tangents;   // R32G32B32A32_SFLOAT: xyz unit tangent (world), w = bitangent sign
-  VertexStream uvs;        // R32G32_SFLOAT (buffer VK_NULL_HANDLE when the model has no UVs)
-  VkBufferUsageFlags bufferUsage = 0;  // VERTEX_BUFFER | STORAGE_BUFFER | TRANSFER_SRC | TRANSFER_DST
+  VertexStream positions;                     // R32G32B32_SFLOAT, world space
+  VertexStream normals;                       // R32G32B32_SFLOAT, unit, world space
+  VertexStream tangents;                      // R32G32B32A32_SFLOAT: xyz unit tangent (world), w = bitangent sign
+  VertexStream uvs;                           // R32G32_SFLOAT (buffer VK_NULL_HANDLE when the model has no UVs)
+  VkBufferUsageFlags bufferUsage = 0;         // VERTEX_BUFFER | STORAGE_BUFFER | TRANSFER_SRC | TRANSFER_DST
   std::optional<NormalMapOutput> normalMaps;  // absent for a model without maps or a batch without them
-  uint32_t queueFamily = 0;  // the family swish's resources belong to (exclusive sharing)
+  uint32_t queueFamily = 0;                   // the family swish's resources belong to (exclusive sharing)
 
   // What swish's passes end with: compute-shader storage writes.
   static constexpr VkPipelineStageFlags2 kSrcStage = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
@@ -126,7 +126,7 @@ struct FrameOutputs {
 struct FrameReport {
   uint64_t frameIndex = 0;
   std::vector<std::string> warnings;  // renormalised / replaced quaternions, bad dt, non-finite codes
-  double cpuMilliseconds = 0;          // network, lookup and filter on the CPU for all characters
+  double cpuMilliseconds = 0;         // network, lookup and filter on the CPU for all characters
 };
 
 // GPU time of each pass of a retired frame in milliseconds (NaN: not run or no timestamps).

@@ -11,10 +11,10 @@
 #include <filesystem>
 #include <memory>
 
+#include "support/cloth_fixture.hpp"
 #include "support/paths.hpp"
 #include "swish/bake/cloth/cloth_solver.hpp"
 #include "swish/io/character_import.hpp"
-#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;
@@ -75,6 +75,14 @@ void BM_ClothPose_CapsuleTube(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_ClothPose_SharedTshirt)->Unit(benchmark::kSecond)->Iterations(4)->Repetitions(3)->ReportAggregatesOnly(false);
-BENCHMARK(BM_ClothPose_CapsuleTube)->Unit(benchmark::kSecond)->Iterations(4)->Repetitions(3)->ReportAggregatesOnly(false);
+BENCHMARK(BM_ClothPose_SharedTshirt)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(4)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(false);
+BENCHMARK(BM_ClothPose_CapsuleTube)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(4)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(false);
 BENCHMARK_MAIN();

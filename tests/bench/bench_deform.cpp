@@ -33,8 +33,10 @@ gpu::Context* benchContext() {
     gpu::ContextOptions o;
     o.validation = false;  // the layers would time themselves
     auto made = gpu::Context::tryCreate(o);
-    if (made) ctx = std::make_unique<gpu::Context>(std::move(made.value()));
-    else std::fprintf(stderr, "bench_deform: no Vulkan device: %s\n", made.error().what());
+    if (made)
+      ctx = std::make_unique<gpu::Context>(std::move(made.value()));
+    else
+      std::fprintf(stderr, "bench_deform: no Vulkan device: %s\n", made.error().what());
     if (ctx) std::fprintf(stderr, "bench_deform: device %s\n", ctx->deviceName().c_str());
   }
   return ctx.get();
@@ -63,7 +65,8 @@ struct DeformSetup {
   uint32_t copyVec4s = 0;
 };
 
-DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint32_t components = 30, uint32_t capsules = 0) {
+DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint32_t components = 30,
+                      uint32_t capsules = 0) {
   DeformSetup s;
   Rng rng(42);
   test::RandomModelSpec spec;
@@ -124,7 +127,8 @@ void BM_Deform(benchmark::State& state) {
   a.jointCount = uint32_t(s.model.skeleton.size());
   // Warm-up: lavapipe compiles a pipeline at its first dispatch; that is not the kernel's cost.
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); });
-  gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.copy->record(cmd, s.copySrc.address(), s.copyDst.address(), s.copyVec4s); });
+  gpuSeconds(*ctx, ts,
+             [&](VkCommandBuffer cmd) { s.copy->record(cmd, s.copySrc.address(), s.copyDst.address(), s.copyVec4s); });
   double deformTotal = 0, copyTotal = 0;
   for (auto _ : state) {
     const double t = gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); });
@@ -143,7 +147,13 @@ void BM_Deform(benchmark::State& state) {
   state.counters["us_per_instance"] = 1e6 * deformTotal / double(state.iterations()) / instances;
 }
 // Args: instances, skinning (0: PCA reconstruction only, to see what skinning costs).
-BENCHMARK(BM_Deform)->Args({1, 1})->Args({22, 1})->Args({22, 0})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+BENCHMARK(BM_Deform)
+    ->Args({1, 1})
+    ->Args({22, 1})
+    ->Args({22, 0})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->MinTime(0.5);
 
 // The deform pass with and without its push-out step: args instances, K, capsules. Each iteration times
 // both dispatches (alternating, so that drift of a shared machine hits both alike); the reported time
@@ -152,12 +162,14 @@ void BM_DeformPushOut(benchmark::State& state) {
   gpu::Context* ctx = benchContext();
   if (!ctx) return state.SkipWithError("no Vulkan device");
   if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
-  const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1)), capsules = uint32_t(state.range(2));
+  const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1)),
+                 capsules = uint32_t(state.range(2));
   DeformSetup s = makeSetup(*ctx, instances, true, k, capsules);
   std::vector<float> posed;
   Rng rng(7);
   for (uint32_t i = 0; i < instances; ++i)
-    runtime::poseBodyProxy(s.model.bodyProxy, s.model.skeleton.skinningMatrices(test::makeRandomPose(rng, s.model.skeleton, 0.15f)),
+    runtime::poseBodyProxy(s.model.bodyProxy,
+                           s.model.skeleton.skinningMatrices(test::makeRandomPose(rng, s.model.skeleton, 0.15f)),
                            posed);
   gpu::Buffer caps(*ctx, posed.size() * 4, gpu::MemoryKind::DeviceLocal, "posed capsules");
   caps.upload(*ctx, posed.data(), posed.size() * 4);
@@ -222,8 +234,8 @@ void BM_TangentFrames(benchmark::State& state) {
   const VkDeviceSize n = g.vertexCount();
   gpu::Buffer normals(*ctx, instances * n * 12, gpu::MemoryKind::DeviceLocal, "normals");
   gpu::Buffer tangents(*ctx, instances * n * 16, gpu::MemoryKind::DeviceLocal, "tangents");
-  gpu::Buffer terms(*ctx, gpu::TangentFramesPass::triangleTermsBytes(g.triangleCount(), instances), gpu::MemoryKind::DeviceLocal,
-                    "triangle terms");
+  gpu::Buffer terms(*ctx, gpu::TangentFramesPass::triangleTermsBytes(g.triangleCount(), instances),
+                    gpu::MemoryKind::DeviceLocal, "triangle terms");
   const gpu::TangentFramesPass pass(*ctx);
   gpu::DescriptorBinding binding;
   if (twoPass) {
@@ -273,7 +285,8 @@ void BM_EmptyDispatch(benchmark::State& state) {
   gpu::EmptyDispatchPass empty(*ctx);
   gpu::TimestampQueries ts(*ctx, 2);
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { empty.record(cmd, n); });  // warm-up (first-use compile)
-  for (auto _ : state) state.SetIterationTime(gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { empty.record(cmd, n); }) / n);
+  for (auto _ : state)
+    state.SetIterationTime(gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { empty.record(cmd, n); }) / n);
   state.counters["dispatches"] = n;
 }
 BENCHMARK(BM_EmptyDispatch)->Arg(1)->Arg(100)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.3);

@@ -63,7 +63,7 @@ void timeBatches(benchmark::State& state, const MlpEvaluator& eval, uint64_t see
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(batch));
   // kIsRate|kInvert turns instances per second into seconds per instance.
   state.counters["time_per_instance"] = benchmark::Counter(double(state.iterations()) * double(batch),
-                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+                                                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 void runMlp(benchmark::State& state, CpuKernel kernel) {

@@ -44,8 +44,8 @@ Sheet cylinder(int n, float wrinkle) {
 }
 
 void BM_BakeNormalMap360(benchmark::State& state) {
-  const Sheet game = cylinder(40, 0.f);       // 1,600 vertices
-  const Sheet sim = cylinder(110, 0.004f);    // 12,100 vertices with wrinkles
+  const Sheet game = cylinder(40, 0.f);     // 1,600 vertices
+  const Sheet sim = cylinder(110, 0.004f);  // 12,100 vertices with wrinkles
   const NormalMapBaker baker(game.uv, game.t, game.p, {});
   const MeshFrameTopology topo = buildFrameTopology(sim.t, sim.p);
   NormalMapBakeStats stats;
@@ -55,7 +55,8 @@ void BM_BakeNormalMap360(benchmark::State& state) {
   }
   state.counters["chartTexels"] = double(stats.chartTexels);
   state.counters["hitTexels"] = double(stats.hitTexels);
-  state.counters["texels/s"] = benchmark::Counter(double(stats.chartTexels), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["texels/s"] =
+      benchmark::Counter(double(stats.chartTexels), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_BakeNormalMap360)->Unit(benchmark::kMillisecond);
 

@@ -31,7 +31,6 @@ namespace {
 using namespace swish;
 constexpr uint32_t kFrames = 24;
 
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? NAN : v[v.size() / 2];

@@ -61,22 +61,32 @@ nlohmann::json recipe() {
             {"clips", {kClip.string()}},
             {"thinning", {{"target_poses", 19}}},
             {"simulation",
-             {{"vertices", 0}, {"transition_seconds", 0.6}, {"settle_seconds", 0.2}, {"frame_rate", 20},
-              {"threads", 2}, {"gravity", 0}}},
+             {{"vertices", 0},
+              {"transition_seconds", 0.6},
+              {"settle_seconds", 0.2},
+              {"frame_rate", 20},
+              {"threads", 2},
+              {"gravity", 0}}},
             {"normal_maps", {{"size", 16}, {"dilation_rings", 2}}},
             {"preview", {{"poses", 1}, {"size", 64}}}}},
           {"train",
-           {{"mesh_components", 8}, {"normal_code_dims", 4}, {"database_size", 8}, {"codebook_size", 32},
-            {"hidden_layers", 2}, {"hidden_width", 16}, {"max_epochs", 100}, {"patience", 30},
-            {"test_fraction", 0.15}, {"bc5_baseline", false}}}};
+           {{"mesh_components", 8},
+            {"normal_code_dims", 4},
+            {"database_size", 8},
+            {"codebook_size", 32},
+            {"hidden_layers", 2},
+            {"hidden_width", 16},
+            {"max_epochs", 100},
+            {"patience", 30},
+            {"test_fraction", 0.15},
+            {"bc5_baseline", false}}}};
 }
 
 // The cluster's daemons, up for the life of this object.
 class LocalSlurm {
  public:
   explicit LocalSlurm(fs::path dir) : dir_(std::move(dir)) {
-    const CommandResult r =
-        runCommand({"bash", SWISH_LOCAL_SLURM, "start", dir_.string(), std::to_string(getpid())});
+    const CommandResult r = runCommand({"bash", SWISH_LOCAL_SLURM, "start", dir_.string(), std::to_string(getpid())});
     if (r.exitCode != 0) {
       error_ = "local_slurm.sh start exited " + std::to_string(r.exitCode) + ": " + r.err + r.out;
       stop();
@@ -120,7 +130,8 @@ std::vector<std::pair<std::string, std::string>> queue(const std::string& jobs) 
   std::vector<std::pair<std::string, std::string>> q;
   std::istringstream in(r.out);
   for (std::string line; std::getline(in, line);)
-    if (const size_t bar = line.find('|'); bar != std::string::npos) q.push_back({line.substr(0, bar), line.substr(bar + 1)});
+    if (const size_t bar = line.find('|'); bar != std::string::npos)
+      q.push_back({line.substr(0, bar), line.substr(bar + 1)});
   return q;
 }
 
@@ -170,7 +181,8 @@ TEST(SlurmBake, ArrayWithARequeuedTaskMakesTheLocalBakesModel) {
   std::printf("%s", sub.err.c_str());
   const fs::path work = tmp / "cluster" / "out" / "work";
   const nlohmann::json submission = nlohmann::json::parse(readText(work / "slurm" / "submission.json"));
-  const size_t poses = submission.at("poses"), shards = submission.at("shards"), shardSize = submission.at("shard_size");
+  const size_t poses = submission.at("poses"), shards = submission.at("shards"),
+               shardSize = submission.at("shard_size");
   ASSERT_EQ(shardSize, 4u);
   ASSERT_GE(shards, 4u) << "the goal is an array of 4 or more tasks";
   const std::string array = submission.at("jobs").at("part1"), dataset = submission.at("jobs").at("dataset"),
@@ -265,7 +277,8 @@ TEST(SlurmBake, ArrayWithARequeuedTaskMakesTheLocalBakesModel) {
   EXPECT_EQ(shard.at("simulated").get<size_t>() + shard.at("reused").get<size_t>(), shard.at("count").get<size_t>());
   for (const auto& [id, fid] : before)
     EXPECT_TRUE(fileId(bake::simulatedPosePath(sim, id)) == fid) << "pose " << id << " was simulated again";
-  const std::string taskLog = readText(work / "slurm" / "logs" / ("part1_" + array + "_" + std::to_string(killed) + ".out"));
+  const std::string taskLog =
+      readText(work / "slurm" / "logs" / ("part1_" + array + "_" + std::to_string(killed) + ".out"));
   EXPECT_NE(taskLog.find("restart 1"), std::string::npos) << taskLog;
   EXPECT_NE(taskLog.find("finished before (kept)"), std::string::npos) << taskLog;
   for (size_t k = 0; k < shards; ++k) {

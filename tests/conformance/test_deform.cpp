@@ -6,8 +6,8 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
-#include <ostream>
 #include <limits>
+#include <ostream>
 
 #include "support/gpu_buffers.hpp"
 #include "support/gpu_compare.hpp"
@@ -29,7 +29,8 @@ struct DeformCase {
 };
 // Readable parameters in test names and JUnit reports.
 void PrintTo(const DeformCase& c, std::ostream* os) {
-  *os << c.vertices << " vertices, K " << c.components << ", " << c.influences << " influences, " << c.instances << " instances";
+  *os << c.vertices << " vertices, K " << c.components << ", " << c.influences << " influences, " << c.instances
+      << " instances";
 }
 
 struct DeformInputs {
@@ -88,7 +89,8 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
-  const gpu::DescriptorBinding instanceInputs = pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
+  const gpu::DescriptorBinding instanceInputs =
+      pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
   a.instanceInputs = instanceInputs.get();
   a.skinJoints = skinJoints.address();
   a.skinWeights = skinWeights.address();
@@ -131,7 +133,8 @@ std::function<double(size_t)> pcaTolerance(const DeformInputs& in) {
   for (uint32_t i = 0; i < in.instances; ++i)
     for (size_t r = 0; r < rows; ++r) {
       double mag = std::abs(double(m.meshPca.mean[Eigen::Index(r)]));
-      for (size_t c = 0; c < k; ++c) mag += std::abs(double(m.meshPca.basis(Eigen::Index(r), Eigen::Index(c))) * in.weights[i * k + c]);
+      for (size_t c = 0; c < k; ++c)
+        mag += std::abs(double(m.meshPca.basis(Eigen::Index(r), Eigen::Index(c))) * in.weights[i * k + c]);
       (*bound)[i * rows + r] = double(k + 1) * FLT_EPSILON * mag;
     }
   return [bound](size_t e) { return (*bound)[e]; };
@@ -145,8 +148,8 @@ double skinTolerance(float reference) { return 2e-6 + 1e-5 * std::abs(double(ref
 
 std::string caseName(const ::testing::TestParamInfo<DeformCase>& info) {
   const auto& c = info.param;
-  return "V" + std::to_string(c.vertices) + "_K" + std::to_string(c.components) + "_Inf" + std::to_string(c.influences) + "_I" +
-         std::to_string(c.instances);
+  return "V" + std::to_string(c.vertices) + "_K" + std::to_string(c.components) + "_Inf" +
+         std::to_string(c.influences) + "_I" + std::to_string(c.instances);
 }
 
 class DeformConformance : public test::GpuTest, public ::testing::WithParamInterface<DeformCase> {};
@@ -159,7 +162,8 @@ TEST_P(DeformConformance, PcaReconstructionMatchesReference) {
     const auto gpu = runDeform(ctx(), in, false, basisTexels);
     for (const auto& p : gpu.problems) ADD_FAILURE() << p;
     test::CompareReport rep;
-    EXPECT_TRUE(test::matchesReference("pre-skinning positions", gpu.positions, referencePositions(in, false), pcaTolerance(in), &rep));
+    EXPECT_TRUE(test::matchesReference("pre-skinning positions", gpu.positions, referencePositions(in, false),
+                                       pcaTolerance(in), &rep));
     std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
   }
 }
@@ -173,7 +177,8 @@ TEST_P(DeformConformance, SkinnedPositionsMatchReference) {
     const auto gpu = runDeform(ctx(), in, true, basisTexels);
     for (const auto& p : gpu.problems) ADD_FAILURE() << p;
     test::CompareReport rep;
-    EXPECT_TRUE(test::matchesReference("skinned positions", gpu.positions, ref, [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
+    EXPECT_TRUE(test::matchesReference(
+        "skinned positions", gpu.positions, ref, [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
     std::printf("max |gpu - reference| = %.3g m over %zu values\n", rep.maxAbsError, rep.compared);
   }
 }
@@ -182,7 +187,8 @@ TEST_P(DeformConformance, SkinnedPositionsMatchReference) {
 // the 64-component case runs 150 instances through one dispatch.
 INSTANTIATE_TEST_SUITE_P(Sizes, DeformConformance,
                          ::testing::Values(DeformCase{1, 1, 1, 1}, DeformCase{7, 5, 4, 3}, DeformCase{997, 30, 4, 22},
-                                           DeformCase{997, 7, 8, 5}, DeformCase{100003, 2, 4, 2}, DeformCase{97, 64, 3, 150}),
+                                           DeformCase{997, 7, 8, 5}, DeformCase{100003, 2, 4, 2},
+                                           DeformCase{97, 64, 3, 150}),
                          caseName);
 
 class DeformSpecialValues : public test::GpuTest {};
@@ -192,20 +198,22 @@ TEST_F(DeformSpecialValues, NanAndInfReachExactlyTheReferenceOutputs) {
   SWISH_TEST_SEED_SCOPE(seed, 0xBAD);
   DeformInputs in = randomInputs(seed, {61, 6, 4, 4});
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-  in.model.meshPca.basis(3 * 17 + 1, 2) = nan;  // vertex 17 (y), every instance
-  in.weights[2 * 6 + 4] = nan;                  // instance 2, every vertex
-  const uint16_t joint = in.model.gameMesh.skin.joints[5 * 4];  // a joint vertex 5 uses
+  in.model.meshPca.basis(3 * 17 + 1, 2) = nan;                    // vertex 17 (y), every instance
+  in.weights[2 * 6 + 4] = nan;                                    // instance 2, every vertex
+  const uint16_t joint = in.model.gameMesh.skin.joints[5 * 4];    // a joint vertex 5 uses
   in.matrices[3 * in.model.skeleton.size() + joint](0, 3) = inf;  // instance 3's translation x of that joint
   in.model.gameMesh.skin.weights[9 * 4 + 1] = 0.f;                // a zero weight: skipped, so...
-  in.matrices[1 * in.model.skeleton.size() + in.model.gameMesh.skin.joints[9 * 4 + 1]](1, 1) = nan;  // ...no NaN unless used
+  in.matrices[1 * in.model.skeleton.size() + in.model.gameMesh.skin.joints[9 * 4 + 1]](1, 1) =
+      nan;  // ...no NaN unless used
   const auto ref = referencePositions(in, true);
   for (const bool basisTexels : {false, true}) {
     SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
     const auto gpu = runDeform(ctx(), in, true, basisTexels);
     for (const auto& p : gpu.problems) ADD_FAILURE() << p;
     test::CompareReport rep;
-    EXPECT_TRUE(test::matchesReference("skinned positions with NaN/Inf inputs", gpu.positions, ref,
-                                       [&](size_t e) { return skinTolerance(ref[e]); }, &rep));
+    EXPECT_TRUE(test::matchesReference(
+        "skinned positions with NaN/Inf inputs", gpu.positions, ref, [&](size_t e) { return skinTolerance(ref[e]); },
+        &rep));
     // The poison must be neither absent nor everywhere, or the test would prove nothing.
     EXPECT_GT(rep.nonFinite, 61u * 3);
     EXPECT_LT(rep.nonFinite, ref.size());
@@ -219,7 +227,8 @@ TEST_F(DeformSpecialValues, ExactlyRepresentableInputsGiveExactResults) {
   DeformInputs in = randomInputs(7, {40, 3, 2, 3});
   Model& m = in.model;
   for (Eigen::Index i = 0; i < m.meshPca.mean.size(); ++i) m.meshPca.mean[i] = float(int(rng.below(64)) - 32);
-  for (Eigen::Index i = 0; i < m.meshPca.basis.size(); ++i) m.meshPca.basis.data()[i] = float(int(rng.below(16)) - 8) * 0.25f;
+  for (Eigen::Index i = 0; i < m.meshPca.basis.size(); ++i)
+    m.meshPca.basis.data()[i] = float(int(rng.below(16)) - 8) * 0.25f;
   for (auto& w : in.weights) w = float(int(rng.below(8)) - 4) * 0.5f;
   for (size_t v = 0; v < m.gameMesh.vertexCount(); ++v) {
     m.gameMesh.skin.weights[2 * v] = (v % 3 == 0) ? 1.f : 0.5f;
@@ -233,13 +242,13 @@ TEST_F(DeformSpecialValues, ExactlyRepresentableInputsGiveExactResults) {
     for (int r = 0; r < 3; ++r) mat(r, 3) = float(int(rng.below(20)) - 10);
   }
   for (bool skinning : {false, true})
-  for (const bool basisTexels : {false, true}) {
-    SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
-    const auto gpu = runDeform(ctx(), in, skinning, basisTexels);
-    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-    EXPECT_TRUE(test::matchesReference(skinning ? "skinned positions" : "PCA positions", gpu.positions,
-                                       referencePositions(in, skinning), [](size_t) { return 0.0; }));
-  }
+    for (const bool basisTexels : {false, true}) {
+      SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
+      const auto gpu = runDeform(ctx(), in, skinning, basisTexels);
+      for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+      EXPECT_TRUE(test::matchesReference(skinning ? "skinned positions" : "PCA positions", gpu.positions,
+                                         referencePositions(in, skinning), [](size_t) { return 0.0; }));
+    }
 }
 
 }  // namespace

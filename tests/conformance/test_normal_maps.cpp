@@ -84,7 +84,8 @@ void expectDecodeExact(gpu::Context& ctx, const NormalMapDatabase& db, const std
     for (size_t i = 0; i < per; ++i)
       if (gpu[s * per + i] != ref.xy[i] && bad++ == 0) first = i;
     EXPECT_EQ(bad, 0u) << "slot " << s << " (map " << slotMaps[s] << "): " << bad << " bytes differ, first at texel "
-                       << first / 2 << " (gpu " << int(gpu[s * per + first]) << ", reference " << int(ref.xy[first]) << ")";
+                       << first / 2 << " (gpu " << int(gpu[s * per + first]) << ", reference " << int(ref.xy[first])
+                       << ")";
   }
 }
 
@@ -93,7 +94,8 @@ struct DecodeCase {
   std::vector<uint32_t> slots;
 };
 void PrintTo(const DecodeCase& c, std::ostream* os) {
-  *os << c.size << "x" << c.size << ", " << c.maps << " maps, " << c.codebook << " codebook entries, " << c.slots.size() << " slots";
+  *os << c.size << "x" << c.size << ", " << c.maps << " maps, " << c.codebook << " codebook entries, " << c.slots.size()
+      << " slots";
 }
 
 class VqDecodeConformance : public test::GpuTest, public ::testing::WithParamInterface<DecodeCase> {};
@@ -113,10 +115,11 @@ TEST_P(VqDecodeConformance, DecodesExactlyLikeReference) {
 // one of 65536 (every 16-bit index value usable); an odd index count (word padding).
 INSTANTIATE_TEST_SUITE_P(Sizes, VqDecodeConformance,
                          ::testing::Values(DecodeCase{4, 1, 1, {0}}, DecodeCase{12, 3, 7, {2, 0, 1}},
-                                           DecodeCase{20, 5, 65536, {4, 4, 1}}, DecodeCase{360, 16, 4096, {0, 3, 5, 7, 9, 11, 13, 15}}),
+                                           DecodeCase{20, 5, 65536, {4, 4, 1}},
+                                           DecodeCase{360, 16, 4096, {0, 3, 5, 7, 9, 11, 13, 15}}),
                          [](const auto& info) {
-                           return "S" + std::to_string(info.param.size) + "_C" + std::to_string(info.param.codebook) + "_Slots" +
-                                  std::to_string(info.param.slots.size());
+                           return "S" + std::to_string(info.param.size) + "_C" + std::to_string(info.param.codebook) +
+                                  "_Slots" + std::to_string(info.param.slots.size());
                          });
 
 class NormalMapSpecialCases : public test::GpuTest {};
@@ -146,71 +149,76 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
   // Both outputs: a buffer copied into the images, and images that share the blend's output (where the
   // device allows it: then no copy).
   for (const bool shared : {false, true})
-  for (const bool store64 : {false, true})
-  for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}, {8, 48}}) {
-    SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + (store64 ? ", 64-bit stores" : "") +
-                 (shared ? ", shared texels" : ""));
-    const gpu::NormalMapBlendPass pass(ctx(), width, store64);
-    EXPECT_EQ(pass.exact(), width >= 64);
-    EXPECT_EQ(pass.stores64(), store64 && ctx().hasShaderInt64());
-    const uint32_t characters = 5, slots = 2;
-    const size_t per = size_t(width) * height * 2;
-    std::vector<runtime::DecodedNormalMap> decoded(slots, {width, height, std::vector<int8_t>(per)});
-    std::vector<int8_t> decodedAll;
-    for (auto& d : decoded) {
-      for (auto& b : d.xy) b = int8_t(int(rng.below(256)) - 128);
-      decodedAll.insert(decodedAll.end(), d.xy.begin(), d.xy.end());
-    }
-    // Characters 0..4: slots and alphas, including alpha 0 (keep prev) and 1 (take decoded).
-    const std::vector<gpu::NormalMapBlendPass::Character> chars = {{0, 0.f}, {1, 1.f}, {0, 0.37f}, {1, float(rng.uniform())}, {0, 0.5f}};
-    std::vector<runtime::BlendedNormalMap> prev;
-    std::vector<int16_t> prevAll;
-    for (uint32_t c = 0; c < characters; ++c) {
-      auto m = runtime::BlendedNormalMap::zeros(width, height);
-      for (auto& v : m.xy) v = int16_t(int(rng.below(65535)) - 32767);
-      prevAll.insert(prevAll.end(), m.xy.begin(), m.xy.end());
-      prev.push_back(std::move(m));
-    }
-    CheckedInput decodedIn(ctx(), std::span<const int8_t>(decodedAll), "decoded");
-    CheckedInput charsIn(ctx(), std::span<const gpu::NormalMapBlendPass::Character>(chars), "characters");
-    CheckedInput prevIn(ctx(), std::span<const int16_t>(prevAll), "previous maps");
-    GuardedOutput outTexels(ctx(), prevAll.size() * sizeof(int16_t), "blended maps");
-    // One layer more than characters: the blend (or its copy into the images) must write the
-    // characters' layers only.
-    gpu::NormalMapImages outImg(ctx(), width, height, characters + 1, shared);
-    if (shared && !outImg.sharesTexels()) continue;  // the device does not allow it: only the copy form runs
-    const gpu::Buffer& out = shared ? outImg.texels() : outTexels.buffer();
-    {
-      const auto binding = pass.makeBinding(ctx(), prevIn.buffer(), out, decodedIn.buffer());
-      gpu::NormalMapBlendPass::Args a;
-      a.characters = charsIn.address();
-      a.width = width;
-      a.height = height;
-      a.characterCount = characters;
-      a.outTexels = out.handle();
-      a.outMaps = outImg.image();
-      a.outMapsShareTexels = shared;
-      ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, binding.get(), a); });
-    }
-    for (const CheckedInput* c : {&decodedIn, &charsIn, &prevIn})
-      if (auto s = c->unchanged(ctx()); !s.empty()) ADD_FAILURE() << s;  // the previous maps too: read, never written
-    const auto images = outImg.download(ctx());
-    const std::vector<int16_t> blended(images.begin(), images.begin() + std::ptrdiff_t(characters * per));
-    if (!shared) {
-      if (auto s = outTexels.guardsIntact(ctx()); !s.empty()) ADD_FAILURE() << s;
-      EXPECT_EQ(outTexels.read<int16_t>(ctx()), blended) << "the images must hold a copy of the blended texels";
-    }
-    EXPECT_EQ(std::vector<int16_t>(images.begin() + std::ptrdiff_t(characters * per), images.end()), std::vector<int16_t>(per, 0))
-        << "a layer beyond the characters was written";
-    for (uint32_t c = 0; c < characters; ++c) {
-      runtime::BlendedNormalMap ref = prev[c];
-      runtime::referenceNormalBlend(ref, decoded[chars[c].decodedSlot], chars[c].alpha);
-      const bool exact = chars[c].alpha == 0.f || chars[c].alpha == 1.f;
-      int maxDiff = 0;
-      for (size_t i = 0; i < per; ++i) maxDiff = std::max(maxDiff, std::abs(int(blended[c * per + i]) - int(ref.xy[i])));
-      EXPECT_LE(maxDiff, exact ? 0 : 1) << "character " << c << " (alpha " << chars[c].alpha << ")";
-    }
-  }
+    for (const bool store64 : {false, true})
+      for (const auto& [width, height] :
+           {std::pair<uint32_t, uint32_t>{12, 12}, {20, 8}, {4, 4}, {64, 8}, {72, 12}, {8, 48}}) {
+        SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + (store64 ? ", 64-bit stores" : "") +
+                     (shared ? ", shared texels" : ""));
+        const gpu::NormalMapBlendPass pass(ctx(), width, store64);
+        EXPECT_EQ(pass.exact(), width >= 64);
+        EXPECT_EQ(pass.stores64(), store64 && ctx().hasShaderInt64());
+        const uint32_t characters = 5, slots = 2;
+        const size_t per = size_t(width) * height * 2;
+        std::vector<runtime::DecodedNormalMap> decoded(slots, {width, height, std::vector<int8_t>(per)});
+        std::vector<int8_t> decodedAll;
+        for (auto& d : decoded) {
+          for (auto& b : d.xy) b = int8_t(int(rng.below(256)) - 128);
+          decodedAll.insert(decodedAll.end(), d.xy.begin(), d.xy.end());
+        }
+        // Characters 0..4: slots and alphas, including alpha 0 (keep prev) and 1 (take decoded).
+        const std::vector<gpu::NormalMapBlendPass::Character> chars = {
+            {0, 0.f}, {1, 1.f}, {0, 0.37f}, {1, float(rng.uniform())}, {0, 0.5f}};
+        std::vector<runtime::BlendedNormalMap> prev;
+        std::vector<int16_t> prevAll;
+        for (uint32_t c = 0; c < characters; ++c) {
+          auto m = runtime::BlendedNormalMap::zeros(width, height);
+          for (auto& v : m.xy) v = int16_t(int(rng.below(65535)) - 32767);
+          prevAll.insert(prevAll.end(), m.xy.begin(), m.xy.end());
+          prev.push_back(std::move(m));
+        }
+        CheckedInput decodedIn(ctx(), std::span<const int8_t>(decodedAll), "decoded");
+        CheckedInput charsIn(ctx(), std::span<const gpu::NormalMapBlendPass::Character>(chars), "characters");
+        CheckedInput prevIn(ctx(), std::span<const int16_t>(prevAll), "previous maps");
+        GuardedOutput outTexels(ctx(), prevAll.size() * sizeof(int16_t), "blended maps");
+        // One layer more than characters: the blend (or its copy into the images) must write the
+        // characters' layers only.
+        gpu::NormalMapImages outImg(ctx(), width, height, characters + 1, shared);
+        if (shared && !outImg.sharesTexels()) continue;  // the device does not allow it: only the copy form runs
+        const gpu::Buffer& out = shared ? outImg.texels() : outTexels.buffer();
+        {
+          const auto binding = pass.makeBinding(ctx(), prevIn.buffer(), out, decodedIn.buffer());
+          gpu::NormalMapBlendPass::Args a;
+          a.characters = charsIn.address();
+          a.width = width;
+          a.height = height;
+          a.characterCount = characters;
+          a.outTexels = out.handle();
+          a.outMaps = outImg.image();
+          a.outMapsShareTexels = shared;
+          ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, binding.get(), a); });
+        }
+        for (const CheckedInput* c : {&decodedIn, &charsIn, &prevIn})
+          if (auto s = c->unchanged(ctx()); !s.empty())
+            ADD_FAILURE() << s;  // the previous maps too: read, never written
+        const auto images = outImg.download(ctx());
+        const std::vector<int16_t> blended(images.begin(), images.begin() + std::ptrdiff_t(characters * per));
+        if (!shared) {
+          if (auto s = outTexels.guardsIntact(ctx()); !s.empty()) ADD_FAILURE() << s;
+          EXPECT_EQ(outTexels.read<int16_t>(ctx()), blended) << "the images must hold a copy of the blended texels";
+        }
+        EXPECT_EQ(std::vector<int16_t>(images.begin() + std::ptrdiff_t(characters * per), images.end()),
+                  std::vector<int16_t>(per, 0))
+            << "a layer beyond the characters was written";
+        for (uint32_t c = 0; c < characters; ++c) {
+          runtime::BlendedNormalMap ref = prev[c];
+          runtime::referenceNormalBlend(ref, decoded[chars[c].decodedSlot], chars[c].alpha);
+          const bool exact = chars[c].alpha == 0.f || chars[c].alpha == 1.f;
+          int maxDiff = 0;
+          for (size_t i = 0; i < per; ++i)
+            maxDiff = std::max(maxDiff, std::abs(int(blended[c * per + i]) - int(ref.xy[i])));
+          EXPECT_LE(maxDiff, exact ? 0 : 1) << "character " << c << " (alpha " << chars[c].alpha << ")";
+        }
+      }
 }
 
 }  // namespace

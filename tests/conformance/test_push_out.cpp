@@ -75,8 +75,9 @@ Reference reference(const PushInputs& in, bool pushOut) {
   const size_t k = size_t(m.meshComponents()), j = m.skeleton.size(), c = m.bodyProxy.capsules.size();
   Reference r;
   for (uint32_t i = 0; i < in.instances; ++i) {
-    Points3f p = runtime::referenceSkin(runtime::referencePcaReconstruct(m.meshPca, std::span(in.weights).subspan(i * k, k)),
-                                        m.gameMesh.skin, std::vector<Mat4f>(in.matrices.begin() + i * j, in.matrices.begin() + (i + 1) * j));
+    Points3f p = runtime::referenceSkin(
+        runtime::referencePcaReconstruct(m.meshPca, std::span(in.weights).subspan(i * k, k)), m.gameMesh.skin,
+        std::vector<Mat4f>(in.matrices.begin() + i * j, in.matrices.begin() + (i + 1) * j));
     const std::span<const float> posed = std::span(in.posed).subspan(i * c * 8, c * 8);
     for (Eigen::Index v = 0; v < p.rows(); ++v) {
       double amp = 1;
@@ -124,7 +125,8 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut) {
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
-  const gpu::DescriptorBinding instanceInputs = pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
+  const gpu::DescriptorBinding instanceInputs =
+      pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
   a.instanceInputs = instanceInputs.get();
   a.skinJoints = skinJoints.address();
   a.skinWeights = skinWeights.address();
@@ -170,7 +172,8 @@ TEST_P(PushOutConformance, PushedPositionsMatchReference) {
   // Not vacuous: a fair share of the vertices must have been moved, and moved by more than rounding.
   const size_t total = size_t(in.instances) * in.model.gameMesh.vertexCount();
   double largest = 0;
-  for (size_t e = 0; e < ref.positions.size(); ++e) largest = std::max(largest, double(std::abs(ref.positions[e] - unpushed.positions[e])));
+  for (size_t e = 0; e < ref.positions.size(); ++e)
+    largest = std::max(largest, double(std::abs(ref.positions[e] - unpushed.positions[e])));
   if (total >= 100) {  // the 1-vertex case may well miss its one capsule
     EXPECT_GE(ref.moved * 20, total) << ref.moved << " of " << total << " vertices pushed";
     EXPECT_GT(largest, 1e-3) << "the pushes move vertices by millimetres at least";
@@ -179,9 +182,10 @@ TEST_P(PushOutConformance, PushedPositionsMatchReference) {
   const auto gpu = runDeform(ctx(), in, true);
   for (const auto& p : gpu.problems) ADD_FAILURE() << p;
   test::CompareReport rep;
-  EXPECT_TRUE(test::matchesReference("pushed positions", gpu.positions, ref.positions, [&](size_t e) { return tolerance(ref, e); }, &rep));
-  std::printf("%zu of %zu vertices pushed (largest move %.3g m); max |gpu - reference| = %.3g m over %zu values\n", ref.moved, total,
-              largest, rep.maxAbsError, rep.compared);
+  EXPECT_TRUE(test::matchesReference(
+      "pushed positions", gpu.positions, ref.positions, [&](size_t e) { return tolerance(ref, e); }, &rep));
+  std::printf("%zu of %zu vertices pushed (largest move %.3g m); max |gpu - reference| = %.3g m over %zu values\n",
+              ref.moved, total, largest, rep.maxAbsError, rep.compared);
 }
 
 // capsuleCount 0 (a frame with the push-out off) is the plain deform, bit for bit the same as the
@@ -217,7 +221,8 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
       0.1f, 1.f, 0.3f,                // outside
       0.1f, 1.f, 0.f;                 // on the axis
   for (size_t v = 0; v < 4; ++v)
-    for (int i = 0; i < m.gameMesh.skin.influences; ++i) m.gameMesh.skin.weights[v * size_t(m.gameMesh.skin.influences) + size_t(i)] = i == 0 ? 1.f : 0.f;
+    for (int i = 0; i < m.gameMesh.skin.influences; ++i)
+      m.gameMesh.skin.weights[v * size_t(m.gameMesh.skin.influences) + size_t(i)] = i == 0 ? 1.f : 0.f;
   m.meshPca.mean[1] = 1.01f;  // vertex 0 at (0.01, 1.01, 0): 1 cm above the axis
   std::fill(in.matrices.begin(), in.matrices.end(), Mat4f::Identity());
   m.bodyProxy.capsules = {{0, Vec3f(0.f, 1.f, 0.f), Vec3f(0.2f, 1.f, 0.f), 0.05f}};
@@ -225,9 +230,10 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
   runtime::poseBodyProxy(m.bodyProxy, in.matrices, in.posed);
   const Reference ref = reference(in, true);
   const float e1 = std::sqrt(0.03f * 0.03f + 0.02f * 0.02f);  // vertex 1's distance from end b
-  const std::vector<float> expected = {0.01f, 1.05f, 0.f, 0.2f + 0.03f * 0.05f / e1, 1.f, 0.02f * 0.05f / e1,
-                                       0.1f, 1.f, 0.3f, 0.1f, 1.f, 0.f};
-  EXPECT_TRUE(test::matchesReference("reference on known answers", ref.positions, expected, [](size_t) { return 1e-6; }));
+  const std::vector<float> expected = {
+      0.01f, 1.05f, 0.f, 0.2f + 0.03f * 0.05f / e1, 1.f, 0.02f * 0.05f / e1, 0.1f, 1.f, 0.3f, 0.1f, 1.f, 0.f};
+  EXPECT_TRUE(
+      test::matchesReference("reference on known answers", ref.positions, expected, [](size_t) { return 1e-6; }));
   EXPECT_EQ(ref.moved, 2u);
   const auto gpu = runDeform(ctx(), in, true);
   for (const auto& p : gpu.problems) ADD_FAILURE() << p;

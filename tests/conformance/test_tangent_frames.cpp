@@ -6,16 +6,16 @@
 // an exactly representable flat mesh, guard words and unchanged inputs.
 #include <cmath>
 #include <cstdio>
-#include <ostream>
 #include <limits>
+#include <ostream>
 
 #include "support/gpu_buffers.hpp"
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
-#include "swish/core/mesh_frames.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/mesh_frames.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 #include "swish/runtime/reference_tangent_frames.hpp"
 
@@ -36,7 +36,9 @@ constexpr double kFrameTolerance = 1e-4;
 struct FramesCase {
   uint32_t vertices, instances;
 };
-void PrintTo(const FramesCase& c, std::ostream* os) { *os << c.vertices << " vertices, " << c.instances << " instances"; }
+void PrintTo(const FramesCase& c, std::ostream* os) {
+  *os << c.vertices << " vertices, " << c.instances << " instances";
+}
 
 struct Frames {
   std::vector<float> normals, tangents;
@@ -60,7 +62,8 @@ Frames runGpu(gpu::Context& ctx, const Model& m, const std::vector<float>& posit
   GuardedOutput normals(ctx, size_t(instances) * n * 3 * 4, "normals");
   GuardedOutput tangents(ctx, size_t(instances) * n * 4 * 4, "tangents");
   const uint32_t triangles = uint32_t(g.triangles.rows());
-  GuardedOutput terms(ctx, std::max<size_t>(16, gpu::TangentFramesPass::triangleTermsBytes(triangles, instances)), "triangle terms");
+  GuardedOutput terms(ctx, std::max<size_t>(16, gpu::TangentFramesPass::triangleTermsBytes(triangles, instances)),
+                      "triangle terms");
   const gpu::TangentFramesPass pass(ctx, store64);
   gpu::DescriptorBinding twoPassBinding;
   if (twoPass) {
@@ -119,7 +122,8 @@ Frames runReference(const Model& m, const std::vector<float>& positions, uint32_
 std::vector<float> deformedPositions(Rng& rng, const Model& m, uint32_t instances) {
   std::vector<float> out;
   for (uint32_t i = 0; i < instances; ++i) {
-    const Quatf q(Eigen::AngleAxisf(rng.uniformf(-1, 1), Vec3f(rng.uniformf(-1, 1), 1, rng.uniformf(-1, 1)).normalized()));
+    const Quatf q(
+        Eigen::AngleAxisf(rng.uniformf(-1, 1), Vec3f(rng.uniformf(-1, 1), 1, rng.uniformf(-1, 1)).normalized()));
     const Vec3f t(rng.uniformf(-3, 3), rng.uniformf(-1, 1), rng.uniformf(-3, 3));
     for (Eigen::Index v = 0; v < m.gameMesh.positions.rows(); ++v) {
       Vec3f p = q * Vec3f(m.gameMesh.positions.row(v).transpose()) + t;
@@ -133,8 +137,10 @@ std::vector<float> deformedPositions(Rng& rng, const Model& m, uint32_t instance
 void expectMatch(const Frames& gpu, const Frames& ref, test::CompareReport* nrep = nullptr) {
   for (const auto& p : gpu.problems) ADD_FAILURE() << p;
   test::CompareReport tr;
-  EXPECT_TRUE(test::matchesReference("normals", gpu.normals, ref.normals, [](size_t) { return kFrameTolerance; }, nrep));
-  EXPECT_TRUE(test::matchesReference("tangents", gpu.tangents, ref.tangents, [](size_t) { return kFrameTolerance; }, &tr));
+  EXPECT_TRUE(test::matchesReference(
+      "normals", gpu.normals, ref.normals, [](size_t) { return kFrameTolerance; }, nrep));
+  EXPECT_TRUE(test::matchesReference(
+      "tangents", gpu.tangents, ref.tangents, [](size_t) { return kFrameTolerance; }, &tr));
   std::printf("max |gpu - reference|: tangents %.3g\n", tr.maxAbsError);
 }
 
@@ -165,14 +171,18 @@ TEST_P(TangentFramesConformance, MatchReference) {
   EXPECT_TRUE(test::matchesReference("two-pass tangents", two.tangents, one.tangents, [](size_t) { return 0.0; }));
   const Frames two32 = runGpu(ctx(), m, pos, GetParam().instances, true, true, false);
   for (const auto& p : two32.problems) ADD_FAILURE() << p;
-  EXPECT_TRUE(test::matchesReference("two-pass normals, 32-bit stores", two32.normals, one.normals, [](size_t) { return 0.0; }));
-  EXPECT_TRUE(test::matchesReference("two-pass tangents, 32-bit stores", two32.tangents, one.tangents, [](size_t) { return 0.0; }));
+  EXPECT_TRUE(test::matchesReference("two-pass normals, 32-bit stores", two32.normals, one.normals,
+                                     [](size_t) { return 0.0; }));
+  EXPECT_TRUE(test::matchesReference("two-pass tangents, 32-bit stores", two32.tangents, one.tangents,
+                                     [](size_t) { return 0.0; }));
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, TangentFramesConformance,
-                         ::testing::Values(FramesCase{1, 1}, FramesCase{7, 2}, FramesCase{997, 3}, FramesCase{100003, 1}),
+                         ::testing::Values(FramesCase{1, 1}, FramesCase{7, 2}, FramesCase{997, 3},
+                                           FramesCase{100003, 1}),
                          [](const auto& info) {
-                           return "V" + std::to_string(info.param.vertices) + "_I" + std::to_string(info.param.instances);
+                           return "V" + std::to_string(info.param.vertices) + "_I" +
+                                  std::to_string(info.param.instances);
                          });
 
 class TangentFramesSpecialCases : public test::GpuTest {};
@@ -185,7 +195,8 @@ TEST_F(TangentFramesSpecialCases, MeshWithoutUvsUsesTheFallbackTangentLikeTheRef
   spec.normalMaps = 0;
   const Model m = test::makeRandomModel(rng, spec);
   const auto pos = deformedPositions(rng, m, 2);
-  for (bool twoPass : {false, true}) expectMatch(runGpu(ctx(), m, pos, 2, false, twoPass), runReference(m, pos, 2, false));
+  for (bool twoPass : {false, true})
+    expectMatch(runGpu(ctx(), m, pos, 2, false, twoPass), runReference(m, pos, 2, false));
 }
 
 // A NaN position poisons the frames of the vertices around it exactly as in the reference (whose
@@ -206,11 +217,14 @@ TEST_F(TangentFramesSpecialCases, NanPositionAffectsExactlyTheReferenceVertices)
   // The reference's fallbacks must actually have fired near the poisoned vertices: the frames there
   // differ from the frames of the same mesh without poison.
   size_t changed = 0;
-  const Frames unpoisoned = runReference(m, [&] {
-    Rng again(seed);
-    test::makeRandomModel(again, spec);
-    return deformedPositions(again, m, 2);
-  }(), 2);
+  const Frames unpoisoned = runReference(
+      m,
+      [&] {
+        Rng again(seed);
+        test::makeRandomModel(again, spec);
+        return deformedPositions(again, m, 2);
+      }(),
+      2);
   for (size_t i = 0; i < ref.normals.size(); ++i) changed += ref.normals[i] != unpoisoned.normals[i];
   EXPECT_GT(changed, 0u);
 }

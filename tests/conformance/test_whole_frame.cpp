@@ -15,9 +15,9 @@
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
+#include "swish/core/mesh_frames.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
-#include "swish/core/mesh_frames.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/reference_tangent_frames.hpp"
 
@@ -41,8 +41,8 @@ runtime::FrameKernelInputs randomFrameInputs(Rng& rng, const Model& m, uint32_t 
   return in;
 }
 
-void expectFrameMatches(const Model& model, const runtime::ReferenceFrameOutputs& gpu, const runtime::ReferenceFrameOutputs& ref,
-                        int frame) {
+void expectFrameMatches(const Model& model, const runtime::ReferenceFrameOutputs& gpu,
+                        const runtime::ReferenceFrameOutputs& ref, int frame) {
   SCOPED_TRACE("frame " + std::to_string(frame));
   ASSERT_EQ(gpu.positions.size(), ref.positions.size());
   ASSERT_EQ(gpu.normals.size(), ref.normals.size());
@@ -56,10 +56,13 @@ void expectFrameMatches(const Model& model, const runtime::ReferenceFrameOutputs
     EXPECT_TRUE(test::matchesReference("positions", span(gpu.positions[i]), r,
                                        [&](size_t e) { return 2e-6 + 1e-5 * std::abs(double(r[e])); }));
     if (i < gpu.normals.size()) {
-      const runtime::ReferenceTangentFrames own = runtime::referenceTangentFrames(gpu.positions[i], model.gameMesh, topo);
+      const runtime::ReferenceTangentFrames own =
+          runtime::referenceTangentFrames(gpu.positions[i], model.gameMesh, topo);
       constexpr double kFrameTolerance = 1e-4;  // test_tangent_frames.cpp says why
-      EXPECT_TRUE(test::matchesReference("normals", span(gpu.normals[i]), span(own.normals), [](size_t) { return kFrameTolerance; }));
-      EXPECT_TRUE(test::matchesReference("tangents", span(gpu.tangents[i]), span(own.tangents), [](size_t) { return kFrameTolerance; }));
+      EXPECT_TRUE(test::matchesReference("normals", span(gpu.normals[i]), span(own.normals),
+                                         [](size_t) { return kFrameTolerance; }));
+      EXPECT_TRUE(test::matchesReference("tangents", span(gpu.tangents[i]), span(own.tangents),
+                                         [](size_t) { return kFrameTolerance; }));
     }
   }
   for (size_t i = 0; i < ref.normalMaps.size(); ++i) {
@@ -90,40 +93,41 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
   // The normal maps written straight into images that share the blend's output (where the device
   // allows it: lavapipe does), and copied into images of their own.
   for (const bool share : {true, false}) {
-  SCOPED_TRACE(share ? "shared texels" : "copied texels");
-  Rng rng(seed + 1);  // the same frames for both
-  gpu::FrameRecorderOptions options;
-  options.framesInFlight = 2;
-  options.shareNormalMapTexels = share;
-  gpu::FrameRecorder recorder(ctx(), gpuModel, instances, options);
-  if (!share) {
-    EXPECT_FALSE(recorder.frame(0).normalMaps.sharesTexels());
-  }
+    SCOPED_TRACE(share ? "shared texels" : "copied texels");
+    Rng rng(seed + 1);  // the same frames for both
+    gpu::FrameRecorderOptions options;
+    options.framesInFlight = 2;
+    options.shareNormalMapTexels = share;
+    gpu::FrameRecorder recorder(ctx(), gpuModel, instances, options);
+    if (!share) {
+      EXPECT_FALSE(recorder.frame(0).normalMaps.sharesTexels());
+    }
 
-  std::vector<runtime::BlendedNormalMap> prevMaps;  // reference state; starts at zeros like the GPU images
-  for (int frame = 0; frame < 3; ++frame) {
-    auto in = randomFrameInputs(rng, model, instances, true);
-    in.pushOut = frame != 1;
-    ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, uint64_t(frame), in); });
-    const uint32_t slot = recorder.slotOf(uint64_t(frame));
-    const auto gpu = recorder.download(slot);
-    const auto ref = runtime::referenceFrame(model, in, prevMaps);
-    expectFrameMatches(model, gpu, ref, frame);
-    // Each selected map decoded once, however many characters chose it, and only in the first frame
-    // that selects it in this slot.
-    const size_t distinct = std::set<uint32_t>(in.selectedMaps.begin(), in.selectedMaps.end()).size();
-    EXPECT_EQ(recorder.frame(slot).decodedSlotCount, distinct);
-    EXPECT_LE(recorder.frame(slot).decodeJobCount, distinct);
-    if (frame < 2) {
-      EXPECT_EQ(recorder.frame(slot).decodeJobCount, distinct);
+    std::vector<runtime::BlendedNormalMap> prevMaps;  // reference state; starts at zeros like the GPU images
+    for (int frame = 0; frame < 3; ++frame) {
+      auto in = randomFrameInputs(rng, model, instances, true);
+      in.pushOut = frame != 1;
+      ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, uint64_t(frame), in); });
+      const uint32_t slot = recorder.slotOf(uint64_t(frame));
+      const auto gpu = recorder.download(slot);
+      const auto ref = runtime::referenceFrame(model, in, prevMaps);
+      expectFrameMatches(model, gpu, ref, frame);
+      // Each selected map decoded once, however many characters chose it, and only in the first frame
+      // that selects it in this slot.
+      const size_t distinct = std::set<uint32_t>(in.selectedMaps.begin(), in.selectedMaps.end()).size();
+      EXPECT_EQ(recorder.frame(slot).decodedSlotCount, distinct);
+      EXPECT_LE(recorder.frame(slot).decodeJobCount, distinct);
+      if (frame < 2) {
+        EXPECT_EQ(recorder.frame(slot).decodeJobCount, distinct);
+      }
+      if (ctx().supportsTimestamps()) {
+        const auto t = recorder.stageTimes(slot);
+        EXPECT_FALSE(std::isnan(t.deformMs) || std::isnan(t.tangentFramesMs) || std::isnan(t.vqDecodeMs) ||
+                     std::isnan(t.normalBlendMs));
+        EXPECT_GE(t.totalMs, t.deformMs);
+      }
+      prevMaps = ref.normalMaps;
     }
-    if (ctx().supportsTimestamps()) {
-      const auto t = recorder.stageTimes(slot);
-      EXPECT_FALSE(std::isnan(t.deformMs) || std::isnan(t.tangentFramesMs) || std::isnan(t.vqDecodeMs) || std::isnan(t.normalBlendMs));
-      EXPECT_GE(t.totalMs, t.deformMs);
-    }
-    prevMaps = ref.normalMaps;
-  }
   }
 }
 
@@ -145,7 +149,8 @@ TEST_F(WholeFrame, DecodedMapsAreKeptAcrossFramesAndTheirSlotsReused) {
     std::vector<uint32_t> maps;
     int decoded;  // maps the frame must decode (-1: not checked)
   };
-  const std::vector<Step> steps = {{{0, 1, 2}, 3}, {{2, 0, 0}, 0}, {{3, 4, 3}, 2}, {{0, 2, 4}, -1}, {{0, 2, 4}, 0}, {{5, 5, 5}, 1}};
+  const std::vector<Step> steps = {{{0, 1, 2}, 3},  {{2, 0, 0}, 0}, {{3, 4, 3}, 2},
+                                   {{0, 2, 4}, -1}, {{0, 2, 4}, 0}, {{5, 5, 5}, 1}};
   std::vector<runtime::BlendedNormalMap> prevMaps;
   for (size_t f = 0; f <= steps.size(); ++f) {
     if (f == steps.size()) recorder.forgetDecodedMaps();  // then the last frame again: everything decoded anew

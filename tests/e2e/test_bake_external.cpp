@@ -24,11 +24,11 @@
 
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/cloth/cloth_solver.hpp"
-#include "swish/bake/dataset/dataset_io.hpp"
 #include "swish/bake/cloth/external_simulation.hpp"
 #include "swish/bake/cloth/pose_export.hpp"
+#include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/model/model_file.hpp"
@@ -45,8 +45,9 @@ namespace {
 const fs::path kClip = test::debianMocap("01_01.bvh");
 
 nlohmann::json recipe(const std::string& name, const nlohmann::json& simulationExtra = nlohmann::json::object()) {
-  nlohmann::json sim = {{"vertices", 0},       {"transition_seconds", 0.3}, {"settle_seconds", 0.2},
-                        {"frame_rate", 20},    {"threads", 2},              {"gravity", 0}};
+  nlohmann::json sim = {{"vertices", 0},         {"transition_seconds", 0.3},
+                        {"settle_seconds", 0.2}, {"frame_rate", 20},
+                        {"threads", 2},          {"gravity", 0}};
   sim.update(simulationExtra);
   return {{"name", name},
           {"output", name},
@@ -58,9 +59,16 @@ nlohmann::json recipe(const std::string& name, const nlohmann::json& simulationE
             {"normal_maps", {{"size", 16}, {"dilation_rings", 2}}},
             {"preview", {{"poses", 0}}}}},
           {"train",
-           {{"mesh_components", 8}, {"normal_code_dims", 4}, {"database_size", 4}, {"codebook_size", 16},
-            {"hidden_layers", 2}, {"hidden_width", 16}, {"max_epochs", 100}, {"patience", 30},
-            {"test_fraction", 0.2}, {"bc5_baseline", false}}}};
+           {{"mesh_components", 8},
+            {"normal_code_dims", 4},
+            {"database_size", 4},
+            {"codebook_size", 16},
+            {"hidden_layers", 2},
+            {"hidden_width", 16},
+            {"max_epochs", 100},
+            {"patience", 30},
+            {"test_fraction", 0.2},
+            {"bc5_baseline", false}}}};
 }
 
 // OBJ as a DCC tool writes it: fixed 6 decimals (half a micrometre of rounding per coordinate).
@@ -71,7 +79,8 @@ void writeToolObj(const fs::path& file, const Points3f& p, const Triangles& t) {
     std::snprintf(line, sizeof line, "v %.6f %.6f %.6f\n", double(p(v, 0)), double(p(v, 1)), double(p(v, 2)));
     o << line;
   }
-  for (Eigen::Index f = 0; f < t.rows(); ++f) o << "f " << t(f, 0) + 1 << " " << t(f, 1) + 1 << " " << t(f, 2) + 1 << "\n";
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    o << "f " << t(f, 0) + 1 << " " << t(f, 1) + 1 << " " << t(f, 2) + 1 << "\n";
 }
 
 // A re-meshed garment: a vertex at every edge midpoint and, instead of each original vertex, the mean
@@ -181,7 +190,7 @@ struct RoundTrip {
   BakeRunResult solverBake, externalBake, remeshBake;
   PoseExportResult exported;
   nlohmann::json sidecar;
-  std::vector<uint32_t> toolFailed;     // poses the external tool could not simulate (no file written)
+  std::vector<uint32_t> toolFailed;          // poses the external tool could not simulate (no file written)
   uint32_t removedPose = 0, brokenPose = 0;  // the re-meshed set's missing and broken results
   std::vector<std::string> remeshLog;
 };
@@ -217,7 +226,8 @@ RoundTrip& roundTrip(bool bake) {
     tbb::parallel_for(size_t(0), poses.size(), [&](size_t i) {
       const auto& e = poses[i];
       Pose p;
-      for (const auto& q : e["rotations"]) p.local.emplace_back(q[3].get<float>(), q[0].get<float>(), q[1].get<float>(), q[2].get<float>());
+      for (const auto& q : e["rotations"])
+        p.local.emplace_back(q[3].get<float>(), q[0].get<float>(), q[1].get<float>(), q[2].get<float>());
       p.rootTranslation = Vec3f(e["root_translation"][0].get<float>(), e["root_translation"][1].get<float>(),
                                 e["root_translation"][2].get<float>());
       const PoseSimulation sim = solver.simulate(p);
@@ -232,8 +242,8 @@ RoundTrip& roundTrip(bool bake) {
       if (failed[i]) r->toolFailed.push_back(poses[i]["id"].get<uint32_t>());
 
     // 4. Bake from the files.
-    r->externalConfig = parseBakeConfig(recipe("external", {{"source", "external"}, {"path", "export/results"}}),
-                                        "external.json", dir);
+    r->externalConfig =
+        parseBakeConfig(recipe("external", {{"source", "external"}, {"path", "export/results"}}), "external.json", dir);
     r->externalBake = runBake(r->externalConfig);
 
     // 5. The same results on a re-meshed garment, in another vertex order, with its rest shape; one
@@ -255,8 +265,8 @@ RoundTrip& roundTrip(bool bake) {
     r->brokenPose = written[2];
     fs::remove(externalPoseCandidates(remeshed, r->removedPose)[0]);
     std::ofstream(externalPoseCandidates(remeshed, r->brokenPose)[0], std::ios::trunc) << "v 0 0 0\nv 1 0\n";
-    r->remeshConfig = parseBakeConfig(recipe("remeshed", {{"source", "external"}, {"path", "remeshed"}}),
-                                      "remeshed.json", dir);
+    r->remeshConfig =
+        parseBakeConfig(recipe("remeshed", {{"source", "external"}, {"path", "remeshed"}}), "remeshed.json", dir);
     BakeRunOptions o;
     o.log = [r](const std::string& l) { r->remeshLog.push_back(l); };
     r->remeshBake = runBake(r->remeshConfig, o);
@@ -335,8 +345,10 @@ TEST(BakeExternal, FilesFromTheExportGiveTheBuiltInBakesModelAndAReMeshedGarment
   double worldMax = 0, preSkinMax = 0, mapMean = 0;
   for (size_t i = 0; i < da.poses.size(); ++i) {
     ASSERT_EQ(da.poses[i].id, db.poses[i].id);
-    worldMax = std::max(worldMax, double((da.poses[i].gameMeshWorld - db.poses[i].gameMeshWorld).cwiseAbs().maxCoeff()));
-    preSkinMax = std::max(preSkinMax, double((da.poses[i].gameMeshPreSkin - db.poses[i].gameMeshPreSkin).cwiseAbs().maxCoeff()));
+    worldMax =
+        std::max(worldMax, double((da.poses[i].gameMeshWorld - db.poses[i].gameMeshWorld).cwiseAbs().maxCoeff()));
+    preSkinMax =
+        std::max(preSkinMax, double((da.poses[i].gameMeshPreSkin - db.poses[i].gameMeshPreSkin).cwiseAbs().maxCoeff()));
     const auto& ma = da.poses[i].normalMap.xy;
     const auto& mb = db.poses[i].normalMap.xy;
     ASSERT_EQ(ma.size(), mb.size());
@@ -351,15 +363,16 @@ TEST(BakeExternal, FilesFromTheExportGiveTheBuiltInBakesModelAndAReMeshedGarment
     modelMax = std::max(modelMax, s.maxMm);
     modelMean += s.meanMm / double(da.poses.size());
   }
-  std::printf("OBJ round trip (6 decimals): dataset world shapes max %.3g m, pre-skin max %.3g m, normal maps worst "
-              "pose mean %.3g; model predictions mean %.4f mm, max %.4f mm over %zu poses\n",
-              worldMax, preSkinMax, mapMean, modelMean, modelMax, da.poses.size());
+  std::printf(
+      "OBJ round trip (6 decimals): dataset world shapes max %.3g m, pre-skin max %.3g m, normal maps worst "
+      "pose mean %.3g; model predictions mean %.4f mm, max %.4f mm over %zu poses\n",
+      worldMax, preSkinMax, mapMean, modelMean, modelMax, da.poses.size());
   RecordProperty("dataset_world_max_m", std::to_string(worldMax));
   RecordProperty("model_max_mm", std::to_string(modelMax));
-  EXPECT_LT(worldMax, 5e-6);    // 0.5 um rounding, through smoothing (a few ulps of metre-scale floats)
+  EXPECT_LT(worldMax, 5e-6);  // 0.5 um rounding, through smoothing (a few ulps of metre-scale floats)
   EXPECT_LT(preSkinMax, 5e-6);
-  EXPECT_LT(mapMean, 1e-3);     // normal-map components in [-1, 1]
-  EXPECT_LT(modelMax, 0.05);    // 50 um anywhere on the garment
+  EXPECT_LT(mapMean, 1e-3);   // normal-map components in [-1, 1]
+  EXPECT_LT(modelMax, 0.05);  // 50 um anywhere on the garment
 
   // The re-meshed garment (closest-point binding), with one result missing and one broken.
   {
@@ -392,7 +405,8 @@ TEST(BakeExternal, FilesFromTheExportGiveTheBuiltInBakesModelAndAReMeshedGarment
     double mean = 0, worstMean = 0, max = 0;
     std::vector<double> all;
     for (const DatasetPose& c : dc.poses) {
-      const auto it = std::find_if(da.poses.begin(), da.poses.end(), [&](const DatasetPose& x) { return x.id == c.id; });
+      const auto it =
+          std::find_if(da.poses.begin(), da.poses.end(), [&](const DatasetPose& x) { return x.id == c.id; });
       ASSERT_NE(it, da.poses.end());
       const Stats s = vertexError(c.gameMeshWorld, it->gameMeshWorld);
       for (Eigen::Index v = 0; v < c.gameMeshWorld.rows(); ++v)
@@ -403,8 +417,10 @@ TEST(BakeExternal, FilesFromTheExportGiveTheBuiltInBakesModelAndAReMeshedGarment
     }
     std::sort(all.begin(), all.end());
     const double p99 = all[all.size() * 99 / 100];
-    std::printf("re-meshed garment bound by closest point: game mesh vs built-in, mean %.3f mm (worst pose %.3f mm), "
-                "p99 %.3f mm, max %.3f mm over %zu poses\n", mean, worstMean, p99, max, dc.poses.size());
+    std::printf(
+        "re-meshed garment bound by closest point: game mesh vs built-in, mean %.3f mm (worst pose %.3f mm), "
+        "p99 %.3f mm, max %.3f mm over %zu poses\n",
+        mean, worstMean, p99, max, dc.poses.size());
     RecordProperty("remesh_mean_mm", std::to_string(mean));
     RecordProperty("remesh_p99_mm", std::to_string(p99));
     RecordProperty("remesh_max_mm", std::to_string(max));

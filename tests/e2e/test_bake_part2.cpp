@@ -12,12 +12,12 @@
 #include "support/error_message.hpp"
 #include "support/random_model.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/bake/pipeline/bake_pipeline.hpp"
-#include "swish/bake/report/bake_report.hpp"
 #include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/pipeline/part2_training.hpp"
-#include "swish/core/skinning.hpp"
+#include "swish/bake/report/bake_report.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/skinning.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/reference_frame.hpp"
@@ -55,7 +55,8 @@ Dataset syntheticDataset(uint64_t seed, int poses, uint32_t mapSize) {
     const Eigen::Vector3f drive(std::sin(2.f * th[1]), th[4] * th[7], std::cos(3.f * th[13]));
     VecXf pre = Eigen::Map<const VecXf>(base.gameMesh.positions.data(), Eigen::Index(3 * n)) + fields * drive;
     p.gameMeshPreSkin = Eigen::Map<const Points3f>(pre.data(), Eigen::Index(n), 3);
-    p.gameMeshWorld = skinPositions(p.gameMeshPreSkin, base.gameMesh.skin, ds.character.skeleton.skinningMatrices(p.pose));
+    p.gameMeshWorld =
+        skinPositions(p.gameMeshPreSkin, base.gameMesh.skin, ds.character.skeleton.skinningMatrices(p.pose));
     p.normalMap = {mapSize, mapSize, std::vector<float>(size_t(mapSize) * mapSize * 2)};
     for (uint32_t y = 0; y < mapSize; ++y)
       for (uint32_t x = 0; x < mapSize; ++x) {
@@ -155,7 +156,8 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
   BakeTrainSettings st = smallTraining();
   st.normalCodeDims = 0;
   const auto& joints = ds.character.skeleton.joints;
-  const std::string j0 = joints[ds.inputJoints[0]].name, j1 = joints[ds.inputJoints[1]].name, j2 = joints[ds.inputJoints[2]].name;
+  const std::string j0 = joints[ds.inputJoints[0]].name, j1 = joints[ds.inputJoints[1]].name,
+                    j2 = joints[ds.inputJoints[2]].name;
 
   st.inputJoints = {j2, j0, j1};
   const BakeTrainOutput all = trainBake(ds, st);
@@ -171,7 +173,9 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
       << all.evaluation.regressionMm.mean << " vs " << third.evaluation.regressionMm.mean;
 
   st.inputJoints = {j0, "NoSuchJoint"};
-  EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("train.input_joints: the character 'synthetic' has no joint 'NoSuchJoint'"),
+  EXPECT_NE(test::errorOf([&] {
+              trainBake(ds, st);
+            }).find("train.input_joints: the character 'synthetic' has no joint 'NoSuchJoint'"),
             std::string::npos);
   st.inputJoints = {j0, j1, j0};
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("joint '" + j0 + "' is named twice"), std::string::npos);
@@ -187,11 +191,18 @@ TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {
     for (const auto& p : ds.poses) w.writePose(p);
     w.writeManifest();
   }
-  const BakeConfig cfg = parseBakeConfig(
-      {{"name", "tiny"}, {"output", "out"}, {"dataset", "dataset"},
-       {"train", {{"mesh_components", 4}, {"normal_code_dims", 3}, {"database_size", 8}, {"codebook_size", 64},
-                  {"hidden_layers", 2}, {"max_epochs", 60}, {"patience", 20}}}},
-      "tiny.json", dir);
+  const BakeConfig cfg = parseBakeConfig({{"name", "tiny"},
+                                          {"output", "out"},
+                                          {"dataset", "dataset"},
+                                          {"train",
+                                           {{"mesh_components", 4},
+                                            {"normal_code_dims", 3},
+                                            {"database_size", 8},
+                                            {"codebook_size", 64},
+                                            {"hidden_layers", 2},
+                                            {"max_epochs", 60},
+                                            {"patience", 20}}}},
+                                         "tiny.json", dir);
   std::vector<std::string> lines;
   BakeRunOptions o;
   o.log = [&](const std::string& l) { lines.push_back(l); };

@@ -19,8 +19,8 @@
 #include "support/gpu_test.hpp"
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/core/error.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
@@ -45,14 +45,25 @@ nlohmann::json smallConfig() {
             {"clips", {kClip.string()}},
             {"thinning", {{"target_poses", 30}}},
             {"simulation",
-             {{"vertices", 0}, {"transition_seconds", 0.3}, {"settle_seconds", 0.2}, {"frame_rate", 20},
-              {"threads", 2}, {"gravity", 0}}},
+             {{"vertices", 0},
+              {"transition_seconds", 0.3},
+              {"settle_seconds", 0.2},
+              {"frame_rate", 20},
+              {"threads", 2},
+              {"gravity", 0}}},
             {"normal_maps", {{"size", 16}, {"dilation_rings", 2}}},
             {"preview", {{"poses", 2}, {"size", 96}}}}},
           {"train",
-           {{"mesh_components", 8}, {"normal_code_dims", 4}, {"database_size", 8}, {"codebook_size", 32},
-            {"hidden_layers", 2}, {"hidden_width", 16}, {"max_epochs", 150}, {"patience", 40},
-            {"test_fraction", 0.15}, {"bc5_baseline", false}}}};
+           {{"mesh_components", 8},
+            {"normal_code_dims", 4},
+            {"database_size", 8},
+            {"codebook_size", 32},
+            {"hidden_layers", 2},
+            {"hidden_width", 16},
+            {"max_epochs", 150},
+            {"patience", 40},
+            {"test_fraction", 0.15},
+            {"bc5_baseline", false}}}};
 }
 
 // One bake shared by the tests below (it is the expensive part).

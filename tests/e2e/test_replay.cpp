@@ -47,7 +47,8 @@ class ReplayE2E : public test::GpuTest {
     spec.bodyCapsules = 6;  // the push-out runs, and the GPU-vs-CPU checks cover it
     model_ = test::makeRandomModel(rng, spec);
     // What the bake records of its evaluation on held-out poses (part2_training.cpp).
-    model_.metadata = R"({"errors": {"held_out_poses": 7, "vertex_total": {"mean_mm": 1.5, "p95_mm": 3, "max_mm": 4}}})";
+    model_.metadata =
+        R"({"errors": {"held_out_poses": 7, "vertex_total": {"mean_mm": 1.5, "p95_mm": 3, "max_mm": 4}}})";
     saveModel(model_, dir_ / "m.swish");
     writeStream("walk.json", rng, 6, {});
   }
@@ -57,7 +58,8 @@ class ReplayE2E : public test::GpuTest {
   }
 
   // A pose stream of `frames` random poses; `edit` may spoil some.
-  void writeStream(const std::string& name, Rng& rng, int frames, const std::function<void(replay::PoseStream&)>& edit) {
+  void writeStream(const std::string& name, Rng& rng, int frames,
+                   const std::function<void(replay::PoseStream&)>& edit) {
     replay::PoseStream s;
     s.framesPerSecond = 30;
     for (const auto& j : model_.skeleton.joints) s.joints.push_back(j.name);
@@ -74,11 +76,15 @@ class ReplayE2E : public test::GpuTest {
   }
 
   json sceneJson(const std::vector<std::string>& streams) const {
-    json j{{"name", "e2e"}, {"frames", {{"count", 5}, {"rate", 30}}},
+    json j{{"name", "e2e"},
+           {"frames", {{"count", 5}, {"rate", 30}}},
            {"outputs", {{"directory", "out"}, {"render", true}, {"gpuCheckEvery", 2}}}};
     for (size_t i = 0; i < streams.size(); ++i)
-      j["characters"].push_back({{"name", "c" + std::to_string(i)}, {"model", "m.swish"}, {"poseStream", streams[i]},
-                                 {"placement", {{"translation", {double(i), 0.0, 0.0}}, {"yawDegrees", 30.0 * double(i)}}}});
+      j["characters"].push_back(
+          {{"name", "c" + std::to_string(i)},
+           {"model", "m.swish"},
+           {"poseStream", streams[i]},
+           {"placement", {{"translation", {double(i), 0.0, 0.0}}, {"yawDegrees", 30.0 * double(i)}}}});
     return j;
   }
   runtime::Scene scene(const json& j) const { return runtime::parseScene(j, dir_ / "scene.json"); }
@@ -118,15 +124,16 @@ TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
   EXPECT_EQ(rep["models"][0]["heldOutErrors"]["held_out_poses"], 7);
   EXPECT_TRUE(rep["truth"]["available"].get<bool>());
   // No bake character behind a random model: penetration is not measured, and the report says why.
-  EXPECT_NE(rep["penetration"]["note"].get<std::string>().find("not measured"), std::string::npos) << rep["penetration"];
+  EXPECT_NE(rep["penetration"]["note"].get<std::string>().find("not measured"), std::string::npos)
+      << rep["penetration"];
   EXPECT_TRUE(rep["penetration"]["pushOut"].get<bool>());
   EXPECT_FALSE(rep["penetration"].contains("overall"));
   std::ifstream md(dir_ / "out/report.md");
   const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("7 held-out poses, simulated): vertex error mean 1.5 mm, p95 3 mm"), std::string::npos) << text;
   EXPECT_TRUE(rep["frames"][0]["gpuVsCpu"]["maxPositionErrorMm"].is_number());
-  for (const char* f : {"report.md", "plots/time_per_frame.svg", "plots/time_per_stage.svg", "plots/error_per_frame.svg",
-                        "plots/error_vs_time.svg"})
+  for (const char* f : {"report.md", "plots/time_per_frame.svg", "plots/time_per_stage.svg",
+                        "plots/error_per_frame.svg", "plots/error_vs_time.svg"})
     EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".partial-"), std::string::npos);
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
@@ -200,7 +207,8 @@ TEST_F(ReplayE2E, FarFromTheOriginTheLocalMeshIsTheSame) {
     // their spacing there is about 1 mm).
     const auto& place = s.characters[1].placement;
     for (Eigen::Index v = 0; v < b.rows(); ++v)
-      EXPECT_NEAR((place.apply(b.row(v).transpose()) - place.translation - b.row(v).transpose().cast<double>()).norm(), 0.0, 1e-9);
+      EXPECT_NEAR((place.apply(b.row(v).transpose()) - place.translation - b.row(v).transpose().cast<double>()).norm(),
+                  0.0, 1e-9);
   }
 }
 
@@ -214,7 +222,9 @@ TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
     replay::ReplayOptions o;
     o.context = &ctx();
     std::vector<Points3f> out;
-    o.onCharacterOutput = [&](uint32_t, uint32_t, const runtime::ReferenceFrameOutputs& r, uint32_t i) { out.push_back(r.positions[i]); };
+    o.onCharacterOutput = [&](uint32_t, uint32_t, const runtime::ReferenceFrameOutputs& r, uint32_t i) {
+      out.push_back(r.positions[i]);
+    };
     replay::ReplayEngine engine(s, lib, o);
     *plan = engine.plan();
     const replay::ReplayResult r = engine.run();
@@ -243,13 +253,13 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
     ro.normalMaps = ro.tangentFrames = maps;
     gpu::FrameRecorder rec(ctx(), g, 3, ro);
     uint64_t model = 0, frame = 0;
-    for (const gpu::Buffer* b : {&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets,
-                                 &g.normalTriangles, &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook,
-                                 &g.indices})
+    for (const gpu::Buffer* b :
+         {&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets, &g.normalTriangles,
+          &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook, &g.indices})
       model += b->size();
     const auto& f = rec.frame(0);
-    for (const gpu::Buffer* b : {&f.meshWeights, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions, &f.normals,
-                                 &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
+    for (const gpu::Buffer* b : {&f.meshWeights, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions,
+                                 &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
       frame += b->handle() ? b->size() : 0;  // blendedTexels: none where the images share its memory
     frame += uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4;
     // Shared texels need a device that samples linear 2D arrays (and lays them out tightly): lavapipe does.
@@ -300,8 +310,10 @@ TEST_F(ReplayE2E, AClipWithOtherJointNamesPlaysThroughItsJointMap) {
   }
   const fs::path map = test::sourceDir() / "assets/joint_maps/cmu_daz.json";
   json j{{"name", "daz"}, {"frames", {{"count", 3}, {"rate", 30}}}, {"outputs", {{"directory", "out"}}}};
-  j["characters"].push_back({{"name", "walker"}, {"model", "default"},
-                             {"animation", {{"file", clip.string()}, {"timeOffset", 1.0}, {"jointMap", map.string()}}}});
+  j["characters"].push_back(
+      {{"name", "walker"},
+       {"model", "default"},
+       {"animation", {{"file", clip.string()}, {"timeOffset", 1.0}, {"jointMap", map.string()}}}});
   const auto r = replay::runReplayJob(scene(j), jobOptions());
   EXPECT_FALSE(r.result.failed()) << (r.result.failures.empty() ? "" : r.result.failures[0]);
   const json rep = json::parse(std::ifstream(dir_ / "out/report.json"));
@@ -323,7 +335,8 @@ TEST_F(ReplayE2E, AClipWithOtherJointNamesPlaysThroughItsJointMap) {
     replay::runReplayJob(scene(j), jobOptions());
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("characters[0].animation.jointMap.chest.shares"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("characters[0].animation.jointMap.chest.shares"), std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }

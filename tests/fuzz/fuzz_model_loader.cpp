@@ -10,8 +10,8 @@
 // exception type, an allocation over -malloc_limit_mb) is a finding. A model that loads must survive
 // serialize -> deserialize -> serialize with identical bytes.
 #include <cstdint>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <span>
 #include <vector>
 

@@ -28,7 +28,8 @@ std::vector<uint8_t> withFutureSection(const std::vector<uint8_t>& file) {
   w.u64(file.size() + swish::kModelSectionHeaderBytes + payload.size());
   w.u32(0);
   w.u32(swish::crc32(std::span<const uint8_t>(w.data().data(), 28)));
-  w.bytes(std::span<const uint8_t>(file.data() + swish::kModelFileHeaderBytes, file.size() - swish::kModelFileHeaderBytes));
+  w.bytes(
+      std::span<const uint8_t>(file.data() + swish::kModelFileHeaderBytes, file.size() - swish::kModelFileHeaderBytes));
   w.text("NEWS");
   w.u64(payload.size());
   w.u32(swish::crc32(payload.data()));

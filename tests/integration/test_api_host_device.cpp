@@ -12,11 +12,11 @@
 #include <cstdio>
 #include <vector>
 
+#include "support/api_host_fixture.hpp"
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
 #include "swish/runtime/frame_evaluator.hpp"
 #include "swish/runtime/reference_frame.hpp"
-#include "support/api_host_fixture.hpp"
 
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"  // Vulkan structs: other members zero on purpose
 
@@ -60,9 +60,11 @@ struct HostFrames {
   std::vector<VkCommandBuffer> cmds;
   std::vector<VkFence> fences;
   HostFrames(VkDevice d, uint32_t family, uint32_t n) : dev(d), cmds(n), fences(n) {
-    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO, nullptr, VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, family};
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO, nullptr,
+                                VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, family};
     vkCreateCommandPool(dev, &pci, nullptr, &pool);
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY, n};
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
+                                   VK_COMMAND_BUFFER_LEVEL_PRIMARY, n};
     vkAllocateCommandBuffers(dev, &ai, cmds.data());
     for (auto& f : fences) {
       VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO, nullptr, VK_FENCE_CREATE_SIGNALED_BIT};
@@ -159,7 +161,8 @@ TEST(ApiHostDevice, RecordsIntoHostCommandBuffersAcrossFramesInFlight) {
     in.instanceCount = characters;
     in.meshWeights = o.meshWeights;
     for (uint32_t c = 0; c < characters; ++c)
-      for (const Mat4f& s : model.skeleton.skinningMatrices(poses.internal[c])) in.skinMatrices.push_back(poses.worlds[c] * s);
+      for (const Mat4f& s : model.skeleton.skinningMatrices(poses.internal[c]))
+        in.skinMatrices.push_back(poses.worlds[c] * s);
     in.selectedMaps = o.mapIndex;
     in.blendAlpha = o.blendAlpha;
     refs[f] = runtime::referenceFrame(model, in, prevMaps);
@@ -191,7 +194,8 @@ TEST(ApiHostDevice, RecordsIntoHostCommandBuffersAcrossFramesInFlight) {
       const auto map = batch.readBackNormalMap(f, c);
       ASSERT_EQ(map.size(), refs[f].normalMaps[c].xy.size());
       int maxDiff = 0;
-      for (size_t t = 0; t < map.size(); ++t) maxDiff = std::max(maxDiff, std::abs(int(map[t]) - int(refs[f].normalMaps[c].xy[t])));
+      for (size_t t = 0; t < map.size(); ++t)
+        maxDiff = std::max(maxDiff, std::abs(int(map[t]) - int(refs[f].normalMaps[c].xy[t])));
       EXPECT_LE(maxDiff, int(f) + 1) << "1 LSB per blend (see test_whole_frame.cpp)";
     }
   // Older frames are no longer held.
@@ -295,7 +299,8 @@ TEST(ApiHostDevice, ErrorsComeAsValuesOrExceptionsWithCodes) {
     }
     return api::ErrorCode::Internal;
   };
-  EXPECT_EQ(codeOf([&] { batch.recordFrame(cmd, 0, std::span(poses.poses).first(1)); }), api::ErrorCode::InvalidArgument);
+  EXPECT_EQ(codeOf([&] { batch.recordFrame(cmd, 0, std::span(poses.poses).first(1)); }),
+            api::ErrorCode::InvalidArgument);
   auto shortPose = poses.poses;
   shortPose[1].localRotations = shortPose[1].localRotations.first(1);
   EXPECT_EQ(codeOf([&] { batch.recordFrame(cmd, 0, shortPose); }), api::ErrorCode::InvalidArgument);

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "support/api_host_fixture.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/io/png.hpp"
@@ -26,7 +27,6 @@
 #include "swish/render/preview_renderer.hpp"
 #include "swish/runtime/frame_evaluator.hpp"
 #include "swish/runtime/reference_frame.hpp"
-#include "support/api_host_fixture.hpp"
 
 namespace swish {
 namespace {
@@ -59,7 +59,8 @@ ApiPose toApi(const Pose& p) {
 }
 
 // Inclusive point-in-triangle test at pixel centres: the CPU rasterisation of a mesh's silhouette.
-std::vector<uint8_t> rasterMask(const Points3f& positions, const Triangles& tris, const api::Mat4& vp, uint32_t w, uint32_t h) {
+std::vector<uint8_t> rasterMask(const Points3f& positions, const Triangles& tris, const api::Mat4& vp, uint32_t w,
+                                uint32_t h) {
   std::vector<uint8_t> mask(size_t(w) * h, 0);
   std::vector<std::array<float, 3>> px(size_t(positions.rows()));
   for (Eigen::Index v = 0; v < positions.rows(); ++v)
@@ -69,8 +70,10 @@ std::vector<uint8_t> rasterMask(const Points3f& positions, const Triangles& tris
     if (a[2] <= 0 || b[2] <= 0 || c[2] <= 0) continue;
     const float area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
     if (area == 0) continue;
-    const int x0 = std::max(0, int(std::floor(std::min({a[0], b[0], c[0]})))), x1 = std::min(int(w) - 1, int(std::ceil(std::max({a[0], b[0], c[0]}))));
-    const int y0 = std::max(0, int(std::floor(std::min({a[1], b[1], c[1]})))), y1 = std::min(int(h) - 1, int(std::ceil(std::max({a[1], b[1], c[1]}))));
+    const int x0 = std::max(0, int(std::floor(std::min({a[0], b[0], c[0]})))),
+              x1 = std::min(int(w) - 1, int(std::ceil(std::max({a[0], b[0], c[0]}))));
+    const int y0 = std::max(0, int(std::floor(std::min({a[1], b[1], c[1]})))),
+              y1 = std::min(int(h) - 1, int(std::ceil(std::max({a[1], b[1], c[1]}))));
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const float X = x + 0.5f, Y = y + 0.5f;
@@ -140,7 +143,8 @@ TEST_F(PreviewRender, KnownFramesDrawTheJerseyOnTheMannequin) {
     // Where the jersey's centroid projects, the image shows the jersey: red-dominant.
     const api::DeformedMesh jersey = preview.lastJersey();
     render::Vec3 centroid{0, 0, 0};
-    for (size_t v = 0; v < jersey.positions.size(); ++v) centroid[v % 3] += jersey.positions[v] / float(jersey.positions.size() / 3);
+    for (size_t v = 0; v < jersey.positions.size(); ++v)
+      centroid[v % 3] += jersey.positions[v] / float(jersey.positions.size() / 3);
     const auto at = render::projectToPixel(preview.viewProjection(), centroid, o.width, o.height);
     ASSERT_TRUE(at[0] >= 0 && at[0] < o.width && at[1] >= 0 && at[1] < o.height);
     const uint8_t* c = pixel(img, o.width, 0, uint32_t(at[0]), uint32_t(at[1]));
@@ -177,7 +181,8 @@ TEST_F(PreviewRender, JerseySilhouetteMatchesTheCpuReferenceProjection) {
   in.meshWeights = out.meshWeights;
   in.skinMatrices = model_.skeleton.skinningMatrices(pose);
   const auto ref = runtime::referenceFrame(model_, in);
-  const auto cpuMask = rasterMask(ref.positions[0], model_.gameMesh.triangles, preview.viewProjection(), o.width, o.height);
+  const auto cpuMask =
+      rasterMask(ref.positions[0], model_.gameMesh.triangles, preview.viewProjection(), o.width, o.height);
 
   size_t inter = 0, uni = 0, gpuCount = 0;
   for (uint32_t y = 0; y < o.height; ++y)
@@ -211,11 +216,13 @@ TEST_F(PreviewRender, NormalMapOffChangesShadingInsideTheJerseyOnly) {
       const uint8_t* on = pixel(img, o.width, 0, x, y);
       const uint8_t* off = pixel(img, o.width, 1, x, y);
       const bool inJersey = pixel(img, o.width, 2, x, y)[3] > 0;
-      const bool changed = std::abs(on[0] - off[0]) + std::abs(on[1] - off[1]) + std::abs(on[2] - off[2]) > 0 || on[3] != off[3];
+      const bool changed =
+          std::abs(on[0] - off[0]) + std::abs(on[1] - off[1]) + std::abs(on[2] - off[2]) > 0 || on[3] != off[3];
       jersey += inJersey;
       (inJersey ? changedInside : changedOutside) += changed;
     }
-  std::printf("jersey pixels %zu, changed by the normal map: %zu inside, %zu outside\n", jersey, changedInside, changedOutside);
+  std::printf("jersey pixels %zu, changed by the normal map: %zu inside, %zu outside\n", jersey, changedInside,
+              changedOutside);
   EXPECT_EQ(changedOutside, 0u) << "the normal map must not change anything outside the jersey";
   // The stand-in's wrinkle maps tilt normals over most of the garment: most visible jersey pixels
   // shade differently (a map that failed to bind, or was all zeros, would change none).

@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <limits>
 
+#include "support/cloth_fixture.hpp"
 #include "support/paths.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/cloth_constraints.hpp"
 #include "swish/bake/cloth/cloth_solver.hpp"
-#include "swish/bake/character/default_character.hpp"
 #include "swish/io/character_import.hpp"
-#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;
@@ -60,7 +60,8 @@ void expectStable(const PoseSimulation& r, const ClothSimSettings& s, const std:
 // The 99th percentile of edge strain: the bulk of the garment, where a handful of sub-millimetre
 // game-mesh edges would otherwise decide the figure.
 float strainPercentile99(const ClothSolver& solver, const Points3f& x) {
-  const ClothConstraints cc = buildClothConstraints(solver.mesh(), solver.mesh().restPositions, solver.settings().material);
+  const ClothConstraints cc =
+      buildClothConstraints(solver.mesh(), solver.mesh().restPositions, solver.settings().material);
   std::vector<float> strain;
   for (const DistanceConstraint& c : cc.stretch) strain.push_back(((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
   std::nth_element(strain.begin(), strain.begin() + std::ptrdiff_t(strain.size() * 99 / 100), strain.end());

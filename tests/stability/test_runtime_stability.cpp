@@ -20,7 +20,6 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-
 bool allFinite(std::span<const float> v) {
   for (float x : v)
     if (!std::isfinite(x)) return false;
@@ -29,8 +28,8 @@ bool allFinite(std::span<const float> v) {
 
 // Values a hostile or broken animation source can produce.
 std::vector<float> nastyFloats() {
-  return {0.f, -0.f, 1.f, -1.f, 1e-30f, -1e-30f, std::numeric_limits<float>::denorm_min(), 1e20f, -1e20f, 1e30f,
-          FLT_MAX, -FLT_MAX, kInf, -kInf, kNaN};
+  return {0.f,   -0.f,    1.f,      -1.f, 1e-30f, -1e-30f, std::numeric_limits<float>::denorm_min(), 1e20f, -1e20f,
+          1e30f, FLT_MAX, -FLT_MAX, kInf, -kInf,  kNaN};
 }
 
 }  // namespace

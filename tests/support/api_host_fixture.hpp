@@ -39,11 +39,11 @@ inline std::unique_ptr<render::HostDevice> makeHostDeviceOrSkip() {
   }
 }
 
-#define SWISH_HOST_DEVICE_OR_SKIP(var)                                   \
-  auto var = ::swish::test::makeHostDeviceOrSkip();                      \
-  if (!var) {                                                            \
-    if (::testing::Test::HasFailure()) return;                           \
-    GTEST_SKIP() << "no usable Vulkan device (see the message above)";   \
+#define SWISH_HOST_DEVICE_OR_SKIP(var)                                 \
+  auto var = ::swish::test::makeHostDeviceOrSkip();                    \
+  if (!var) {                                                          \
+    if (::testing::Test::HasFailure()) return;                         \
+    GTEST_SKIP() << "no usable Vulkan device (see the message above)"; \
   }
 
 inline void expectNoValidationMessages(const render::HostDevice& d) {

@@ -9,10 +9,10 @@
 namespace swish::test {
 
 struct CapsuleSpec {
-  float radius = 0.12f;       // body
+  float radius = 0.12f;                  // body
   float axisLow = 0.f, axisHigh = 0.7f;  // capsule axis along +y (hemispheres beyond)
-  int around = 32, rows = 28;           // body tessellation of the cylinder part
-  float gap = 0.012f;         // garment off the body
+  int around = 32, rows = 28;            // body tessellation of the cylinder part
+  float gap = 0.012f;                    // garment off the body
   float garmentLow = 0.05f, garmentHigh = 0.62f;
   int garmentAround = 40, garmentRows = 24;
   Vec3f offset = Vec3f::Zero();  // the whole character moved (huge-coordinate tests)

@@ -14,7 +14,8 @@ std::string CheckedInput::unchanged(gpu::Context& ctx) const {
   buffer_.download(ctx, now.data(), now.size());
   for (size_t i = 0; i < now.size(); ++i)
     if (now[i] != bytes_[i])
-      return "input '" + buffer_.name() + "' changed at byte " + std::to_string(i) + " of " + std::to_string(now.size());
+      return "input '" + buffer_.name() + "' changed at byte " + std::to_string(i) + " of " +
+             std::to_string(now.size());
   return "";
 }
 

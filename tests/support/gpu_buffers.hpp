@@ -18,7 +18,8 @@ class CheckedInput {
  public:
   template <class T>
   CheckedInput(gpu::Context& ctx, std::span<const T> data, const std::string& name)
-      : bytes_(reinterpret_cast<const uint8_t*>(data.data()), reinterpret_cast<const uint8_t*>(data.data()) + data.size_bytes()),
+      : bytes_(reinterpret_cast<const uint8_t*>(data.data()),
+               reinterpret_cast<const uint8_t*>(data.data()) + data.size_bytes()),
         buffer_(ctx, bytes_.size(), gpu::MemoryKind::DeviceLocal, name) {
     buffer_.upload(ctx, bytes_.data(), bytes_.size());
   }

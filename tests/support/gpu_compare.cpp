@@ -5,10 +5,12 @@
 
 namespace swish::test {
 
-::testing::AssertionResult matchesReference(const std::string& what, std::span<const float> gpu, std::span<const float> ref,
-                                            const std::function<double(size_t)>& tolerance, CompareReport* report) {
+::testing::AssertionResult matchesReference(const std::string& what, std::span<const float> gpu,
+                                            std::span<const float> ref, const std::function<double(size_t)>& tolerance,
+                                            CompareReport* report) {
   if (gpu.size() != ref.size())
-    return ::testing::AssertionFailure() << what << ": " << gpu.size() << " GPU values, " << ref.size() << " reference values";
+    return ::testing::AssertionFailure() << what << ": " << gpu.size() << " GPU values, " << ref.size()
+                                         << " reference values";
   CompareReport r;
   r.compared = gpu.size();
   size_t bad = 0;
@@ -32,7 +34,8 @@ namespace swish::test {
   }
   if (report) *report = r;
   if (bad == 0) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << what << ": " << bad << " of " << gpu.size() << " values differ" << first.str();
+  return ::testing::AssertionFailure() << what << ": " << bad << " of " << gpu.size() << " values differ"
+                                       << first.str();
 }
 
 }  // namespace swish::test

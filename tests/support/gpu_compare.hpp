@@ -18,7 +18,8 @@ struct CompareReport {
   double maxAbsError = 0;  // over finite elements
 };
 
-::testing::AssertionResult matchesReference(const std::string& what, std::span<const float> gpu, std::span<const float> ref,
-                                            const std::function<double(size_t)>& tolerance, CompareReport* report = nullptr);
+::testing::AssertionResult matchesReference(const std::string& what, std::span<const float> gpu,
+                                            std::span<const float> ref, const std::function<double(size_t)>& tolerance,
+                                            CompareReport* report = nullptr);
 
 }  // namespace swish::test

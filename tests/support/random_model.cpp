@@ -39,7 +39,8 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
     Joint j;
     j.name = "joint" + std::to_string(i);
     j.parent = i == 0 ? -1 : int(rng.below(i));
-    j.rest.translation = i == 0 ? Vec3f(0, 1, 0) : Vec3f(rng.uniformf(-.1f, .1f), rng.uniformf(.05f, .15f), rng.uniformf(-.05f, .05f));
+    j.rest.translation =
+        i == 0 ? Vec3f(0, 1, 0) : Vec3f(rng.uniformf(-.1f, .1f), rng.uniformf(.05f, .15f), rng.uniformf(-.05f, .05f));
     j.rest.rotation = Quatf::Identity();
     m.skeleton.joints.push_back(j);
   }
@@ -124,7 +125,8 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
     BodyCapsule cap;
     cap.joint = uint32_t(rng.below(s.joints));
     cap.a = Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
-    cap.b = c % 4 == 3 ? cap.a : Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
+    cap.b = c % 4 == 3 ? cap.a
+                       : Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
     cap.radius = rng.uniformf(0.005f, 0.05f);
     m.bodyProxy.capsules.push_back(cap);
   }

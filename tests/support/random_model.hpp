@@ -16,11 +16,11 @@ struct RandomModelSpec {
   uint32_t meshComponents = 6;  // K
   uint32_t hiddenLayers = 2;
   uint32_t hiddenWidth = 16;
-  uint32_t normalMaps = 4;      // 0: model without a normal-map database
+  uint32_t normalMaps = 4;  // 0: model without a normal-map database
   uint32_t codeDims = 3;
-  uint32_t mapSize = 16;        // width = height, multiple of 4
+  uint32_t mapSize = 16;  // width = height, multiple of 4
   uint32_t codebookSize = 32;
-  uint32_t bodyCapsules = 0;    // body proxy capsules across the mesh (drawn last: other draws unchanged)
+  uint32_t bodyCapsules = 0;  // body proxy capsules across the mesh (drawn last: other draws unchanged)
 };
 
 Model makeRandomModel(Rng& rng, const RandomModelSpec& spec = {});

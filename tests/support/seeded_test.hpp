@@ -9,6 +9,6 @@
 
 #include "support/random_model.hpp"
 
-#define SWISH_TEST_SEED_SCOPE(name, fallback)                          \
+#define SWISH_TEST_SEED_SCOPE(name, fallback)                       \
   const uint64_t name = ::swish::test::announcedTestSeed(fallback); \
   SCOPED_TRACE("seed " + std::to_string(name))

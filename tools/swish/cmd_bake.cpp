@@ -13,15 +13,15 @@
 #include <string>
 #include <vector>
 
-#include "swish/bake/pipeline/bake_config.hpp"
-#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/pose_export.hpp"
-#include "swish/core/error.hpp"
+#include "swish/bake/pipeline/bake_config.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/cluster/pose_list_file.hpp"
 #include "swish/cluster/slurm_bake.hpp"
-#include "swish/io/gltf_export.hpp"
 #include "swish/command.hpp"
+#include "swish/core/error.hpp"
+#include "swish/io/gltf_export.hpp"
 
 namespace {
 
@@ -35,11 +35,12 @@ swish::cli::RunFn setup(CLI::App& sub) {
     size_t shardSize = 0;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("config", o->config,
-                 "bake recipe (JSON; schema in src/swish/bake/pipeline/bake_config.hpp). part1.clips takes files, folders, globs "
-                 "(\"mocap/cmu/*.bvh\") and index files ({\"index\": \"mocap/cmu-daz/index.tsv\", \"joint_map\": "
-                 "\"map.json\", \"weights\": {..}}: src/swish/bake/poses/clip_list.hpp); part1.holdout keeps whole subjects "
-                 "out of training and reports the model on them (docs/baking.md)");
+  sub.add_option(
+      "config", o->config,
+      "bake recipe (JSON; schema in src/swish/bake/pipeline/bake_config.hpp). part1.clips takes files, folders, globs "
+      "(\"mocap/cmu/*.bvh\") and index files ({\"index\": \"mocap/cmu-daz/index.tsv\", \"joint_map\": "
+      "\"map.json\", \"weights\": {..}}: src/swish/bake/poses/clip_list.hpp); part1.holdout keeps whole subjects "
+      "out of training and reports the model on them (docs/baking.md)");
   sub.add_option("--write-default-character", o->defaultCharacterGlb,
                  "write the embedded default character (mannequin + jersey, skinned) to a .glb file to look at "
                  "or to use as a starting point, and stop (regenerates assets/default/default_character.glb)");
@@ -123,15 +124,18 @@ swish::cli::RunFn setup(CLI::App& sub) {
       return 0;
     }
     if (o->config.empty()) {
-      std::fprintf(stderr, "swish bake: give a bake recipe (JSON), e.g. 'swish bake assets/default/bake.json'; see --help\n");
+      std::fprintf(stderr,
+                   "swish bake: give a bake recipe (JSON), e.g. 'swish bake assets/default/bake.json'; see --help\n");
       return 2;
     }
     const swish::bake::BakeConfig cfg = swish::bake::loadBakeConfig(o->config);
     if (!o->exportPoses.empty()) {
-      if (!cfg.part1) throw swish::Error(o->config + ": --export-poses needs a \"part1\" section (the poses come from it)");
+      if (!cfg.part1)
+        throw swish::Error(o->config + ": --export-poses needs a \"part1\" section (the poses come from it)");
       const auto log = [](const std::string& l) { std::fprintf(stderr, "%s\n", l.c_str()); };
       const auto r = swish::bake::exportPoses(*cfg.part1, o->exportPoses, log);
-      std::printf("exported %zu poses to %s; read %s/README.md\n", r.poses, o->exportPoses.c_str(), o->exportPoses.c_str());
+      std::printf("exported %zu poses to %s; read %s/README.md\n", r.poses, o->exportPoses.c_str(),
+                  o->exportPoses.c_str());
       return 0;
     }
     if (o->checkOnly) {
@@ -151,12 +155,12 @@ swish::cli::RunFn setup(CLI::App& sub) {
         const auto [training, heldOut] = swish::bake::splitHeldOutSubjects(*cfg.part1);
         std::string names;
         for (const auto& n : cfg.part1->holdoutSubjects) names += (names.empty() ? "" : ", ") + n;
-        std::printf("held-out subjects %s: %zu clip(s) -> %zu evenly spaced frames -> dataset %s (training: %zu clip(s))\n",
-                    names.c_str(), heldOut.clips.size(), cfg.part1->holdoutPoses,
-                    cfg.holdoutDatasetDir().string().c_str(), training.clips.size());
+        std::printf(
+            "held-out subjects %s: %zu clip(s) -> %zu evenly spaced frames -> dataset %s (training: %zu clip(s))\n",
+            names.c_str(), heldOut.clips.size(), cfg.part1->holdoutPoses, cfg.holdoutDatasetDir().string().c_str(),
+            training.clips.size());
       }
-      if (!cfg.part1)
-        std::printf("part 1: none (the dataset %s must exist)\n", cfg.dataset.string().c_str());
+      if (!cfg.part1) std::printf("part 1: none (the dataset %s must exist)\n", cfg.dataset.string().c_str());
       return 0;
     }
     if (o->readClips) {

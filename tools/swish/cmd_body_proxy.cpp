@@ -45,26 +45,32 @@ int runBodyProxy(const BodyProxyOptions& o) {
   std::string note, how;
   const auto character = replay::rebuildBakeCharacter(entry, note, &how);
   if (!character) throw Error(o.model + ": no body to fit the proxy to: " + note);
-  if (character->body.triangleCount() == 0) throw Error(o.model + ": the bake's character '" + character->name + "' has no body mesh");
+  if (character->body.triangleCount() == 0)
+    throw Error(o.model + ": the bake's character '" + character->name + "' has no body mesh");
   bake::BodyProxyFitSettings s;
   s.reach = o.reach;
   const bake::BodyProxyFit fit = bake::fitBodyProxy(character->body, entry.model.skeleton, &entry.model.gameMesh, s);
-  if (fit.proxy.empty()) throw Error(o.model + ": no capsule fits the body of '" + character->name + "' (nothing written)");
-  std::printf("Body of '%s' (%s): %zu (joint, part) groups, %zu capsules kept, %zu dropped; the surfaces checked stand at most "
-              "%.2f mm outside the body.\n",
-              character->name.c_str(), how.c_str(), fit.groups, fit.proxy.capsules.size(), fit.dropped, fit.worstOutsideMm);
+  if (fit.proxy.empty())
+    throw Error(o.model + ": no capsule fits the body of '" + character->name + "' (nothing written)");
+  std::printf(
+      "Body of '%s' (%s): %zu (joint, part) groups, %zu capsules kept, %zu dropped; the surfaces checked stand at most "
+      "%.2f mm outside the body.\n",
+      character->name.c_str(), how.c_str(), fit.groups, fit.proxy.capsules.size(), fit.dropped, fit.worstOutsideMm);
   for (size_t c = 0; c < fit.proxy.capsules.size(); ++c) {
     const BodyCapsule& k = fit.proxy.capsules[c];
-    std::printf("  %-16s radius %5.1f mm, length %5.1f mm\n", fit.capsuleJoints[c].c_str(), 1000.f * k.radius, 1000.f * (k.b - k.a).norm());
+    std::printf("  %-16s radius %5.1f mm, length %5.1f mm\n", fit.capsuleJoints[c].c_str(), 1000.f * k.radius,
+                1000.f * (k.b - k.a).norm());
   }
   entry.model.bodyProxy = fit.proxy;
   saveModel(entry.model, out);
-  std::printf("Wrote %s (format %u.%u).\n", out.string().c_str(), unsigned(kModelFileMajorVersion), unsigned(kModelFileMinorVersion));
+  std::printf("Wrote %s (format %u.%u).\n", out.string().c_str(), unsigned(kModelFileMajorVersion),
+              unsigned(kModelFileMinorVersion));
   return 0;
 }
 
 swish::cli::CommandRegistration reg{
-    "body-proxy", "Fit the run-time push-out's body proxy to the body a model was baked on, and write the model with it",
+    "body-proxy",
+    "Fit the run-time push-out's body proxy to the body a model was baked on, and write the model with it",
     [](CLI::App& app) -> swish::cli::RunFn {
       auto o = std::make_shared<BodyProxyOptions>();
       app.add_option("model", o->model, "the .swish model (its bake metadata names the character)")->required();

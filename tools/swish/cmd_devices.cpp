@@ -13,7 +13,8 @@ struct DevicesOptions {
 
 swish::cli::RunFn setup(CLI::App& app) {
   auto o = std::make_shared<DevicesOptions>();
-  app.add_option("--device", o->device, "Device to select: index or name substring (default: SWISH_DEVICE, else automatic)");
+  app.add_option("--device", o->device,
+                 "Device to select: index or name substring (default: SWISH_DEVICE, else automatic)");
   return [o]() {
     swish::gpu::ContextOptions co;
     co.device = o->device;
@@ -23,13 +24,16 @@ swish::cli::RunFn setup(CLI::App& app) {
     if (devices.empty()) std::printf("no Vulkan devices\n");
     for (const auto& d : devices)
       std::printf("%c %u: %s (%s, Vulkan %u.%u)%s%s\n", int(d.index) == picked ? '*' : ' ', d.index, d.name.c_str(),
-                  swish::gpu::deviceTypeName(d.type), VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion),
+                  swish::gpu::deviceTypeName(d.type), VK_API_VERSION_MAJOR(d.apiVersion),
+                  VK_API_VERSION_MINOR(d.apiVersion),
                   d.usable ? "" : " - unusable: ", d.usable ? "" : d.unusableReason.c_str());
     if (picked < 0) {
       std::printf("no device would be picked: %s\n", why.c_str());
       return 1;
     }
-    std::printf("swish would use device %d (* above); override with --device or SWISH_DEVICE (index or name substring)\n", picked);
+    std::printf(
+        "swish would use device %d (* above); override with --device or SWISH_DEVICE (index or name substring)\n",
+        picked);
     return 0;
   };
 }

@@ -66,7 +66,8 @@ Model generatedModel(Rng& rng, const FramesOptions& o) {
       g.skin.weights.push_back(w[k] / sum);
     }
   }
-  computeVertexFrames(g.positions, g.uvs, g.triangles, buildFrameTopology(g.triangles, g.positions), g.normals, g.tangents);
+  computeVertexFrames(g.positions, g.uvs, g.triangles, buildFrameTopology(g.triangles, g.positions), g.normals,
+                      g.tangents);
   m.meshPca.mean = Eigen::Map<const VecXf>(g.positions.data(), 3 * n);
   m.meshPca.basis = MatXf(3 * n, o.components);
   for (Eigen::Index i = 0; i < m.meshPca.basis.size(); ++i) m.meshPca.basis.data()[i] = float(rng.normal(0, 0.002));
@@ -106,9 +107,10 @@ int run(const FramesOptions& o) {
               ctx.validationEnabled() ? ", validation on" : "");
   Rng rng(o.seed);
   const Model model = generatedModel(rng, o);
-  std::printf("model: %zu vertices, K = %d, %u normal maps of %ux%u; %u characters, %u frames, %u in flight, seed %llu\n",
-              model.gameMesh.vertexCount(), model.meshComponents(), model.normalMaps.mapCount(), model.normalMaps.width,
-              model.normalMaps.height, o.characters, o.frames, o.framesInFlight, (unsigned long long)o.seed);
+  std::printf(
+      "model: %zu vertices, K = %d, %u normal maps of %ux%u; %u characters, %u frames, %u in flight, seed %llu\n",
+      model.gameMesh.vertexCount(), model.meshComponents(), model.normalMaps.mapCount(), model.normalMaps.width,
+      model.normalMaps.height, o.characters, o.frames, o.framesInFlight, (unsigned long long)o.seed);
   gpu::GpuModel gm(ctx, model, "generated model");
   gpu::FrameRecorderOptions fo;
   fo.framesInFlight = o.framesInFlight;
@@ -189,9 +191,12 @@ int run(const FramesOptions& o) {
   double posErr = 0, nrmErr = 0, tanErr = 0;
   int mapErr = 0;
   for (size_t i = 0; i < gpu.positions.size(); ++i) {
-    posErr = std::max(posErr, maxAbsDiff(gpu.positions[i].data(), lastRef.positions[i].data(), size_t(gpu.positions[i].size())));
-    nrmErr = std::max(nrmErr, maxAbsDiff(gpu.normals[i].data(), lastRef.normals[i].data(), size_t(gpu.normals[i].size())));
-    tanErr = std::max(tanErr, maxAbsDiff(gpu.tangents[i].data(), lastRef.tangents[i].data(), size_t(gpu.tangents[i].size())));
+    posErr = std::max(
+        posErr, maxAbsDiff(gpu.positions[i].data(), lastRef.positions[i].data(), size_t(gpu.positions[i].size())));
+    nrmErr =
+        std::max(nrmErr, maxAbsDiff(gpu.normals[i].data(), lastRef.normals[i].data(), size_t(gpu.normals[i].size())));
+    tanErr = std::max(tanErr,
+                      maxAbsDiff(gpu.tangents[i].data(), lastRef.tangents[i].data(), size_t(gpu.tangents[i].size())));
   }
   for (size_t i = 0; i < gpu.normalMaps.size(); ++i)
     for (size_t t = 0; t < gpu.normalMaps[i].xy.size(); ++t)
@@ -205,8 +210,10 @@ int run(const FramesOptions& o) {
   std::printf("  total                                            %8.3f ms  (%.1f us per character)\n", median(total),
               1e3 * median(total) / o.characters);
   std::printf("CPU recording time (median) %.3f ms\n", median(cpuRecord));
-  std::printf("\nlast frame, GPU vs CPU reference: positions %.3g mm, normals %.3g, tangents %.3g, normal maps %d snorm16 LSB\n",
-              posErr * 1e3, nrmErr, tanErr, mapErr);
+  std::printf(
+      "\nlast frame, GPU vs CPU reference: positions %.3g mm, normals %.3g, tangents %.3g, normal maps %d snorm16 "
+      "LSB\n",
+      posErr * 1e3, nrmErr, tanErr, mapErr);
   const bool ok = posErr < 1e-3 && nrmErr < 1e-3 && tanErr < 1e-3 && mapErr <= 2;
   if (ctx.validationEnabled()) {
     std::printf("validation messages: %zu\n", ctx.validationMessageCount());
@@ -226,12 +233,13 @@ swish::cli::RunFn setup(CLI::App& app) {
   app.add_option("--map-size", o->mapSize, "Normal-map width and height (multiple of 4)")->check(CLI::Range(4u, 2048u));
   app.add_option("--frames-in-flight", o->framesInFlight, "Frames in flight")->check(CLI::Range(1u, 8u));
   app.add_option("--seed", o->seed, "Seed of the generated model and inputs");
-  app.add_option("--device", o->device, "Vulkan device: index or name substring (default: SWISH_DEVICE, else automatic)");
+  app.add_option("--device", o->device,
+                 "Vulkan device: index or name substring (default: SWISH_DEVICE, else automatic)");
   app.add_flag("--validation", o->validation, "Enable the Vulkan validation layers (also SWISH_VALIDATION=1)");
   return [o]() { return run(*o); };
 }
 
-swish::cli::CommandRegistration reg{"frames", "Run a GPU frame loop of a generated model and check it against the CPU reference",
-                                    setup};
+swish::cli::CommandRegistration reg{
+    "frames", "Run a GPU frame loop of a generated model and check it against the CPU reference", setup};
 
 }  // namespace

@@ -44,7 +44,8 @@ std::string mlpShape(const Mlp& mlp) {
 nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t fileBytes) {
   using nlohmann::json;
   json j;
-  j["file"] = {{"bytes", fileBytes}, {"formatVersion", std::to_string(info.majorVersion) + "." + std::to_string(info.minorVersion)}};
+  j["file"] = {{"bytes", fileBytes},
+               {"formatVersion", std::to_string(info.majorVersion) + "." + std::to_string(info.minorVersion)}};
   json sections = json::array();
   for (const auto& s : info.sections)
     sections.push_back({{"tag", s.tag}, {"payloadBytes", s.payloadBytes}, {"offset", s.offset}, {"known", s.known}});
@@ -52,33 +53,43 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
 
   json inputs = json::array();
   for (uint32_t idx : m.inputJoints) inputs.push_back({{"index", idx}, {"name", m.skeleton.joints[idx].name}});
-  j["skeleton"] = {{"joints", m.skeleton.size()}, {"inputJoints", inputs},
-                   {"jointsWithSkinWeight", skinnedJointCount(m.gameMesh)}};
+  j["skeleton"] = {
+      {"joints", m.skeleton.size()}, {"inputJoints", inputs}, {"jointsWithSkinWeight", skinnedJointCount(m.gameMesh)}};
 
   json layers = json::array();
   for (const auto& l : m.mlp.layers) layers.push_back({{"in", l.weight.cols()}, {"out", l.weight.rows()}});
-  j["mlp"] = {{"thetaSize", m.thetaSize()}, {"lambdaSize", m.lambdaSize()}, {"layers", layers},
-              {"activation", "SELU after every layer but the last"}, {"parameters", mlpParameters(m.mlp)}};
+  j["mlp"] = {{"thetaSize", m.thetaSize()},
+              {"lambdaSize", m.lambdaSize()},
+              {"layers", layers},
+              {"activation", "SELU after every layer but the last"},
+              {"parameters", mlpParameters(m.mlp)}};
 
   j["meshPca"] = {{"components", m.meshComponents()}};
   const Mesh& g = m.gameMesh;
-  j["gameMesh"] = {{"vertices", g.vertexCount()}, {"triangles", g.triangleCount()},
-                   {"influencesPerVertex", g.skin.influences}, {"hasNormals", g.normals.rows() > 0},
-                   {"hasTangents", g.tangents.rows() > 0}, {"hasUvs", g.uvs.rows() > 0}};
+  j["gameMesh"] = {{"vertices", g.vertexCount()},
+                   {"triangles", g.triangleCount()},
+                   {"influencesPerVertex", g.skin.influences},
+                   {"hasNormals", g.normals.rows() > 0},
+                   {"hasTangents", g.tangents.rows() > 0},
+                   {"hasUvs", g.uvs.rows() > 0}};
 
   const auto& db = m.normalMaps;
   if (db.empty()) {
     j["normalMaps"] = nullptr;
   } else {
-    j["normalMaps"] = {{"maps", db.mapCount()},          {"width", db.width},
-                       {"height", db.height},           {"codeDims", db.codeDims()},
-                       {"codebookEntries", db.codebookSize}, {"codebookBytes", db.codebook.size()},
+    j["normalMaps"] = {{"maps", db.mapCount()},
+                       {"width", db.width},
+                       {"height", db.height},
+                       {"codeDims", db.codeDims()},
+                       {"codebookEntries", db.codebookSize},
+                       {"codebookBytes", db.codebook.size()},
                        {"blockIndices", db.indices.size()}};
   }
   j["temporalFilter"] = {{"timeConstantSeconds", m.temporalFilter.timeConstantSeconds}};
   json capsules = json::array();
   for (const BodyCapsule& c : m.bodyProxy.capsules)
-    capsules.push_back({{"joint", m.skeleton.joints[c.joint].name}, {"radiusM", c.radius}, {"lengthM", (c.b - c.a).norm()}});
+    capsules.push_back(
+        {{"joint", m.skeleton.joints[c.joint].name}, {"radiusM", c.radius}, {"lengthM", (c.b - c.a).norm()}});
   j["bodyProxy"] = {{"capsules", capsules}};
   // Metadata is meant to be JSON; show it as such when it is, as text when it is not.
   const json meta = json::parse(m.metadata, nullptr, /*allow_exceptions=*/false);
@@ -97,10 +108,10 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
   o << "  input joints  " << m.inputJoints.size() << " (Theta = " << m.thetaSize() << " values):";
   for (uint32_t idx : m.inputJoints) o << " " << m.skeleton.joints[idx].name;
   o << "\n";
-  o << "  mlp           " << mlpShape(m.mlp) << " (SELU; " << m.mlp.layers.size() << " layers, "
-    << mlpParameters(m.mlp) << " parameters)\n";
-  o << "  lambda        " << m.lambdaSize() << " = K " << m.meshComponents() << " mesh weights + "
-    << m.normalCodeDims() << " normal-code dimensions\n";
+  o << "  mlp           " << mlpShape(m.mlp) << " (SELU; " << m.mlp.layers.size() << " layers, " << mlpParameters(m.mlp)
+    << " parameters)\n";
+  o << "  lambda        " << m.lambdaSize() << " = K " << m.meshComponents() << " mesh weights + " << m.normalCodeDims()
+    << " normal-code dimensions\n";
   const Mesh& g = m.gameMesh;
   o << "  game mesh     " << g.vertexCount() << " vertices, " << g.triangleCount() << " triangles, "
     << g.skin.influences << " influences per vertex" << (g.uvs.rows() ? ", UVs" : "")
@@ -110,12 +121,13 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
     o << "  normal maps   none\n";
   } else {
     o << "  normal maps   " << db.mapCount() << " maps of " << db.width << "x" << db.height << ", code of "
-      << db.codeDims() << " dims, codebook " << db.codebookSize << " entries (" << db.codebook.size()
-      << " bytes), " << db.indices.size() << " block indices\n";
+      << db.codeDims() << " dims, codebook " << db.codebookSize << " entries (" << db.codebook.size() << " bytes), "
+      << db.indices.size() << " block indices\n";
   }
   o << "  temporal      time constant " << m.temporalFilter.timeConstantSeconds << " s\n";
   o << "  body proxy    " << m.bodyProxy.capsules.size() << " capsules"
-    << (m.bodyProxy.empty() ? " (no push-out at run time)" : " (the run-time push-out keeps the garment off them)") << "\n";
+    << (m.bodyProxy.empty() ? " (no push-out at run time)" : " (the run-time push-out keeps the garment off them)")
+    << "\n";
   o << "  sections\n";
   for (const auto& s : info.sections) {
     char line[128];

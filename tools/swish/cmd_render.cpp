@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "swish/bake/pipeline/baked_character.hpp"
-#include "swish/model/model_file.hpp"
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
+#include "swish/model/model_file.hpp"
 #include "swish/render/body_from_character.hpp"
 #include "swish/render/preview_renderer.hpp"
 #include "swish/swish.hpp"
@@ -50,7 +50,8 @@ void applyPoseSpec(const std::string& spec, const api::ModelInfo& info, std::vec
   const std::string joint = spec.substr(0, eq);
   size_t j = 0;
   while (j < info.jointNames.size() && info.jointNames[j] != joint) ++j;
-  if (j == info.jointNames.size()) throw Error("--pose '" + spec + "': the model's skeleton has no joint '" + joint + "'");
+  if (j == info.jointNames.size())
+    throw Error("--pose '" + spec + "': the model's skeleton has no joint '" + joint + "'");
   std::istringstream in(spec.substr(eq + 1));
   float r[3];
   char comma;
@@ -63,13 +64,14 @@ void applyPoseSpec(const std::string& spec, const api::ModelInfo& info, std::vec
 // The body to draw and the words that name it. 'auto' draws the body the model was baked on (its metadata
 // names the character), and refuses when that character's file is not at hand rather than drawing the
 // garment on another body at the wrong place.
-std::optional<render::BodyMesh> loadBody(const RenderOptions& o, const api::ModelInfo& info, std::string& label, std::string& why) {
+std::optional<render::BodyMesh> loadBody(const RenderOptions& o, const api::ModelInfo& info, std::string& label,
+                                         std::string& why) {
   if (o.character == "none") {
     why = "--character none";
     return std::nullopt;
   }
-  const Character c = bake::characterToDraw(o.character, o.character == "auto" ? loadModel(o.model).metadata : std::string(),
-                                            o.model, label);
+  const Character c = bake::characterToDraw(
+      o.character, o.character == "auto" ? loadModel(o.model).metadata : std::string(), o.model, label);
   return render::bodyFromCharacter(c, info, why);
 }
 
@@ -99,8 +101,9 @@ int run(const RenderOptions& o) {
   const render::PreviewImage img = preview.render(pose, {{true, true}, {false, true}});
   for (const auto& w : preview.lastReport().warnings) std::printf("swish render: warning: %s\n", w.c_str());
   render::writePreviewPng(o.out, img, popts.background);
-  std::printf("%s: %ux%u, left: with swish's normal map, right: without (%s, %s), on %s\n", o.out.c_str(), img.width, img.height,
-              info.name.c_str(), popts.body ? ("on " + bodyLabel).c_str() : "garment only", device.deviceName().c_str());
+  std::printf("%s: %ux%u, left: with swish's normal map, right: without (%s, %s), on %s\n", o.out.c_str(), img.width,
+              img.height, info.name.c_str(), popts.body ? ("on " + bodyLabel).c_str() : "garment only",
+              device.deviceName().c_str());
   if (o.validation)
     for (const auto& m : device.validationMessages()) std::fprintf(stderr, "validation: %s\n", m.c_str());
   return o.validation && !device.validationMessages().empty() ? 1 : 0;
@@ -112,12 +115,16 @@ static CommandRegistration registration{
     "render", "Draw one pose of a model headlessly (with and without the normal map) into a PNG", [](CLI::App& app) {
       auto o = std::make_shared<RenderOptions>();
       app.add_option("model", o->model, "the .swish model")->required();
-      app.add_option("--pose", o->pose, "JOINT=RX,RY,RZ: degrees on top of the rest rotation (repeatable); none: the rest pose");
-      app.add_option("--character", o->character, "body to draw: 'auto' (the body the model was baked on, from its metadata; an error when that file is not at hand), 'default' (the embedded mannequin), a glTF/FBX file, or 'none'");
+      app.add_option("--pose", o->pose,
+                     "JOINT=RX,RY,RZ: degrees on top of the rest rotation (repeatable); none: the rest pose");
+      app.add_option("--character", o->character,
+                     "body to draw: 'auto' (the body the model was baked on, from its metadata; an error when that "
+                     "file is not at hand), 'default' (the embedded mannequin), a glTF/FBX file, or 'none'");
       app.add_option("--out,-o", o->out, "output PNG");
       app.add_option("--width", o->width, "width of each half, pixels")->check(CLI::Range(16, 4096));
       app.add_option("--height", o->height, "height, pixels")->check(CLI::Range(16, 4096));
-      app.add_option("--device", o->device, "Vulkan device index or name substring (default: SWISH_DEVICE or automatic)");
+      app.add_option("--device", o->device,
+                     "Vulkan device index or name substring (default: SWISH_DEVICE or automatic)");
       app.add_flag("--validation", o->validation, "enable the Vulkan validation layer; any message fails the command");
       return [o] {
         try {

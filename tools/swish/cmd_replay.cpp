@@ -45,23 +45,27 @@ fs::path defaultScenePath() {
   std::error_code ec;
   for (const fs::path& root : swish::replay::assetSearchRoots())
     if (fs::exists(root / "assets/scenes/football.json", ec)) return root / "assets/scenes/football.json";
-  throw swish::Error("no scene given and the default scene assets/scenes/football.json was not found (looked in the "
-                     "current folder and beside the swish executable)");
+  throw swish::Error(
+      "no scene given and the default scene assets/scenes/football.json was not found (looked in the "
+      "current folder and beside the swish executable)");
 }
 
 int runReplay(const ReplayCliOptions& o) {
   using namespace swish;
   const bool isDefault = o.scene.empty();
   runtime::Scene scene = runtime::loadScene(isDefault ? defaultScenePath() : fs::path(o.scene));
-  if (!o.out.empty()) scene.outputs.directory = fs::absolute(o.out);
-  else if (isDefault) scene.outputs.directory = fs::current_path() / "replay-out";  // not into the source tree
+  if (!o.out.empty())
+    scene.outputs.directory = fs::absolute(o.out);
+  else if (isDefault)
+    scene.outputs.directory = fs::current_path() / "replay-out";  // not into the source tree
   if (o.frames > 0) scene.frameCount = o.frames;
   replay::ModelLibrary models(scene);  // loaded once: plan, replay and render share it
 
   if (o.plan) {
     const runtime::ReplayPlan plan = runtime::planReplay(scene, models.modelMap());
-    std::printf("Scene '%s' (%s): %zu characters, frames %u..%u at %g fps\n", scene.name.c_str(), scene.source.string().c_str(),
-                scene.characters.size(), scene.firstFrame, scene.firstFrame + scene.frameCount - 1, scene.framesPerSecond);
+    std::printf("Scene '%s' (%s): %zu characters, frames %u..%u at %g fps\n", scene.name.c_str(),
+                scene.source.string().c_str(), scene.characters.size(), scene.firstFrame,
+                scene.firstFrame + scene.frameCount - 1, scene.framesPerSecond);
     for (const auto& e : models.entries()) std::printf("Model '%s': %s\n", e->key.c_str(), e->label.c_str());
     std::printf("%s", plan.describe().c_str());
     return 0;
@@ -78,26 +82,30 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.pushOut = o.pushOut;
   const replay::ReplayJobResult r = replay::runReplayJob(scene, jo);
   if (!o.quiet) {
-    std::printf("Replayed %zu frames of '%s' on %s.\n", r.result.frames.size(), scene.name.c_str(), r.result.device.c_str());
+    std::printf("Replayed %zu frames of '%s' on %s.\n", r.result.frames.size(), scene.name.c_str(),
+                r.result.device.c_str());
     if (!r.directory.empty()) std::printf("Report: %s\n", (r.directory / "report.md").string().c_str());
     std::printf("%zu pose issues, %zu check failures.\n", r.result.issueCount, r.result.failures.size());
     const replay::TruthSummary& t = r.result.truthOverall;
     if (t.samples + t.failed > 0) {
-      std::printf("Ground truth on %u frames: %u character poses simulated (%u failed), %.1f s wall in all, %.2f s CPU "
-                  "per pose",
-                  r.result.truthFrames, t.samples + t.failed, t.failed, r.result.truthWallSeconds,
-                  t.cpuSeconds / double(t.samples + t.failed));
-      if (t.samples > 0) std::printf("; vertex error mean %.2f mm, p95 %.2f mm, max %.2f mm", t.meanMm, t.p95Mm, t.maxMm);
+      std::printf(
+          "Ground truth on %u frames: %u character poses simulated (%u failed), %.1f s wall in all, %.2f s CPU "
+          "per pose",
+          r.result.truthFrames, t.samples + t.failed, t.failed, r.result.truthWallSeconds,
+          t.cpuSeconds / double(t.samples + t.failed));
+      if (t.samples > 0)
+        std::printf("; vertex error mean %.2f mm, p95 %.2f mm, max %.2f mm", t.meanMm, t.p95Mm, t.maxMm);
       if (t.samples > 0 && t.normalMaps) std::printf("; normal maps mean %.2f deg, p95 %.2f deg", t.meanDeg, t.p95Deg);
       std::printf(".\n");
     }
     std::printf("Ground truth: %s\n", r.result.truthNote.c_str());
     if (!r.result.penetrationPerCharacter.empty()) {
       auto line = [](const char* what, const bake::PenetrationPool& p) {
-        std::printf("Garment inside the body, %s: %u of %u character frames with a vertex deeper than %g mm, deepest %.1f mm, "
-                    "p95 of the per-frame deepest %.1f mm, %.3f %% of vertices inside.\n",
-                    what, p.framesVisible, p.frames, bake::kVisiblePenetrationMm, p.deepestMm, p.deepestPercentileMm(0.95),
-                    100.0 * p.share());
+        std::printf(
+            "Garment inside the body, %s: %u of %u character frames with a vertex deeper than %g mm, deepest %.1f mm, "
+            "p95 of the per-frame deepest %.1f mm, %.3f %% of vertices inside.\n",
+            what, p.framesVisible, p.frames, bake::kVisiblePenetrationMm, p.deepestMm, p.deepestPercentileMm(0.95),
+            100.0 * p.share());
       };
       line("model", r.result.penetrationOverall.model);
       if (r.result.penetrationOverall.pushedMeasured) line("after the push-out", r.result.penetrationOverall.pushed);
@@ -132,31 +140,39 @@ swish::cli::CommandRegistration reg{
     "replay", "Replay a scene headlessly and report error against run time (default: the football play)",
     [](CLI::App& app) -> swish::cli::RunFn {
       auto o = std::make_shared<ReplayCliOptions>();
-      app.add_option("scene", o->scene, "scene file (JSON; see src/swish/runtime/scene_file.hpp). Default: assets/scenes/football.json");
+      app.add_option("scene", o->scene,
+                     "scene file (JSON; see src/swish/runtime/scene_file.hpp). Default: assets/scenes/football.json");
       app.add_flag("--plan", o->plan, "print the planned work (stages, dispatches, memory, what is left out) and exit");
       app.add_option("--out", o->out, "output folder (overrides the scene's outputs.directory)");
-      app.add_option("--device", o->device, "Vulkan device: index or name substring (default: SWISH_DEVICE, else automatic)");
-      app.add_option("--truth-every", o->truthEvery,
-                     "ground truth: run the bake's source cloth simulation on every Nth frame and report the per-vertex "
-                     "(mm) and normal-map (deg) error of the run time against it (about 2 s of CPU per character and truth frame with "
-                     "the default model, in parallel)");
+      app.add_option("--device", o->device,
+                     "Vulkan device: index or name substring (default: SWISH_DEVICE, else automatic)");
+      app.add_option(
+          "--truth-every", o->truthEvery,
+          "ground truth: run the bake's source cloth simulation on every Nth frame and report the per-vertex "
+          "(mm) and normal-map (deg) error of the run time against it (about 2 s of CPU per character and truth frame "
+          "with "
+          "the default model, in parallel)");
       app.add_option("--truth-vertices", o->truthVertices,
                      "truth simulation vertices instead of the bake's (0: the welded game mesh; coarser is faster, and "
                      "further from the bake's truth; the report says so)");
       app.add_option("--truth-substeps", o->truthSubsteps, "truth simulation substeps instead of the bake's")
           ->check(CLI::Range(1, 1000));
-      app.add_option("--penetration-every", o->penetrationEvery,
-                     "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "
-                     "on every Nth frame; 0: not at all (default 30: the measure poses a body collider per character, costly on the CPU)");
+      app.add_option(
+          "--penetration-every", o->penetrationEvery,
+          "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "
+          "on every Nth frame; 0: not at all (default 30: the measure poses a body collider per character, costly on "
+          "the CPU)");
       app.add_flag("--push-out", o->pushOut,
                    "push the garment out of the model's body proxy on the GPU (models that carry one; off by default: "
                    "measured to raise the error against the source simulation)");
       app.add_option("--frames", o->frames, "replay only this many frames");
       app.add_flag("--quiet", o->quiet, "no progress bar or summary");
       app.add_flag("--validation", o->validation, "enable the Vulkan validation layers");
-      app.add_flag("--render", o->render,
-                   "also draw one character with the preview renderer: PNG frames + contact_sheet.png in <out>/render/");
-      app.add_option("--render-character", o->renderCharacter, "scene character index to draw with --render (default 0)");
+      app.add_flag(
+          "--render", o->render,
+          "also draw one character with the preview renderer: PNG frames + contact_sheet.png in <out>/render/");
+      app.add_option("--render-character", o->renderCharacter,
+                     "scene character index to draw with --render (default 0)");
       app.add_option("--render-frames", o->renderFrames, "at most this many frames, spread over the scene (default 16)")
           ->check(CLI::Range(1u, 10000u));
       return [o] { return runReplay(*o); };

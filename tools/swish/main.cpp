@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <exception>
 
-#include "swish/core/error.hpp"
 #include "swish/command.hpp"
+#include "swish/core/error.hpp"
 
 namespace swish::cli {
 std::vector<CommandInfo>& commandRegistry() {

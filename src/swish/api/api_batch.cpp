@@ -15,8 +15,8 @@ uint32_t heldSlot(const BatchImpl& b, uint64_t frameIndex, const char* what) {
   const uint32_t slot = uint32_t(frameIndex % b.slots.size());
   if (b.slots[slot].frame != frameIndex)
     throw Error(ErrorCode::InvalidArgument, std::string(what) + ": frame " + std::to_string(frameIndex) +
-                                                " is not held by this batch (only the last " + std::to_string(b.slots.size()) +
-                                                " recorded frames are)");
+                                                " is not held by this batch (only the last " +
+                                                std::to_string(b.slots.size()) + " recorded frames are)");
   return slot;
 }
 
@@ -26,8 +26,8 @@ uint32_t retiredSlot(const BatchImpl& b, uint64_t frameIndex, uint32_t character
     throw Error(ErrorCode::FrameInFlight, std::string(what) + ": frame " + std::to_string(frameIndex) +
                                               " is not retired yet (wait for its fence, then retireFrame)");
   if (character >= b.characters)
-    throw Error(ErrorCode::InvalidArgument, std::string(what) + ": character " + std::to_string(character) + " of " +
-                                                std::to_string(b.characters));
+    throw Error(ErrorCode::InvalidArgument,
+                std::string(what) + ": character " + std::to_string(character) + " of " + std::to_string(b.characters));
   return slot;
 }
 
@@ -41,20 +41,21 @@ CharacterBatch::~CharacterBatch() = default;
 uint32_t CharacterBatch::characters() const { return impl_->characters; }
 uint32_t CharacterBatch::framesInFlight() const { return uint32_t(impl_->slots.size()); }
 
-FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex, std::span<const CharacterPose> poses) {
+FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex,
+                                        std::span<const CharacterPose> poses) {
   return translateErrors(ErrorCode::InvalidArgument, [&] {
     BatchImpl& b = *impl_;
     const auto start = std::chrono::steady_clock::now();
     const std::string where = "recordFrame(frame " + std::to_string(frameIndex) + ") of '" + b.model->info.name + "'";
     if (cmd == VK_NULL_HANDLE) throw Error(ErrorCode::InvalidArgument, where + ": no command buffer");
     if (b.lastRecorded && frameIndex != *b.lastRecorded + 1)
-      throw Error(ErrorCode::InvalidArgument, where + ": frames must be recorded in order; the last one was " +
-                                                  std::to_string(*b.lastRecorded));
+      throw Error(ErrorCode::InvalidArgument,
+                  where + ": frames must be recorded in order; the last one was " + std::to_string(*b.lastRecorded));
     const uint32_t slot = uint32_t(frameIndex % b.slots.size());
     if (b.slots[slot].frame && !b.slots[slot].retired)
-      throw Error(ErrorCode::FrameInFlight, where + ": its resources were last used by frame " +
-                                                std::to_string(*b.slots[slot].frame) +
-                                                ", which is not retired (wait for that frame's fence, then retireFrame)");
+      throw Error(ErrorCode::FrameInFlight,
+                  where + ": its resources were last used by frame " + std::to_string(*b.slots[slot].frame) +
+                      ", which is not retired (wait for that frame's fence, then retireFrame)");
     if (poses.size() != b.characters)
       throw Error(ErrorCode::InvalidArgument, where + ": " + std::to_string(poses.size()) + " poses for " +
                                                   std::to_string(b.characters) + " characters");
@@ -80,7 +81,8 @@ FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex
     for (uint32_t c : out.invalidDt)
       report.warnings.push_back("character " + std::to_string(c) + ": negative or NaN dtSeconds treated as 0");
     for (uint32_t c : out.nonFiniteCode)
-      report.warnings.push_back("character " + std::to_string(c) + ": the network's normal code was not finite; kept the previous map");
+      report.warnings.push_back("character " + std::to_string(c) +
+                                ": the network's normal code was not finite; kept the previous map");
     b.inputs.meshWeights = out.meshWeights;
     b.inputs.selectedMaps.clear();
     b.inputs.blendAlpha.clear();
@@ -91,7 +93,8 @@ FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex
     b.recorder->record(cmd, frameIndex, b.inputs);
     b.slots[slot] = {frameIndex, false};
     b.lastRecorded = frameIndex;
-    report.cpuMilliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    report.cpuMilliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return report;
   });
 }
@@ -170,8 +173,8 @@ FrameOutputs CharacterBatch::outputs(uint64_t frameIndex) const {
     o.tangents = {f.tangents.handle(), 0, n * 16, 16, VK_FORMAT_R32G32B32A32_SFLOAT};
     if (gm.hasUvs()) o.uvs = {gm.uvs.handle(), 0, 0, 8, VK_FORMAT_R32G32_SFLOAT};
     // gpu/buffer.cpp creates every buffer with these usages.
-    o.bufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                    VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    o.bufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     o.queueFamily = b.model->runtime->ctx.queueFamily();
     if (b.normalMaps) {
       NormalMapOutput nm;

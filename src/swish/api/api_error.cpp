@@ -8,12 +8,18 @@ namespace swish::api {
 
 const char* errorCodeName(ErrorCode code) {
   switch (code) {
-    case ErrorCode::InvalidArgument: return "invalid argument";
-    case ErrorCode::BadModel: return "bad model";
-    case ErrorCode::DeviceUnsupported: return "device unsupported";
-    case ErrorCode::FrameInFlight: return "frame in flight";
-    case ErrorCode::VulkanFailure: return "Vulkan failure";
-    case ErrorCode::Internal: return "internal error";
+    case ErrorCode::InvalidArgument:
+      return "invalid argument";
+    case ErrorCode::BadModel:
+      return "bad model";
+    case ErrorCode::DeviceUnsupported:
+      return "device unsupported";
+    case ErrorCode::FrameInFlight:
+      return "frame in flight";
+    case ErrorCode::VulkanFailure:
+      return "Vulkan failure";
+    case ErrorCode::Internal:
+      return "internal error";
   }
   return "unknown error";
 }

@@ -79,5 +79,6 @@ namespace swish::api {
 // The host's pose as a skeleton Pose: sizes checked (InvalidArgument), quaternions sanitised with the
 // documented policy (normalised, or the REST rotation when NaN/zero), each fix appended to `warnings`
 // when given. characterToWorld must be finite (InvalidArgument).
-Pose toSkeletonPose(const swish::Model& model, const CharacterPose& pose, uint32_t character, std::vector<std::string>* warnings);
+Pose toSkeletonPose(const swish::Model& model, const CharacterPose& pose, uint32_t character,
+                    std::vector<std::string>* warnings);
 }  // namespace swish::api

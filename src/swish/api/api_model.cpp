@@ -6,15 +6,17 @@
 
 namespace swish::api {
 
-Pose toSkeletonPose(const swish::Model& model, const CharacterPose& in, uint32_t character, std::vector<std::string>* warnings) {
+Pose toSkeletonPose(const swish::Model& model, const CharacterPose& in, uint32_t character,
+                    std::vector<std::string>* warnings) {
   const Skeleton& sk = model.skeleton;
   if (in.localRotations.size() != sk.size())
-    throw Error(ErrorCode::InvalidArgument, "character " + std::to_string(character) + ": " +
-                                                std::to_string(in.localRotations.size()) + " joint rotations, the model's skeleton has " +
-                                                std::to_string(sk.size()));
+    throw Error(ErrorCode::InvalidArgument,
+                "character " + std::to_string(character) + ": " + std::to_string(in.localRotations.size()) +
+                    " joint rotations, the model's skeleton has " + std::to_string(sk.size()));
   for (float v : in.characterToWorld)
     if (!std::isfinite(v))
-      throw Error(ErrorCode::InvalidArgument, "character " + std::to_string(character) + ": characterToWorld is not finite");
+      throw Error(ErrorCode::InvalidArgument,
+                  "character " + std::to_string(character) + ": characterToWorld is not finite");
   Pose p;
   p.local.resize(sk.size());
   for (size_t j = 0; j < sk.size(); ++j) {
@@ -38,7 +40,8 @@ Pose toSkeletonPose(const swish::Model& model, const CharacterPose& in, uint32_t
     if (std::isfinite(t[0]) && std::isfinite(t[1]) && std::isfinite(t[2])) {
       p.rootTranslation = Vec3f(t[0], t[1], t[2]);
     } else if (warnings) {
-      warnings->push_back("character " + std::to_string(character) + ": non-finite root translation replaced by the rest one");
+      warnings->push_back("character " + std::to_string(character) +
+                          ": non-finite root translation replaced by the rest one");
     }
   }
   return p;

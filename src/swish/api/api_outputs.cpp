@@ -17,7 +17,8 @@ void setFamilies(uint32_t owner, uint32_t dst, uint32_t& srcOut, uint32_t& dstOu
 }
 }  // namespace
 
-std::vector<VkBufferMemoryBarrier2> FrameOutputs::vertexBarriers(uint32_t dstQueueFamily, VkPipelineStageFlags2 dstStage,
+std::vector<VkBufferMemoryBarrier2> FrameOutputs::vertexBarriers(uint32_t dstQueueFamily,
+                                                                 VkPipelineStageFlags2 dstStage,
                                                                  VkAccessFlags2 dstAccess) const {
   std::vector<VkBufferMemoryBarrier2> out;
   for (const VertexStream* s : {&positions, &normals, &tangents}) {
@@ -36,7 +37,8 @@ std::vector<VkBufferMemoryBarrier2> FrameOutputs::vertexBarriers(uint32_t dstQue
   return out;
 }
 
-std::optional<VkImageMemoryBarrier2> FrameOutputs::normalMapBarrier(uint32_t dstQueueFamily, VkPipelineStageFlags2 dstStage,
+std::optional<VkImageMemoryBarrier2> FrameOutputs::normalMapBarrier(uint32_t dstQueueFamily,
+                                                                    VkPipelineStageFlags2 dstStage,
                                                                     VkAccessFlags2 dstAccess) const {
   if (!normalMaps) return std::nullopt;
   VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};

@@ -46,8 +46,8 @@ std::string unsuitableReason(VkPhysicalDevice pd) {
   return {};
 }
 
-void enableRequiredFeatures(VkPhysicalDevice pd, VkPhysicalDeviceFeatures2& features, VkPhysicalDeviceVulkan12Features& v12,
-                            VkPhysicalDeviceVulkan13Features& v13) {
+void enableRequiredFeatures(VkPhysicalDevice pd, VkPhysicalDeviceFeatures2& features,
+                            VkPhysicalDeviceVulkan12Features& v12, VkPhysicalDeviceVulkan13Features& v13) {
   v12.bufferDeviceAddress = VK_TRUE;  // kernels take buffers as addresses in push constants
   v13.maintenance4 = VK_TRUE;         // workgroup sizes are specialisation constants (LocalSizeId)
   // Storage images of R16G16_SNORM for the normal maps, where the device has them.
@@ -85,7 +85,8 @@ Runtime Runtime::adopt(const DeviceHandles& host) {
     d.queue = host.queue;
     d.queueFamily = host.queueFamily;
     if (!d.instance || !d.physicalDevice || !d.device || !d.queue)
-      throw Error(ErrorCode::InvalidArgument, "Runtime::adopt: instance, physical device, device and queue must all be given");
+      throw Error(ErrorCode::InvalidArgument,
+                  "Runtime::adopt: instance, physical device, device and queue must all be given");
     return Runtime(std::make_shared<RuntimeImpl>(gpu::Context::adopt(d)));
   });
 }
@@ -108,7 +109,8 @@ bool Runtime::supportsNormalMaps() const { return impl_->ctx.supportsNormalMaps(
 
 Model Runtime::loadModel(const std::filesystem::path& path) const {
   swish::Model model = translateErrors(ErrorCode::BadModel, [&] { return swish::loadModel(path); });
-  return translateErrors(ErrorCode::Internal, [&] { return makeModel(impl_, std::move(model), path.filename().string()); });
+  return translateErrors(ErrorCode::Internal,
+                         [&] { return makeModel(impl_, std::move(model), path.filename().string()); });
 }
 
 Result<Model> Runtime::tryLoadModel(const std::filesystem::path& path) const noexcept {

@@ -17,9 +17,9 @@
 namespace swish::cluster {
 
 struct PoseList {
-  uint64_t fingerprint = 0;       // DatasetPosePlan::fingerprint of the plan it was written from
-  uint64_t settingsDigest = 0;    // settingsDigest(part 1 settings) of the recipe
-  std::vector<Pose> poses;        // pose id = index
+  uint64_t fingerprint = 0;     // DatasetPosePlan::fingerprint of the plan it was written from
+  uint64_t settingsDigest = 0;  // settingsDigest(part 1 settings) of the recipe
+  std::vector<Pose> poses;      // pose id = index
   std::vector<uint64_t> poseFingerprints;
 };
 

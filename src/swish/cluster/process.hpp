@@ -6,7 +6,7 @@
 namespace swish::cluster {
 
 struct CommandResult {
-  int exitCode = -1;     // the program's exit status; 127: it could not be started (not installed)
+  int exitCode = -1;  // the program's exit status; 127: it could not be started (not installed)
   std::string out, err;
 };
 

@@ -15,11 +15,11 @@
 
 #include <tbb/global_control.h>
 
+#include "swish/bake/cloth/pose_driver.hpp"
+#include "swish/bake/cloth/simulated_pose_file.hpp"
 #include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
-#include "swish/bake/cloth/pose_driver.hpp"
-#include "swish/bake/cloth/simulated_pose_file.hpp"
 #include "swish/cluster/pose_list_file.hpp"
 #include "swish/cluster/process.hpp"
 #include "swish/core/error.hpp"
@@ -78,7 +78,8 @@ std::string envOr(const char* name, const std::string& fallback = {}) {
 fs::path selfExecutable() {
   std::error_code ec;
   fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw Error("cannot find this program's own path (/proc/self/exe): " + ec.message() + "; give --swish-binary");
+  if (ec)
+    throw Error("cannot find this program's own path (/proc/self/exe): " + ec.message() + "; give --swish-binary");
   return p;
 }
 
@@ -141,16 +142,17 @@ std::string submit(const std::vector<std::string>& argv, const std::function<voi
 }
 
 void writeScript(const fs::path& file, const std::string& what, const std::vector<std::string>& command) {
-  std::string text = "#!/bin/bash\n# " + what +
-                     "\n# Written by `swish bake --slurm` (src/swish/cluster/slurm_bake.hpp); submitting again rewrites "
-                     "it.\n# The sbatch options are on the sbatch command line (see submission.json).\nset -e\nexec " +
-                     shellLine(command) + "\n";
+  std::string text =
+      "#!/bin/bash\n# " + what +
+      "\n# Written by `swish bake --slurm` (src/swish/cluster/slurm_bake.hpp); submitting again rewrites "
+      "it.\n# The sbatch options are on the sbatch command line (see submission.json).\nset -e\nexec " +
+      shellLine(command) + "\n";
   writeTextFileAtomic(file, text);
   fs::permissions(file, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add);
 }
 
 struct PoseFileState {
-  std::vector<uint8_t> state;  // 0 missing, 1 done, 2 failed (done, left out)
+  std::vector<uint8_t> state;   // 0 missing, 1 done, 2 failed (done, left out)
   std::vector<double> seconds;  // of the finished ones
 };
 PoseFileState scanPoseFiles(const fs::path& simDir, const std::vector<uint64_t>& fingerprints) {
@@ -272,8 +274,10 @@ nlohmann::json submitSlurmBake(const bake::BakeConfig& cfg, const fs::path& conf
     if (o.log) o.log(l);
   };
   if (!cfg.part1)
-    throw Error("bake '" + cfg.name + "': the recipe has no \"part1\" section, so there is nothing to simulate on a "
-                "cluster; part 2 alone runs as `swish bake " + configFile.string() + "` (in one sbatch job if you like)");
+    throw Error("bake '" + cfg.name +
+                "': the recipe has no \"part1\" section, so there is nothing to simulate on a "
+                "cluster; part 2 alone runs as `swish bake " +
+                configFile.string() + "` (in one sbatch job if you like)");
   if (o.cpusPerTask < 1) throw Error("--cpus-per-task must be 1 or more");
   const double limit = parseSlurmTime(o.timeLimit);
   if (!o.finalTimeLimit.empty()) parseSlurmTime(o.finalTimeLimit);
@@ -285,7 +289,8 @@ nlohmann::json submitSlurmBake(const bake::BakeConfig& cfg, const fs::path& conf
     const nlohmann::json old = readJsonFile(subFile);
     std::string err;
     const auto q = queueOf(submittedJobs(old), &err);
-    if (!q) throw Error("cannot tell whether the earlier submission (" + subFile.string() + ") is still queued: " + err);
+    if (!q)
+      throw Error("cannot tell whether the earlier submission (" + subFile.string() + ") is still queued: " + err);
     if (!q->empty()) {
       std::string ids;
       for (const std::string& j : submittedJobs(old)) ids += " " + j;
@@ -378,9 +383,13 @@ nlohmann::json submitSlurmBake(const bake::BakeConfig& cfg, const fs::path& conf
               {exe.string(), "bake", config.string(), "--slurm-task", "part2", "--pose-list", fp});
 
   auto common = [&](const std::string& stage, const std::string& time, const std::string& output) {
-    std::vector<std::string> a = {"sbatch", "--parsable", "--job-name=swish-" + cfg.name + "-" + stage,
-                                  "--chdir=" + dir.string(), "--output=" + (dir / "logs" / output).string(),
-                                  "--open-mode=append", "--cpus-per-task=" + std::to_string(o.cpusPerTask)};
+    std::vector<std::string> a = {"sbatch",
+                                  "--parsable",
+                                  "--job-name=swish-" + cfg.name + "-" + stage,
+                                  "--chdir=" + dir.string(),
+                                  "--output=" + (dir / "logs" / output).string(),
+                                  "--open-mode=append",
+                                  "--cpus-per-task=" + std::to_string(o.cpusPerTask)};
     if (!time.empty()) a.push_back("--time=" + time);
     if (!o.partition.empty()) a.push_back("--partition=" + o.partition);
     if (!o.account.empty()) a.push_back("--account=" + o.account);
@@ -464,9 +473,9 @@ nlohmann::json submitSlurmBake(const bake::BakeConfig& cfg, const fs::path& conf
   if (o.dryRun)
     log("slurm: dry run: nothing submitted; the scripts and the pose list are in " + dir.string());
   else
-    log("slurm: submitted: part 1 " + (array.empty() ? std::string("(nothing left to simulate)") : "array job " + array) +
-        ", dataset job " + dataset + ", part 2 job " + part2 + "; follow it with `swish bake " + configFile.string() +
-        " --status`");
+    log("slurm: submitted: part 1 " +
+        (array.empty() ? std::string("(nothing left to simulate)") : "array job " + array) + ", dataset job " +
+        dataset + ", part 2 job " + part2 + "; follow it with `swish bake " + configFile.string() + " --status`");
   return sub;
 }
 
@@ -492,8 +501,8 @@ void runSlurmStage(const bake::BakeConfig& cfg, const std::string& stage, uint64
                 ": the bake was submitted again with another recipe; this job stops without writing anything");
   bake::DatasetBuildSettings s = *cfg.part1;
   if (settingsDigest(s) != list.settingsDigest)
-    throw Error("the recipe's part 1 settings changed after `swish bake --slurm` wrote " + (dir / "poses.bin").string() +
-                "; this job stops without writing anything: submit again");
+    throw Error("the recipe's part 1 settings changed after `swish bake --slurm` wrote " +
+                (dir / "poses.bin").string() + "; this job stops without writing anything: submit again");
 
   if (stage == "dataset" || stage == "part2") {
     bake::BakeRunOptions run;
@@ -512,8 +521,8 @@ void runSlurmStage(const bake::BakeConfig& cfg, const std::string& stage, uint64
   if (shardSize == 0) throw Error("--slurm-task part1 needs --shard-size");
   const size_t shard = std::stoul(task), first = shard * shardSize;
   if (first >= list.poses.size())
-    throw Error("array task " + task + ": shard " + task + " of " + std::to_string(shardSize) + " poses starts past the " +
-                std::to_string(list.poses.size()) + " poses");
+    throw Error("array task " + task + ": shard " + task + " of " + std::to_string(shardSize) +
+                " poses starts past the " + std::to_string(list.poses.size()) + " poses");
   const size_t last = std::min(list.poses.size(), first + shardSize);
   const std::string jobId = envOr("SLURM_ARRAY_JOB_ID", "?") + "_" + task;
   const std::string restart = envOr("SLURM_RESTART_COUNT", "0");
@@ -534,10 +543,18 @@ void runSlurmStage(const bake::BakeConfig& cfg, const std::string& stage, uint64
   const double setup = since(t0);
   const fs::path progressFile = shardFile(dir, shard);
   auto writeProgress = [&](const std::string& state, size_t done, size_t simulated, size_t reused, size_t failed) {
-    const nlohmann::json j = {{"shard", shard},       {"first", first},     {"count", ids.size()},
-                              {"done", done},         {"simulated", simulated}, {"reused", reused},
-                              {"failed", failed},     {"state", state},     {"job", jobId},
-                              {"restart", std::stoi(restart)}, {"host", hostName()}, {"updated", utcNow()},
+    const nlohmann::json j = {{"shard", shard},
+                              {"first", first},
+                              {"count", ids.size()},
+                              {"done", done},
+                              {"simulated", simulated},
+                              {"reused", reused},
+                              {"failed", failed},
+                              {"state", state},
+                              {"job", jobId},
+                              {"restart", std::stoi(restart)},
+                              {"host", hostName()},
+                              {"updated", utcNow()},
                               {"pose_list", fingerprintHex(poseList)}};
     writeTextFileAtomic(progressFile, j.dump(2) + "\n");
   };
@@ -586,8 +603,8 @@ std::string slurmBakeStatus(const bake::BakeConfig& cfg) {
   auto line = [&](const std::string& l) { out += l + "\n"; };
   const std::string fp = sub.value("pose_list", std::string());
   line("bake '" + cfg.name + "': submitted " + sub.value("submitted", std::string("?")) + " from " +
-       sub.value("submitted_from", std::string("?")) + (sub.value("dry_run", false) ? " (dry run: nothing queued)" : "") +
-       ", pose list " + fp);
+       sub.value("submitted_from", std::string("?")) +
+       (sub.value("dry_run", false) ? " (dry run: nothing queued)" : "") + ", pose list " + fp);
   if (fingerprintHex(list.fingerprint) != fp)
     line("warning: " + (dir / "poses.bin").string() + " holds the pose list " + fingerprintHex(list.fingerprint) +
          ", not the submission's");
@@ -627,8 +644,8 @@ std::string slurmBakeStatus(const bake::BakeConfig& cfg) {
   const size_t waiting = n - done - inFlight;
   {
     char l[400];
-    std::snprintf(l, sizeof l, "part 1: %zu of %zu poses done (%zu failed, left out), %zu running, %zu waiting", done, n,
-                  failed, inFlight, waiting);
+    std::snprintf(l, sizeof l, "part 1: %zu of %zu poses done (%zu failed, left out), %zu running, %zu waiting", done,
+                  n, failed, inFlight, waiting);
     line(l);
   }
   line("  job " + (arrayId.empty() ? std::string("none (every pose was simulated before the submission)") : arrayId) +
@@ -641,8 +658,9 @@ std::string slurmBakeStatus(const bake::BakeConfig& cfg) {
     const double left = std::ceil(double(n - done) / double(tasks * size_t(cpus))) * spp;
     char l[300];
     std::snprintf(l, sizeof l, "  about %s left at %.2f s per pose (%s) with %zu task%s of %d cpus at once",
-                  duration(left).c_str(), spp, files.seconds.size() >= 3 ? "median so far" : "the submission's estimate",
-                  tasks, tasks == 1 ? "" : "s", cpus);
+                  duration(left).c_str(), spp,
+                  files.seconds.size() >= 3 ? "median so far" : "the submission's estimate", tasks,
+                  tasks == 1 ? "" : "s", cpus);
     line(l);
   }
   for (size_t k : running) {

@@ -34,16 +34,16 @@
 namespace swish::cluster {
 
 struct SlurmSubmitOptions {
-  std::string partition, account;           // sbatch --partition / --account; empty: the cluster's default
-  std::string timeLimit = "1:00:00";        // per array task (sbatch --time); sizes the shards
-  std::string finalTimeLimit;               // the dataset and part 2 jobs; empty: the partition's default
-  int cpusPerTask = 1;                      // every job's --cpus-per-task; a task simulates that many poses at once
-  int maxRunning = 0;                       // array tasks at once (--array=...%N); 0: no limit
-  std::vector<std::string> sbatchArgs;      // given to every sbatch call as they are, after swish's own
-  double secondsPerPose = 0.0;              // one pose on one core; 0: measured (see submitSlurmBake)
-  size_t posesPerTask = 0;                  // 0: from seconds per pose and the time limit
-  bool dryRun = false;                      // write the pose list and scripts, print the sbatch lines, submit nothing
-  std::filesystem::path swishExecutable;    // what the jobs run; empty: this process's own executable
+  std::string partition, account;         // sbatch --partition / --account; empty: the cluster's default
+  std::string timeLimit = "1:00:00";      // per array task (sbatch --time); sizes the shards
+  std::string finalTimeLimit;             // the dataset and part 2 jobs; empty: the partition's default
+  int cpusPerTask = 1;                    // every job's --cpus-per-task; a task simulates that many poses at once
+  int maxRunning = 0;                     // array tasks at once (--array=...%N); 0: no limit
+  std::vector<std::string> sbatchArgs;    // given to every sbatch call as they are, after swish's own
+  double secondsPerPose = 0.0;            // one pose on one core; 0: measured (see submitSlurmBake)
+  size_t posesPerTask = 0;                // 0: from seconds per pose and the time limit
+  bool dryRun = false;                    // write the pose list and scripts, print the sbatch lines, submit nothing
+  std::filesystem::path swishExecutable;  // what the jobs run; empty: this process's own executable
   std::function<void(const std::string&)> log;
 };
 

@@ -18,8 +18,8 @@ class Error : public std::runtime_error {
 template <class T>
 class Expected {
  public:
-  Expected(T value) : v_(std::move(value)) {}                  // NOLINT(implicit)
-  Expected(Error error) : v_(std::move(error)) {}              // NOLINT(implicit)
+  Expected(T value) : v_(std::move(value)) {}      // NOLINT(implicit)
+  Expected(Error error) : v_(std::move(error)) {}  // NOLINT(implicit)
   bool ok() const { return std::holds_alternative<T>(v_); }
   explicit operator bool() const { return ok(); }
   T& value() {

@@ -19,12 +19,18 @@ struct Fnv1a {
     for (size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
   }
   template <class T>
-  void value(const T& v) { bytes(&v, sizeof v); }
+  void value(const T& v) {
+    bytes(&v, sizeof v);
+  }
   // Dense Eigen matrices and vectors: their coefficients, in storage order.
   template <class M>
-  void matrix(const M& m) { bytes(m.data(), size_t(m.size()) * sizeof(typename M::Scalar)); }
+  void matrix(const M& m) {
+    bytes(m.data(), size_t(m.size()) * sizeof(typename M::Scalar));
+  }
   template <class T>
-  void vec(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
+  void vec(const std::vector<T>& v) {
+    bytes(v.data(), v.size() * sizeof(T));
+  }
 };
 
 inline uint64_t fnv1a(const void* p, size_t n) {

@@ -10,9 +10,9 @@ namespace swish {
 constexpr int kMaxInfluences = 8;
 
 struct SkinWeights {
-  int influences = 4;             // per vertex, 1..kMaxInfluences
-  std::vector<uint16_t> joints;   // vertexCount * influences, joint indices into the skeleton
-  std::vector<float> weights;     // vertexCount * influences, non-negative, summing to 1 per vertex
+  int influences = 4;            // per vertex, 1..kMaxInfluences
+  std::vector<uint16_t> joints;  // vertexCount * influences, joint indices into the skeleton
+  std::vector<float> weights;    // vertexCount * influences, non-negative, summing to 1 per vertex
 
   size_t vertexCount() const { return influences > 0 ? weights.size() / size_t(influences) : 0; }
 };

@@ -28,7 +28,7 @@ struct SanitizedQuat {
 // the caller can report it. Never silently.
 SanitizedQuat sanitizeQuaternion(const Quatf& q);
 
-Rot6 toRot6(const Quatf& q);       // q must be unit (sanitize first)
+Rot6 toRot6(const Quatf& q);  // q must be unit (sanitize first)
 Rot6 toRot6(const Mat3f& r);
 // Back to a rotation matrix by Gram-Schmidt on the two columns (defined for any non-degenerate input).
 Mat3f rot6ToMatrix(const Rot6& r6);

@@ -19,8 +19,8 @@ void Skeleton::validate(const std::string& what) const {
   for (size_t i = 0; i < joints.size(); ++i) {
     const Joint& j = joints[i];
     if (j.parent >= int(i) || j.parent < -1)
-      throw Error(what + ": joint '" + j.name + "' (index " + std::to_string(i) +
-                  ") has parent index " + std::to_string(j.parent) + ", parents must come first");
+      throw Error(what + ": joint '" + j.name + "' (index " + std::to_string(i) + ") has parent index " +
+                  std::to_string(j.parent) + ", parents must come first");
     if (!names.insert(j.name).second) throw Error(what + ": joint name '" + j.name + "' repeats");
     if (!j.rest.translation.allFinite() || !j.rest.rotation.coeffs().allFinite())
       throw Error(what + ": joint '" + j.name + "' has a non-finite rest transform");

@@ -13,8 +13,8 @@ namespace swish {
 
 struct Joint {
   std::string name;
-  int parent = -1;        // index of the parent joint, -1 for a root
-  RigidTransform rest;    // local rest transform relative to the parent
+  int parent = -1;      // index of the parent joint, -1 for a root
+  RigidTransform rest;  // local rest transform relative to the parent
 };
 
 // A pose of a whole skeleton: one local rotation per joint (unit quaternions) plus the root joint's

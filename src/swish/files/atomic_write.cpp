@@ -81,11 +81,9 @@ fs::path temporaryPathFor(const fs::path& target) {
 }  // namespace
 
 AtomicFileWriter::AtomicFileWriter(fs::path target) : target_(std::move(target)) {
-  if (target_.empty() || !target_.has_filename())
-    throw Error("cannot write " + quoted(target_) + ": not a file name");
+  if (target_.empty() || !target_.has_filename()) throw Error("cannot write " + quoted(target_) + ": not a file name");
   std::error_code ec;
-  if (fs::is_directory(target_, ec))
-    throw Error("cannot write " + quoted(target_) + ": it is a directory");
+  if (fs::is_directory(target_, ec)) throw Error("cannot write " + quoted(target_) + ": it is a directory");
   temp_ = temporaryPathFor(target_);
   fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd_ < 0) {
@@ -117,8 +115,8 @@ void AtomicFileWriter::discard() noexcept {
 void AtomicFileWriter::failAndDiscard(const std::string& action, int err) {
   const fs::path temp = temp_;
   discard();
-  throw Error("cannot write " + quoted(target_) + ": " + action + " " + quoted(temp) + " failed: " +
-              std::strerror(err));
+  throw Error("cannot write " + quoted(target_) + ": " + action + " " + quoted(temp) +
+              " failed: " + std::strerror(err));
 }
 
 void AtomicFileWriter::writeRaw(const char* data, size_t size) {
@@ -158,8 +156,8 @@ void AtomicFileWriter::commit() {
     const int err = errno;
     const fs::path temp = temp_;
     discard();
-    throw Error("cannot write " + quoted(target_) + ": renaming " + quoted(temp) + " over it failed: " +
-                std::strerror(err));
+    throw Error("cannot write " + quoted(target_) + ": renaming " + quoted(temp) +
+                " over it failed: " + std::strerror(err));
   }
   committed_ = true;
   temp_.clear();
@@ -201,7 +199,8 @@ size_t removeStaleOutputs(const std::filesystem::path& folder, std::string_view 
     const std::string name = it->path().filename().string();
     if (!name.starts_with(prefix)) continue;
     if (std::none_of(suffixes.begin(), suffixes.end(), [&](std::string_view s) { return name.ends_with(s); })) continue;
-    if (std::any_of(written.begin(), written.end(), [&](const fs::path& w) { return w.filename() == it->path().filename(); }))
+    if (std::any_of(written.begin(), written.end(),
+                    [&](const fs::path& w) { return w.filename() == it->path().filename(); }))
       continue;
     stale.push_back(it->path());
   }

@@ -43,7 +43,8 @@ void Buffer::finish(Context& ctx, VkDeviceMemory mem, uint32_t type) {
   VkPhysicalDeviceMemoryProperties mp;
   vkGetPhysicalDeviceMemoryProperties(ctx.physicalDevice(), &mp);
   const VkMemoryPropertyFlags hostFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  if ((mp.memoryTypes[type].propertyFlags & hostFlags) == hostFlags) SWISH_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &mapped_));
+  if ((mp.memoryTypes[type].propertyFlags & hostFlags) == hostFlags)
+    SWISH_VK(vkMapMemory(device_, mem, 0, VK_WHOLE_SIZE, 0, &mapped_));
   VkBufferDeviceAddressInfo ai{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
   ai.buffer = handle();
   address_ = vkGetBufferDeviceAddress(device_, &ai);
@@ -72,8 +73,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, MemoryKind kind, const std::stri
   finish(ctx, mem, type);
 }
 
-Buffer::Buffer(Context& ctx, VkDeviceSize size, VkDeviceMemory sharedMemory, uint32_t memoryType, VkDeviceSize memoryBytes,
-               const std::string& name)
+Buffer::Buffer(Context& ctx, VkDeviceSize size, VkDeviceMemory sharedMemory, uint32_t memoryType,
+               VkDeviceSize memoryBytes, const std::string& name)
     : size_(size), name_(name) {
   createHandle(ctx);
   VkMemoryRequirements req;
@@ -87,8 +88,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkDeviceMemory sharedMemory, uin
 namespace {
 void checkRange(const std::string& name, VkDeviceSize size, VkDeviceSize bytes, VkDeviceSize offset) {
   if (offset > size || bytes > size - offset)
-    throw Error("buffer '" + name + "': access of " + std::to_string(bytes) + " bytes at offset " + std::to_string(offset) +
-                " exceeds its size " + std::to_string(size));
+    throw Error("buffer '" + name + "': access of " + std::to_string(bytes) + " bytes at offset " +
+                std::to_string(offset) + " exceeds its size " + std::to_string(size));
 }
 }  // namespace
 

@@ -51,7 +51,8 @@ class Buffer {
 
  private:
   void createHandle(Context& ctx);
-  void finish(Context& ctx, VkDeviceMemory memory, uint32_t memoryType);  // binds, maps when host visible, gets the address
+  void finish(Context& ctx, VkDeviceMemory memory,
+              uint32_t memoryType);  // binds, maps when host visible, gets the address
   VkUnique<VkBuffer> buffer_;
   VkUnique<VkDeviceMemory> memory_;  // empty for a buffer over shared memory
   VkDeviceSize size_ = 0;

@@ -12,8 +12,9 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::string& shaderName, co
   if (!shader) throw Error("shader '" + shaderName + "' is not embedded in this build of swish");
   const VkDevice dev = ctx.device();
   if (pushBytes > ctx.properties().limits.maxPushConstantsSize)
-    throw Error("shader '" + shaderName + "' needs " + std::to_string(pushBytes) + " bytes of push constants, device '" +
-                ctx.deviceName() + "' allows " + std::to_string(ctx.properties().limits.maxPushConstantsSize));
+    throw Error("shader '" + shaderName + "' needs " + std::to_string(pushBytes) +
+                " bytes of push constants, device '" + ctx.deviceName() + "' allows " +
+                std::to_string(ctx.properties().limits.maxPushConstantsSize));
 
   VkShaderModuleCreateInfo smci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   smci.codeSize = shader->wordCount * 4;
@@ -50,7 +51,8 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::string& shaderName, co
 void ComputePipeline::bind(VkCommandBuffer cmd, const void* push, uint32_t bytes, VkDescriptorSet set) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline());
   if (bytes) vkCmdPushConstants(cmd, layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
-  if (set != VK_NULL_HANDLE) vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout(), 0, 1, &set, 0, nullptr);
+  if (set != VK_NULL_HANDLE)
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout(), 0, 1, &set, 0, nullptr);
 }
 
 }  // namespace swish::gpu

@@ -34,11 +34,16 @@ std::string versionString(uint32_t v) {
 
 int typeRank(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-    default: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
   }
 }
 
@@ -77,8 +82,8 @@ bool normalMapFormatUsable(VkPhysicalDevice pd) {
 }
 
 VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                              VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                              void* user);
+                                              VkDebugUtilsMessageTypeFlagsEXT,
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
 
 }  // namespace
 
@@ -141,10 +146,11 @@ struct Context::Impl {
 namespace {
 
 VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                              VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                              void* user) {
+                                              VkDebugUtilsMessageTypeFlagsEXT,
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
-  static_cast<Context::Impl*>(user)->record(std::string("[") + level + "] " + (data && data->pMessage ? data->pMessage : ""));
+  static_cast<Context::Impl*>(user)->record(std::string("[") + level + "] " +
+                                            (data && data->pMessage ? data->pMessage : ""));
   return VK_FALSE;
 }
 
@@ -186,7 +192,8 @@ VkInstance createInstance(const ContextOptions& options, bool validation, Contex
   if (validation) {
     if (!layerAvailable(kValidationLayer))
       throw Error(std::string("validation was requested (SWISH_VALIDATION or an option) but ") + kValidationLayer +
-                  " is not installed: install the Vulkan validation layers (Debian: vulkan-validationlayers) or turn validation off");
+                  " is not installed: install the Vulkan validation layers (Debian: vulkan-validationlayers) or turn "
+                  "validation off");
     ici.enabledLayerCount = 1;
     ici.ppEnabledLayerNames = &layer;
     ici.enabledExtensionCount = 1;
@@ -199,8 +206,9 @@ VkInstance createInstance(const ContextOptions& options, bool validation, Contex
   VkInstance instance = VK_NULL_HANDLE;
   const VkResult r = vkCreateInstance(&ici, nullptr, &instance);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-    throw Error("no Vulkan driver is installed (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER): install one, e.g. "
-                "Debian's mesa-vulkan-drivers for the lavapipe CPU implementation");
+    throw Error(
+        "no Vulkan driver is installed (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER): install one, e.g. "
+        "Debian's mesa-vulkan-drivers for the lavapipe CPU implementation");
   if (r != VK_SUCCESS) throwVkError(r, "vkCreateInstance", __FILE__, __LINE__);
   return instance;
 }
@@ -248,7 +256,9 @@ std::string deviceList(const std::vector<PhysicalDeviceInfo>& devs) {
 // Index into devs of the device to use, or throws Error saying why none can be.
 int pick(const std::vector<PhysicalDeviceInfo>& devs, const std::string& request) {
   if (devs.empty())
-    throw Error("no Vulkan device found: install a Vulkan driver (for a CPU fallback, Debian's mesa-vulkan-drivers provides lavapipe)");
+    throw Error(
+        "no Vulkan device found: install a Vulkan driver (for a CPU fallback, Debian's mesa-vulkan-drivers provides "
+        "lavapipe)");
   if (!request.empty()) {
     const bool isIndex = std::all_of(request.begin(), request.end(), [](unsigned char c) { return std::isdigit(c); });
     int found = -1;
@@ -263,8 +273,8 @@ int pick(const std::vector<PhysicalDeviceInfo>& devs, const std::string& request
         }
     }
     if (found < 0)
-      throw Error("no Vulkan device matches '" + request + "' (SWISH_DEVICE or --device: an index or a name substring); devices:" +
-                  deviceList(devs));
+      throw Error("no Vulkan device matches '" + request +
+                  "' (SWISH_DEVICE or --device: an index or a name substring); devices:" + deviceList(devs));
     if (!devs[found].usable)
       throw Error("Vulkan device '" + devs[found].name + "' cannot run swish: " + devs[found].unusableReason);
     return found;
@@ -280,11 +290,16 @@ int pick(const std::vector<PhysicalDeviceInfo>& devs, const std::string& request
 
 const char* deviceTypeName(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
-    default: return "other";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return "CPU";
+    default:
+      return "other";
   }
 }
 
@@ -370,7 +385,8 @@ Context Context::adopt(const AdoptedDevice& host) {
   std::vector<VkQueueFamilyProperties> fams(n);
   vkGetPhysicalDeviceQueueFamilyProperties(host.physicalDevice, &n, fams.data());
   if (host.queueFamily >= n || !(fams[host.queueFamily].queueFlags & VK_QUEUE_COMPUTE_BIT))
-    throw Error("adopting a host device: queue family " + std::to_string(host.queueFamily) + " does not support compute");
+    throw Error("adopting a host device: queue family " + std::to_string(host.queueFamily) +
+                " does not support compute");
   auto impl = std::make_unique<Impl>();
   impl->ownsDevice = false;
   impl->instance = host.instance;

@@ -10,8 +10,9 @@
 //
 // Required of the device (swish enables them on its own device; a host must have enabled them on an
 // adopted one): Vulkan 1.3, a compute queue, bufferDeviceAddress (buffers are passed to kernels as
-// addresses in push constants), maintenance4 (workgroup sizes are specialisation constants). For normal maps also shaderStorageImageExtendedFormats and storage
-// image support of VK_FORMAT_R16G16_SNORM. Missing ones give a swish::Error saying which.
+// addresses in push constants), maintenance4 (workgroup sizes are specialisation constants). For normal maps also
+// shaderStorageImageExtendedFormats and storage image support of VK_FORMAT_R16G16_SNORM. Missing ones give a
+// swish::Error saying which.
 //
 // Validation: ContextOptions::validation, or SWISH_VALIDATION=1, enables VK_LAYER_KHRONOS_validation
 // with a debug messenger recording every warning and error message; tests assert there are none.
@@ -27,8 +28,8 @@
 namespace swish::gpu {
 
 struct ContextOptions {
-  std::string device;                 // index or name substring; empty: SWISH_DEVICE, else automatic
-  std::optional<bool> validation;     // unset: SWISH_VALIDATION (1/true/on enables)
+  std::string device;              // index or name substring; empty: SWISH_DEVICE, else automatic
+  std::optional<bool> validation;  // unset: SWISH_VALIDATION (1/true/on enables)
   std::string applicationName = "swish";
 };
 
@@ -43,12 +44,12 @@ struct AdoptedDevice {
 };
 
 struct PhysicalDeviceInfo {
-  uint32_t index = 0;                 // in vkEnumeratePhysicalDevices order
+  uint32_t index = 0;  // in vkEnumeratePhysicalDevices order
   std::string name;
   VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
   uint32_t apiVersion = 0;
-  bool usable = false;                // meets the requirements above
-  std::string unusableReason;         // why not, when !usable
+  bool usable = false;         // meets the requirements above
+  std::string unusableReason;  // why not, when !usable
 };
 
 const char* deviceTypeName(VkPhysicalDeviceType t);
@@ -77,7 +78,7 @@ class Context {
   const VkPhysicalDeviceProperties& properties() const;
   std::string deviceName() const;
   bool ownsDevice() const;
-  bool supportsNormalMaps() const;   // storage images of R16G16_SNORM usable
+  bool supportsNormalMaps() const;  // storage images of R16G16_SNORM usable
   bool supportsTimestamps() const;
   // 64-bit integers in shaders (shaderInt64): enabled on swish's own device when supported; never
   // assumed on an adopted device (a host need not have enabled it, and Vulkan cannot be asked).

@@ -4,7 +4,8 @@
 
 namespace swish::gpu {
 
-CopyVec4Pass::CopyVec4Pass(Context& ctx) : pipeline_(ctx, "copy_vec4.comp", {kWorkgroupSize}, sizeof(layout::CopyVec4Params)) {}
+CopyVec4Pass::CopyVec4Pass(Context& ctx)
+    : pipeline_(ctx, "copy_vec4.comp", {kWorkgroupSize}, sizeof(layout::CopyVec4Params)) {}
 
 void CopyVec4Pass::record(VkCommandBuffer cmd, VkDeviceAddress src, VkDeviceAddress dst, uint32_t count) const {
   layout::CopyVec4Params p;

@@ -31,14 +31,16 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
   if (influences < 1 || influences > uint32_t(kMaxInfluences))
     throw Error("deform pass: " + std::to_string(influences) + " skin influences; supported: 1..8");
-  inputsLayout_ = DescriptorLayout(ctx, std::vector<VkDescriptorType>(basisTexels_ ? 3 : 2, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
+  inputsLayout_ = DescriptorLayout(
+      ctx, std::vector<VkDescriptorType>(basisTexels_ ? 3 : 2, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
   pipeline_ = ComputePipeline(ctx, basisTexels_ ? "deform_basis_texels.comp" : "deform.comp",
                               {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u}, sizeof(layout::DeformParams),
                               inputsLayout_.get());
 }
 
-DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices, const Buffer* basis,
-                                                 VkDeviceSize weightsOffset, VkDeviceSize matricesOffset) const {
+DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
+                                                 const Buffer* basis, VkDeviceSize weightsOffset,
+                                                 VkDeviceSize matricesOffset) const {
   std::vector<BoundResource> r = {BoundResource::texels(weights, VK_FORMAT_R32G32B32A32_SFLOAT, weightsOffset),
                                   BoundResource::texels(skinMatrices, VK_FORMAT_R32G32B32A32_SFLOAT, matricesOffset)};
   if (basisTexels_) {
@@ -57,7 +59,8 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.skinJoints = layout::Address::of(a.skinJoints);
   p.skinWeights = layout::Address::of(a.skinWeights);
   p.positionsOut = layout::Address::of(a.positionsOut);
-  if (a.capsuleCount > 0 && !a.capsules) throw Error("deform pass: " + std::to_string(a.capsuleCount) + " capsules but no capsule buffer");
+  if (a.capsuleCount > 0 && !a.capsules)
+    throw Error("deform pass: " + std::to_string(a.capsuleCount) + " capsules but no capsule buffer");
   p.capsules = layout::Address::of(a.capsules);
   p.vertexCount = a.vertexCount;
   p.instanceCount = a.instanceCount;

@@ -1,10 +1,10 @@
 #pragma once
 // The deform pass (shaders/deform.comp): PCA reconstruction + linear blend skinning (+ the push-out of
-// the posed body proxy, runtime/reference_push_out.hpp) of every instance of one model in ONE dispatch; each vertex's basis values are read once per frame for all instances.
-// The per-instance inputs (mesh weights, skin matrix rows) are bound as texel buffers through a
-// descriptor set made once per pair of buffers by bindInstanceInputs (descriptor_binding.hpp says why),
-// and with them the model's basis as R32 texels where it fits in the device's maxTexelBufferElements
-// (shaders/deform_basis_texels.comp; else shaders/deform.comp reads it through its address).
+// the posed body proxy, runtime/reference_push_out.hpp) of every instance of one model in ONE dispatch; each vertex's
+// basis values are read once per frame for all instances. The per-instance inputs (mesh weights, skin matrix rows) are
+// bound as texel buffers through a descriptor set made once per pair of buffers by bindInstanceInputs
+// (descriptor_binding.hpp says why), and with them the model's basis as R32 texels where it fits in the device's
+// maxTexelBufferElements (shaders/deform_basis_texels.comp; else shaders/deform.comp reads it through its address).
 //
 // Records one dispatch into the caller's command buffer (never submits). Synchronisation the caller
 // provides: inputs written by the host before the submission (mapped memory; the submission makes them
@@ -41,12 +41,16 @@ class DeformPass {
 
   // Layout of the mesh-weights buffer: float[instances][paddedComponents(K)], each row zero padded.
   static uint32_t paddedComponents(uint32_t k) { return (k + 3) / 4 * 4; }
-  static VkDeviceSize weightsBytes(uint32_t instances, uint32_t k) { return VkDeviceSize(instances) * paddedComponents(k) * 4; }
+  static VkDeviceSize weightsBytes(uint32_t instances, uint32_t k) {
+    return VkDeviceSize(instances) * paddedComponents(k) * 4;
+  }
   // Writes `instances` rows of K weights (row-major, as FrameKernelInputs holds them) in that layout.
   static void packWeights(const float* weights, uint32_t instances, uint32_t k, float* out);
   // Layout of the skin-matrices buffer: vec4[instances][jointCount][3], the top three rows of each
   // affine skinning matrix (3 texel fetches per influence instead of 4 columns).
-  static VkDeviceSize skinMatricesBytes(uint32_t instances, uint32_t joints) { return VkDeviceSize(instances) * joints * 48; }
+  static VkDeviceSize skinMatricesBytes(uint32_t instances, uint32_t joints) {
+    return VkDeviceSize(instances) * joints * 48;
+  }
   // Writes `count` matrices (instance-major, as FrameKernelInputs holds them) in that layout.
   static void packSkinMatrices(const Mat4f* matrices, size_t count, float* out);
 
@@ -55,13 +59,15 @@ class DeformPass {
   // the pre-skinning shape (used to check the PCA reconstruction on its own). basisFloats: 3N x K, the
   // basis read as texels when it is > 0 and within the device's maxTexelBufferElements; 0: through
   // Args::basis.
-  DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true, uint64_t basisFloats = 0);
+  DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
+             uint64_t basisFloats = 0);
   bool basisTexels() const { return basisTexels_; }
 
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
   // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise).
-  DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices, const Buffer* basis,
-                                       VkDeviceSize weightsOffset = 0, VkDeviceSize matricesOffset = 0) const;
+  DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
+                                       const Buffer* basis, VkDeviceSize weightsOffset = 0,
+                                       VkDeviceSize matricesOffset = 0) const;
   // Returns the dispatches recorded (1; 0 for an empty input).
   uint32_t record(VkCommandBuffer cmd, const Args& args) const;
 

@@ -68,11 +68,14 @@ DescriptorLayout::DescriptorLayout(Context& ctx, std::vector<VkDescriptorType> t
   const VkDevice dev = ctx.device();
   VkDescriptorSetLayout layout;
   SWISH_VK(vkCreateDescriptorSetLayout(dev, &lci, nullptr, &layout));
-  layout_ = VkUnique<VkDescriptorSetLayout>(layout, [dev](VkDescriptorSetLayout h) { vkDestroyDescriptorSetLayout(dev, h, nullptr); });
+  layout_ = VkUnique<VkDescriptorSetLayout>(
+      layout, [dev](VkDescriptorSetLayout h) { vkDestroyDescriptorSetLayout(dev, h, nullptr); });
 }
 
 DescriptorBinding::DescriptorBinding(DescriptorBinding&& o) noexcept
-    : pool_(std::move(o.pool_)), views_(std::move(o.views_)), set_(std::exchange(o.set_, VkDescriptorSet(VK_NULL_HANDLE))) {}
+    : pool_(std::move(o.pool_)),
+      views_(std::move(o.views_)),
+      set_(std::exchange(o.set_, VkDescriptorSet(VK_NULL_HANDLE))) {}
 
 DescriptorBinding& DescriptorBinding::operator=(DescriptorBinding&& o) noexcept {
   if (this != &o) {
@@ -85,10 +88,12 @@ DescriptorBinding& DescriptorBinding::operator=(DescriptorBinding&& o) noexcept 
   return *this;
 }
 
-DescriptorBinding::DescriptorBinding(Context& ctx, const DescriptorLayout& layout, const std::vector<BoundResource>& res) {
+DescriptorBinding::DescriptorBinding(Context& ctx, const DescriptorLayout& layout,
+                                     const std::vector<BoundResource>& res) {
   const auto& types = layout.types();
   if (res.size() != types.size())
-    throw Error("descriptor binding: " + std::to_string(res.size()) + " resources for " + std::to_string(types.size()) + " bindings");
+    throw Error("descriptor binding: " + std::to_string(res.size()) + " resources for " + std::to_string(types.size()) +
+                " bindings");
   const VkDevice dev = ctx.device();
   std::map<VkDescriptorType, uint32_t> counts;
   for (VkDescriptorType t : types) ++counts[t];
@@ -147,8 +152,9 @@ DescriptorBinding::DescriptorBinding(Context& ctx, const DescriptorLayout& layou
     const VkDeviceSize texels = bytes / texel;
     if (texels == 0) throw Error(where + ": buffer '" + b.name() + "' holds no whole texel");
     if (texels > limits.maxTexelBufferElements)
-      throw Error(where + ": buffer '" + b.name() + "' holds " + std::to_string(texels) + " texels, beyond the device's " +
-                  std::to_string(limits.maxTexelBufferElements) + " (maxTexelBufferElements); use fewer instances per batch");
+      throw Error(where + ": buffer '" + b.name() + "' holds " + std::to_string(texels) +
+                  " texels, beyond the device's " + std::to_string(limits.maxTexelBufferElements) +
+                  " (maxTexelBufferElements); use fewer instances per batch");
     VkBufferViewCreateInfo vci{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
     vci.buffer = b.handle();
     vci.format = r.format;

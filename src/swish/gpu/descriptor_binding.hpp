@@ -30,11 +30,12 @@ struct BoundResource {
   const Buffer* buffer = nullptr;
   VkFormat format = VK_FORMAT_UNDEFINED;  // texel buffers
   VkDeviceSize offset = 0;
-  VkDeviceSize range = VK_WHOLE_SIZE;     // texel buffers: whole texels of the rest of the buffer
-  VkImageView image = VK_NULL_HANDLE;     // storage images (layout GENERAL)
+  VkDeviceSize range = VK_WHOLE_SIZE;  // texel buffers: whole texels of the rest of the buffer
+  VkImageView image = VK_NULL_HANDLE;  // storage images (layout GENERAL)
 
   // A uniform texel buffer (GLSL samplerBuffer / usamplerBuffer) over `buffer` from `offset`.
-  static BoundResource texels(const Buffer& buffer, VkFormat format, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE);
+  static BoundResource texels(const Buffer& buffer, VkFormat format, VkDeviceSize offset = 0,
+                              VkDeviceSize range = VK_WHOLE_SIZE);
   // A storage buffer (GLSL buffer block) over `buffer` from `offset`.
   static BoundResource storage(const Buffer& buffer, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE);
   static BoundResource storageImage(VkImageView view);

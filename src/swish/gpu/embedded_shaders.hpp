@@ -8,8 +8,8 @@
 namespace swish::shaders {
 
 struct EmbeddedShader {
-  const char* name;        // file name in shaders/, e.g. "deform.comp"
-  const uint32_t* words;   // SPIR-V words
+  const char* name;       // file name in shaders/, e.g. "deform.comp"
+  const uint32_t* words;  // SPIR-V words
   size_t wordCount;
 };
 

@@ -18,7 +18,10 @@ enum Mark : uint32_t { kBegin = 0, kAfterDeform, kAfterTangentFrames, kAfterDeco
 }
 
 FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capacity, const FrameRecorderOptions& o)
-    : ctx_(&ctx), model_(&model), capacity_(capacity), tangentFrames_(o.tangentFrames),
+    : ctx_(&ctx),
+      model_(&model),
+      capacity_(capacity),
+      tangentFrames_(o.tangentFrames),
       normalMaps_(o.normalMaps && model.hasNormalMaps()),
       deform_(ctx, model.kernelMeshComponents(), model.influences(), true, model.basis.size() / sizeof(float)) {
   if (o.framesInFlight < 1 || o.framesInFlight > 8)
@@ -29,7 +32,8 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
     decode_ = VqDecodePass(ctx);
     blend_ = NormalMapBlendPass(ctx, model.mapWidth());
   }
-  for (uint32_t s = 0; s < o.framesInFlight; ++s) frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s, o.shareNormalMapTexels);
+  for (uint32_t s = 0; s < o.framesInFlight; ++s)
+    frames_.emplace_back(ctx, model, capacity, tangentFrames_, normalMaps_, s, o.shareNormalMapTexels);
   for (uint32_t s = 0; s < o.framesInFlight; ++s) {
     FrameResources& f = frames_[s];
     f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices, &model.basis);
@@ -57,16 +61,19 @@ void FrameRecorder::forgetDecodedMaps() {
 uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& in) {
   const GpuModel& m = *model_;
   if (in.instanceCount > capacity_)
-    throw Error("frame recorder: " + std::to_string(in.instanceCount) + " instances, capacity " + std::to_string(capacity_));
+    throw Error("frame recorder: " + std::to_string(in.instanceCount) + " instances, capacity " +
+                std::to_string(capacity_));
   const size_t k = m.meshComponents(), j = m.jointCount();
   if (in.meshWeights.size() != in.instanceCount * k || in.skinMatrices.size() != in.instanceCount * j)
     throw Error("frame recorder: mesh weights or skinning matrices do not match " + std::to_string(in.instanceCount) +
                 " instances of '" + m.name() + "'");
   const bool maps = normalMaps_ && !in.selectedMaps.empty();
-  if (!in.selectedMaps.empty() && (in.selectedMaps.size() != in.instanceCount || in.blendAlpha.size() != in.instanceCount))
+  if (!in.selectedMaps.empty() &&
+      (in.selectedMaps.size() != in.instanceCount || in.blendAlpha.size() != in.instanceCount))
     throw Error("frame recorder: selected maps and blend weights must be given for every instance, or not at all");
   for (uint32_t map : in.selectedMaps)
-    if (map >= m.mapCount()) throw Error("frame recorder: map " + std::to_string(map) + " is not in the database of '" + m.name() + "'");
+    if (map >= m.mapCount())
+      throw Error("frame recorder: map " + std::to_string(map) + " is not in the database of '" + m.name() + "'");
 
   FrameResources& f = frames_[slotOf(frameIndex)];
   f.instanceCount = in.instanceCount;
@@ -119,7 +126,7 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
 
   if (tangentFrames_) {
     computeToComputeBarrier(cmd);  // positions written -> read
-    TangentFramesPass::Args t;  // two-pass: each triangle's terms computed once (the rest is in the set)
+    TangentFramesPass::Args t;     // two-pass: each triangle's terms computed once (the rest is in the set)
     t.uvs = m.uvs.address();
     t.triangles = m.triangles.address();
     t.vertexCount = m.vertexCount();
@@ -137,7 +144,9 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
     // selected (never one this frame reads). A batch selects a few dozen maps at most, so linear
     // searches beat hashing. The distinct maps of a frame never outnumber the slots (one per instance).
     const uint64_t now = ++records_;  // 0 in slotLastUsed: never selected
-    auto slotOfMap = [&](uint32_t map) { return size_t(std::find(f.slotMap.begin(), f.slotMap.end(), map) - f.slotMap.begin()); };
+    auto slotOfMap = [&](uint32_t map) {
+      return size_t(std::find(f.slotMap.begin(), f.slotMap.end(), map) - f.slotMap.begin());
+    };
     for (uint32_t map : in.selectedMaps)  // first the slots this frame reads, so that none is given away
       if (const size_t slot = slotOfMap(map); slot < f.slotMap.size()) f.slotLastUsed[slot] = now;
     std::vector<uint32_t> jobMaps, jobSlots;
@@ -189,7 +198,9 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
 StageTimes FrameRecorder::stageTimes(uint32_t slot) const {
   const auto t = frames_.at(slot).timestamps.readNs();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  auto span = [&](uint32_t a, uint32_t b) { return (std::isnan(t[a]) || std::isnan(t[b])) ? nan : (t[b] - t[a]) * 1e-6; };
+  auto span = [&](uint32_t a, uint32_t b) {
+    return (std::isnan(t[a]) || std::isnan(t[b])) ? nan : (t[b] - t[a]) * 1e-6;
+  };
   StageTimes s{span(kBegin, kAfterDeform), nan, nan, nan, nan};
   uint32_t last = kAfterDeform;
   if (!std::isnan(t[kAfterTangentFrames])) s.tangentFramesMs = span(kAfterDeform, last = kAfterTangentFrames);
@@ -234,11 +245,12 @@ void FrameRecorder::uploadNormalMaps(uint32_t slot, const std::vector<runtime::B
   const size_t per = size_t(f.normalMaps.width()) * f.normalMaps.height() * 2;
   if (maps.size() > f.normalMaps.layers()) throw Error("frame recorder: more maps than instance capacity");
   for (size_t i = 0; i < maps.size(); ++i) {
-    if (maps[i].xy.size() != per) throw Error("frame recorder: normal map " + std::to_string(i) + " has the wrong size");
+    if (maps[i].xy.size() != per)
+      throw Error("frame recorder: normal map " + std::to_string(i) + " has the wrong size");
     std::copy(maps[i].xy.begin(), maps[i].xy.end(), all.begin() + i * per);
   }
   f.normalMaps.upload(*ctx_, all);
-  if (!f.normalMaps.sharesTexels())  // else the upload wrote them
+  if (!f.normalMaps.sharesTexels())                                           // else the upload wrote them
     f.blendedTexels.upload(*ctx_, all.data(), all.size() * sizeof(int16_t));  // what the next frame's blend reads
 }
 

@@ -46,7 +46,8 @@ struct StageTimes {
 
 class FrameRecorder {
  public:
-  FrameRecorder(Context& ctx, const GpuModel& model, uint32_t instanceCapacity, const FrameRecorderOptions& options = {});
+  FrameRecorder(Context& ctx, const GpuModel& model, uint32_t instanceCapacity,
+                const FrameRecorderOptions& options = {});
   FrameRecorder(const FrameRecorder&) = delete;
   FrameRecorder& operator=(const FrameRecorder&) = delete;
 

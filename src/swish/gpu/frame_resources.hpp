@@ -29,8 +29,8 @@ struct FrameResources {
   FrameResources() = default;
   // withNormalMaps: allocate the decode slots and per-character images (the model must have a database);
   // shareTexels: lay the images over the blend's output where the device allows it (NormalMapImages).
-  FrameResources(Context& ctx, const GpuModel& model, uint32_t instanceCapacity, bool withTangentFrames, bool withNormalMaps,
-                 uint32_t slot, bool shareTexels = true);
+  FrameResources(Context& ctx, const GpuModel& model, uint32_t instanceCapacity, bool withTangentFrames,
+                 bool withNormalMaps, uint32_t slot, bool shareTexels = true);
 
   // Inputs, written by FrameRecorder::record.
   Buffer meshWeights;      // float[instances][K4] (DeformPass::packWeights)
@@ -39,11 +39,11 @@ struct FrameResources {
   Buffer decodeSlotMaps;   // the VQ decode jobs: uint[2][instances], maps then the slots they go to
   Buffer blendCharacters;  // layout::NormalMapBlendCharacter[instances]
   // Outputs.
-  Buffer positions;        // float[instances][N][3]
-  Buffer normals;          // float[instances][N][3]
-  Buffer tangents;         // float[instances][N][4]
-  Buffer decodedMaps;      // uint16[slots][H][W] (snorm8 X | Y << 8): decoded database maps, one slot per instance
-  Buffer triangleTerms;    // vec4[instances][T][3], scratch of the two-pass tangent frames
+  Buffer positions;            // float[instances][N][3]
+  Buffer normals;              // float[instances][N][3]
+  Buffer tangents;             // float[instances][N][4]
+  Buffer decodedMaps;          // uint16[slots][H][W] (snorm8 X | Y << 8): decoded database maps, one slot per instance
+  Buffer triangleTerms;        // vec4[instances][T][3], scratch of the two-pass tangent frames
   NormalMapImages normalMaps;  // one layer per instance
   // uint32[instances][H][W] (snorm16 X | Y << 16): the blend's output, copied into normalMaps; empty
   // where normalMaps.sharesTexels() (the blend writes normalMaps.texels(), the images' own memory).

@@ -36,8 +36,8 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   const size_t n = vertexCount_;
   if (n == 0) fail("the game mesh has no vertices");
   if (size_t(m.meshPca.mean.size()) != 3 * n || size_t(m.meshPca.basis.rows()) != 3 * n)
-    fail("mesh PCA has " + std::to_string(m.meshPca.mean.size()) + " mean values and " + std::to_string(m.meshPca.basis.rows()) +
-         " basis rows, 3 x " + std::to_string(n) + " vertices expected");
+    fail("mesh PCA has " + std::to_string(m.meshPca.mean.size()) + " mean values and " +
+         std::to_string(m.meshPca.basis.rows()) + " basis rows, 3 x " + std::to_string(n) + " vertices expected");
   if (influences_ < 1 || influences_ > uint32_t(kMaxInfluences) || g.skin.weights.size() != n * influences_ ||
       g.skin.joints.size() != n * influences_)
     fail("skin weights do not have 1..8 influences for each of the " + std::to_string(n) + " vertices");
@@ -47,7 +47,8 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
            " is not in the skeleton of " + std::to_string(jointCount_) + " joints");
   for (Eigen::Index t = 0; t < g.triangles.rows(); ++t)
     for (int k = 0; k < 3; ++k)
-      if (g.triangles(t, k) >= n) fail("triangle " + std::to_string(t) + " refers to vertex " + std::to_string(g.triangles(t, k)));
+      if (g.triangles(t, k) >= n)
+        fail("triangle " + std::to_string(t) + " refers to vertex " + std::to_string(g.triangles(t, k)));
   hasUvs_ = size_t(g.uvs.rows()) == n;
 
   mean = uploaded(ctx, name + ": PCA mean", m.meshPca.mean.data(), 3 * n);
@@ -55,13 +56,16 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
     const std::vector<float> zero(3 * n, 0.f);
     basis = uploaded(ctx, name + ": PCA basis", zero);
   } else {
-    basis = uploaded(ctx, name + ": PCA basis", m.meshPca.basis.data(), size_t(m.meshPca.basis.size()));  // column-major = [k][3N]
+    basis = uploaded(ctx, name + ": PCA basis", m.meshPca.basis.data(),
+                     size_t(m.meshPca.basis.size()));  // column-major = [k][3N]
   }
   const std::vector<uint32_t> joints(g.skin.joints.begin(), g.skin.joints.end());
   skinJoints = uploaded(ctx, name + ": skin joints", joints);
   skinWeights = uploaded(ctx, name + ": skin weights", g.skin.weights);
-  if (hasUvs_) uvs = uploaded(ctx, name + ": UVs", g.uvs.data(), 2 * n);
-  else uvs = Buffer(ctx, 8, MemoryKind::DeviceLocal, name + ": UVs (none)");
+  if (hasUvs_)
+    uvs = uploaded(ctx, name + ": UVs", g.uvs.data(), 2 * n);
+  else
+    uvs = Buffer(ctx, 8, MemoryKind::DeviceLocal, name + ": UVs (none)");
   triangles = uploaded(ctx, name + ": triangles", g.triangles.data(), size_t(g.triangles.size()));
 
   const MeshFrameTopology topo = buildFrameTopology(g.triangles, g.positions);
@@ -74,9 +78,11 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   const NormalMapDatabase& db = m.normalMaps;
   if (!db.empty()) {
     if (db.width == 0 || db.height == 0 || db.width % 4 || db.height % 4)
-      fail("normal-map size " + std::to_string(db.width) + "x" + std::to_string(db.height) + " is not a positive multiple of 4");
+      fail("normal-map size " + std::to_string(db.width) + "x" + std::to_string(db.height) +
+           " is not a positive multiple of 4");
     if (db.codebook.size() != size_t(db.codebookSize) * 32) fail("VQ codebook size does not match its entry count");
-    if (db.indices.size() != size_t(db.mapCount()) * db.blocksPerMap()) fail("VQ index count does not match maps x blocks");
+    if (db.indices.size() != size_t(db.mapCount()) * db.blocksPerMap())
+      fail("VQ index count does not match maps x blocks");
     mapCount_ = db.mapCount();
     mapWidth_ = db.width;
     mapHeight_ = db.height;

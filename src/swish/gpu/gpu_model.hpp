@@ -25,8 +25,8 @@ class GpuModel {
   uint32_t vertexCount() const { return vertexCount_; }
   uint32_t triangleCount() const { return triangleCount_; }
   uint32_t jointCount() const { return jointCount_; }
-  uint32_t meshComponents() const { return meshComponents_; }        // K of the model (may be 0)
-  uint32_t kernelMeshComponents() const { return kernelComponents_; } // max(K, 1): a zero column pads K = 0
+  uint32_t meshComponents() const { return meshComponents_; }          // K of the model (may be 0)
+  uint32_t kernelMeshComponents() const { return kernelComponents_; }  // max(K, 1): a zero column pads K = 0
   uint32_t influences() const { return influences_; }
   bool hasUvs() const { return hasUvs_; }
   bool hasNormalMaps() const { return mapCount_ > 0; }

@@ -15,9 +15,12 @@ static_assert(sizeof(NormalMapBlendPass::Character) == sizeof(layout::NormalMapB
               offsetof(NormalMapBlendPass::Character, alpha) == offsetof(layout::NormalMapBlendCharacter, alpha));
 
 NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width, bool store64)
-    : width_(width), store64_(store64 && ctx.hasShaderInt64()),
-      layout_(ctx, {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER}) {
-  if (width == 0 || width % 4) throw Error("normal-map blend: map width " + std::to_string(width) + " is not a multiple of 4");
+    : width_(width),
+      store64_(store64 && ctx.hasShaderInt64()),
+      layout_(ctx, {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER}) {
+  if (width == 0 || width % 4)
+    throw Error("normal-map blend: map width " + std::to_string(width) + " is not a multiple of 4");
   const VkPhysicalDeviceLimits& lim = ctx.properties().limits;
   const uint32_t blocksX = width / 4;
   const uint32_t most = std::min({kMaxRowGroup, lim.maxComputeWorkGroupSize[0], lim.maxComputeWorkGroupInvocations});
@@ -26,11 +29,12 @@ NormalMapBlendPass::NormalMapBlendPass(Context& ctx, uint32_t width, bool store6
   if (!exact_) rowGroup_ = std::min(kFallbackGroup, most);
   for (size_t i = 0; i < std::size(kRowsPerInvocation); ++i)
     pipelines_[i] = ComputePipeline(ctx, store64_ ? "normal_map_blend_store64.comp" : "normal_map_blend.comp",
-                                    {rowGroup_, exact_ ? 1u : 0u, kRowsPerInvocation[i]}, sizeof(layout::NormalMapBlendParams),
-                                    layout_.get());
+                                    {rowGroup_, exact_ ? 1u : 0u, kRowsPerInvocation[i]},
+                                    sizeof(layout::NormalMapBlendParams), layout_.get());
 }
 
-DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const Buffer& prev, const Buffer& out, const Buffer& decoded) const {
+DescriptorBinding NormalMapBlendPass::makeBinding(Context& ctx, const Buffer& prev, const Buffer& out,
+                                                  const Buffer& decoded) const {
   return DescriptorBinding(ctx, layout_,
                            {BoundResource::texels(prev, VK_FORMAT_R32G32B32A32_UINT), BoundResource::storage(out),
                             BoundResource::texels(decoded, VK_FORMAT_R32G32_UINT)});
@@ -75,7 +79,8 @@ uint32_t NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding
   ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   ib.image = a.outMaps;
   ib.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, a.characterCount};
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr, 1, &ib);
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr,
+                       1, &ib);
   VkBufferImageCopy c{};  // tightly packed rows and layers: the texels' layout is the image's
   c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, a.characterCount};
   c.imageExtent = {a.width, a.height, 1};
@@ -87,7 +92,8 @@ uint32_t NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding
   ib.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
   ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   ib.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &ib);
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0,
+                       nullptr, 1, &ib);
   return 1;
 }
 

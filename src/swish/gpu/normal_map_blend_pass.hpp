@@ -18,9 +18,9 @@
 //
 // prev, out and the decoded slots (VqDecodePass output) are bound through a descriptor set made by
 // makeBinding(); prev and out may be the same buffer (one frame in flight). Records one dispatch and,
-// unless the images share out's memory, one copy (never submits). The caller places computeToComputeBarrier after the VQ decode pass and
-// before this one (which also orders this frame's read of `prev` after the previous frame's write of it
-// on the same queue). The images are written by a transfer, after which record() places a barrier
+// unless the images share out's memory, one copy (never submits). The caller places computeToComputeBarrier after the
+// VQ decode pass and before this one (which also orders this frame's read of `prev` after the previous frame's write of
+// it on the same queue). The images are written by a transfer, after which record() places a barrier
 // TRANSFER/TRANSFER_WRITE -> COMPUTE_SHADER/SHADER_READ|WRITE, so that the documented contract for a
 // renderer holds unchanged: a barrier COMPUTE_SHADER/SHADER_WRITE -> its own stage/SHADER_READ
 // before sampling `out` (the two form a dependency chain). With shared texels the dispatch writes the
@@ -63,13 +63,14 @@ class NormalMapBlendPass {
   }
 
   struct Args {
-    VkDeviceAddress characters = 0;  // Character[characterCount]
-    uint32_t width = 0, height = 0;  // multiples of 4, those of the bound buffers, decoded slots and images; width
-                                     // that of the pass
-    uint32_t characterCount = 0;     // <= layers of the bound buffers and of outMaps
+    VkDeviceAddress characters = 0;       // Character[characterCount]
+    uint32_t width = 0, height = 0;       // multiples of 4, those of the bound buffers, decoded slots and images; width
+                                          // that of the pass
+    uint32_t characterCount = 0;          // <= layers of the bound buffers and of outMaps
     VkBuffer outTexels = VK_NULL_HANDLE;  // the `out` buffer of the binding, copied into outMaps
-    VkImage outMaps = VK_NULL_HANDLE;     // a NormalMapImages::image() (layout GENERAL): layers 0..characterCount-1 written
-    bool outMapsShareTexels = false;      // outMaps lies over outTexels' memory (NormalMapImages::sharesTexels): no copy
+    VkImage outMaps =
+        VK_NULL_HANDLE;               // a NormalMapImages::image() (layout GENERAL): layers 0..characterCount-1 written
+    bool outMapsShareTexels = false;  // outMaps lies over outTexels' memory (NormalMapImages::sharesTexels): no copy
   };
 
   NormalMapBlendPass() = default;
@@ -78,8 +79,8 @@ class NormalMapBlendPass {
   NormalMapBlendPass(Context& ctx, uint32_t width, bool store64 = true);
   uint32_t width() const { return width_; }
   uint32_t rowGroup() const { return rowGroup_; }  // block columns per workgroup
-  bool exact() const { return exact_; }             // rowGroup() divides width / 4
-  bool stores64() const { return store64_; }        // normal_map_blend_store64.comp
+  bool exact() const { return exact_; }            // rowGroup() divides width / 4
+  bool stores64() const { return store64_; }       // normal_map_blend_store64.comp
 
   // A descriptor set binding the packed texels `prev` (read), `out` (written) and the decoded slots
   // `decoded` (uint16[slots][height][width], from its start).

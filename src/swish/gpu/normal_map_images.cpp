@@ -9,8 +9,8 @@ namespace swish::gpu {
 
 namespace {
 // The usage the header and docs/integration.md promise: storage, sampled, transfer src/dst.
-constexpr VkImageUsageFlags kUsage =
-    VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+constexpr VkImageUsageFlags kUsage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 }  // namespace
 
 bool NormalMapImages::deviceSupportsLinear(Context& ctx, uint32_t width, uint32_t height, uint32_t layers) {
@@ -20,8 +20,8 @@ bool NormalMapImages::deviceSupportsLinear(Context& ctx, uint32_t width, uint32_
   vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), kFormat, &fp);
   if ((fp.linearTilingFeatures & features) != features) return false;
   VkImageFormatProperties ip;
-  if (vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), kFormat, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_LINEAR, kUsage, 0,
-                                               &ip) != VK_SUCCESS)
+  if (vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), kFormat, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_LINEAR,
+                                               kUsage, 0, &ip) != VK_SUCCESS)
     return false;
   return ip.maxArrayLayers >= layers && ip.maxExtent.width >= width && ip.maxExtent.height >= height &&
          ip.maxResourceSize >= VkDeviceSize(width) * height * 4 * layers;
@@ -30,8 +30,9 @@ bool NormalMapImages::deviceSupportsLinear(Context& ctx, uint32_t width, uint32_
 NormalMapImages::NormalMapImages(Context& ctx, uint32_t width, uint32_t height, uint32_t layers, bool shareTexels)
     : width_(width), height_(height), layers_(layers) {
   if (!ctx.supportsNormalMaps())
-    throw Error("Vulkan device '" + ctx.deviceName() +
-                "' cannot store normal maps: it lacks storage images of R16G16_SNORM (shaderStorageImageExtendedFormats)");
+    throw Error(
+        "Vulkan device '" + ctx.deviceName() +
+        "' cannot store normal maps: it lacks storage images of R16G16_SNORM (shaderStorageImageExtendedFormats)");
   if (width == 0 || height == 0 || layers == 0) throw Error("normal-map images: width, height and layers must be > 0");
   const VkDevice dev = ctx.device();
   const VkDeviceSize texelBytes = VkDeviceSize(width) * height * 4 * layers;
@@ -110,22 +111,24 @@ NormalMapImages::NormalMapImages(Context& ctx, uint32_t width, uint32_t height, 
     b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = img;
     b.subresourceRange = vci.subresourceRange;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &b);
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
     const VkClearColorValue zero{};
     vkCmdClearColorImage(cmd, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1, &vci.subresourceRange);
     b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
     b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
     b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &b);
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
   });
 }
 
 namespace {
 // Layout transitions around transfers: the images live in GENERAL, copies use the TRANSFER_*_OPTIMAL
 // layouts (what the validation layers' best-practice checks ask for).
-void transition(VkCommandBuffer cmd, VkImage image, uint32_t layers, VkImageLayout from, VkImageLayout to, VkAccessFlags src,
-                VkPipelineStageFlags srcStage, VkAccessFlags dst, VkPipelineStageFlags dstStage) {
+void transition(VkCommandBuffer cmd, VkImage image, uint32_t layers, VkImageLayout from, VkImageLayout to,
+                VkAccessFlags src, VkPipelineStageFlags srcStage, VkAccessFlags dst, VkPipelineStageFlags dstStage) {
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.srcAccessMask = src;
   b.dstAccessMask = dst;
@@ -147,7 +150,8 @@ std::vector<int16_t> NormalMapImages::download(Context& ctx) const {
       mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
       mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
       vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                           VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr, 0, nullptr);
+                           VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr, 0,
+                           nullptr);
     });
     std::vector<int16_t> out(count);
     texels_.download(ctx, out.data(), count * sizeof(int16_t));
@@ -155,14 +159,16 @@ std::vector<int16_t> NormalMapImages::download(Context& ctx) const {
   }
   Buffer staging(ctx, count * sizeof(int16_t), MemoryKind::HostVisible, "normal-map readback");
   ctx.submitAndWait([&](VkCommandBuffer cmd) {
-    transition(cmd, image(), layers_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
-               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    transition(cmd, image(), layers_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+               VK_PIPELINE_STAGE_TRANSFER_BIT);
     VkBufferImageCopy c{};
     c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers_};
     c.imageExtent = {width_, height_, 1};
     vkCmdCopyImageToBuffer(cmd, image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(), 1, &c);
-    transition(cmd, image(), layers_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_READ_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, kShaderRW, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    transition(cmd, image(), layers_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+               VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, kShaderRW,
+               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
     computeToHostBarrier(cmd);
   });
   std::vector<int16_t> out(count);
@@ -173,7 +179,8 @@ std::vector<int16_t> NormalMapImages::download(Context& ctx) const {
 void NormalMapImages::upload(Context& ctx, const std::vector<int16_t>& texels) {
   const size_t count = size_t(width_) * height_ * layers_ * 2;
   if (texels.size() != count)
-    throw Error("normal-map upload: " + std::to_string(texels.size()) + " values given, " + std::to_string(count) + " expected");
+    throw Error("normal-map upload: " + std::to_string(texels.size()) + " values given, " + std::to_string(count) +
+                " expected");
   if (sharesTexels()) {
     texels_.upload(ctx, texels.data(), count * sizeof(int16_t));
     return;
@@ -187,8 +194,9 @@ void NormalMapImages::upload(Context& ctx, const std::vector<int16_t>& texels) {
     c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers_};
     c.imageExtent = {width_, height_, 1};
     vkCmdCopyBufferToImage(cmd, staging.handle(), image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
-    transition(cmd, image(), layers_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, kShaderRW, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    transition(cmd, image(), layers_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+               VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, kShaderRW,
+               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
   });
 }
 

@@ -22,12 +22,16 @@ std::vector<uint32_t> TangentFramesPass::frameTriangles(const MeshFrameTopology&
   for (size_t v = 0; v + 1 < welded.offsets.size(); ++v) {
     uint32_t j = own.offsets[v];
     for (uint32_t i = welded.offsets[v]; i < welded.offsets[v + 1]; ++i) {
-      if (out[i] & SWISH_NOT_OWN_TRIANGLE) throw Error("tangent frames: triangle index " + std::to_string(out[i]) + " too large");
-      if (j < own.offsets[v + 1] && own.triangles[j] == out[i]) ++j;
-      else out[i] |= SWISH_NOT_OWN_TRIANGLE;
+      if (out[i] & SWISH_NOT_OWN_TRIANGLE)
+        throw Error("tangent frames: triangle index " + std::to_string(out[i]) + " too large");
+      if (j < own.offsets[v + 1] && own.triangles[j] == out[i])
+        ++j;
+      else
+        out[i] |= SWISH_NOT_OWN_TRIANGLE;
     }
     if (j != own.offsets[v + 1])
-      throw Error("tangent frames: vertex " + std::to_string(v) + "'s own triangles are not a subsequence of its welded ones");
+      throw Error("tangent frames: vertex " + std::to_string(v) +
+                  "'s own triangles are not a subsequence of its welded ones");
   }
   return out;
 }
@@ -47,8 +51,8 @@ TangentFramesPass::TangentFramesPass(Context& ctx, bool store64)
       pipeline_(ctx, "tangent_frames.comp", {kWorkgroupSize}, sizeof(layout::TangentFramesParams)),
       trianglePipeline_(ctx, store64_ ? "triangle_frames_store64.comp" : "triangle_frames.comp", {kWorkgroupSize},
                         sizeof(layout::TriangleFramesParams), twoPassLayout_.get()),
-      gatherPipeline_(ctx, store64_ ? "vertex_frames_gather_store64.comp" : "vertex_frames_gather.comp", {kWorkgroupSize},
-                      sizeof(layout::VertexFramesGatherParams), twoPassLayout_.get()) {}
+      gatherPipeline_(ctx, store64_ ? "vertex_frames_gather_store64.comp" : "vertex_frames_gather.comp",
+                      {kWorkgroupSize}, sizeof(layout::VertexFramesGatherParams), twoPassLayout_.get()) {}
 
 DescriptorBinding TangentFramesPass::bindTwoPass(Context& ctx, const TwoPassBuffers& b) const {
   for (const Buffer* p : {b.positions, b.triangleTerms, b.normalOffsets, b.frameTriangles, b.normalsOut, b.tangentsOut})

@@ -84,9 +84,9 @@ class TangentFramesPass {
  private:
   bool store64_ = false;
   DescriptorLayout twoPassLayout_;
-  ComputePipeline pipeline_;         // single pass: tangent_frames.comp
-  ComputePipeline trianglePipeline_; // two passes: triangle_frames.comp ...
-  ComputePipeline gatherPipeline_;   // ... then vertex_frames_gather.comp
+  ComputePipeline pipeline_;          // single pass: tangent_frames.comp
+  ComputePipeline trianglePipeline_;  // two passes: triangle_frames.comp ...
+  ComputePipeline gatherPipeline_;    // ... then vertex_frames_gather.comp
 };
 
 }  // namespace swish::gpu

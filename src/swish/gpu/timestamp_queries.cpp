@@ -33,7 +33,8 @@ void TimestampQueries::reset(VkCommandBuffer cmd) {
 }
 
 void TimestampQueries::mark(VkCommandBuffer cmd, uint32_t index) {
-  if (index >= capacity_) throw Error("timestamp index " + std::to_string(index) + " beyond the pool's " + std::to_string(capacity_));
+  if (index >= capacity_)
+    throw Error("timestamp index " + std::to_string(index) + " beyond the pool's " + std::to_string(capacity_));
   written_[index] = true;
   if (pool_) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_.get(), index);
 }

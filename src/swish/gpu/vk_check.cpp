@@ -34,8 +34,8 @@ const char* vkResultName(VkResult r) {
 }
 
 void throwVkError(VkResult r, const char* call, const char* file, int line) {
-  throw Error(std::string("Vulkan call failed: ") + call + " returned " + vkResultName(r) + " (" + std::to_string(int(r)) +
-              ") at " + file + ":" + std::to_string(line));
+  throw Error(std::string("Vulkan call failed: ") + call + " returned " + vkResultName(r) + " (" +
+              std::to_string(int(r)) + ") at " + file + ":" + std::to_string(line));
 }
 
 }  // namespace swish::gpu

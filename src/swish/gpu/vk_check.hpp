@@ -19,8 +19,8 @@ const char* vkResultName(VkResult r);
 
 }  // namespace swish::gpu
 
-#define SWISH_VK(call)                                                                  \
-  do {                                                                                  \
-    const VkResult swishVkResult_ = (call);                                             \
+#define SWISH_VK(call)                                                                                       \
+  do {                                                                                                       \
+    const VkResult swishVkResult_ = (call);                                                                  \
     if (swishVkResult_ != VK_SUCCESS) ::swish::gpu::throwVkError(swishVkResult_, #call, __FILE__, __LINE__); \
   } while (0)

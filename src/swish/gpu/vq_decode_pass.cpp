@@ -6,12 +6,14 @@
 
 namespace swish::gpu {
 
-VqDecodePass::VqDecodePass(Context& ctx) : pipeline_(ctx, "vq_decode.comp", {kWorkgroupSize}, sizeof(layout::VqDecodeParams)) {}
+VqDecodePass::VqDecodePass(Context& ctx)
+    : pipeline_(ctx, "vq_decode.comp", {kWorkgroupSize}, sizeof(layout::VqDecodeParams)) {}
 
 uint32_t VqDecodePass::record(VkCommandBuffer cmd, const Args& a) const {
   if (a.jobCount == 0 || a.width == 0 || a.height == 0) return 0;
   if (a.width % 4 || a.height % 4)
-    throw Error("VQ decode: map size " + std::to_string(a.width) + "x" + std::to_string(a.height) + " is not a multiple of 4");
+    throw Error("VQ decode: map size " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                " is not a multiple of 4");
   layout::VqDecodeParams p;
   p.codebook = layout::Address::of(a.codebook);
   p.indices = layout::Address::of(a.indices);

@@ -14,7 +14,7 @@ namespace swish::io {
 // keep their vertex order and count (no vertex joining), other formats get identical vertices joined.
 // animationOnly: a file with animation but no meshes (assimp flags those incomplete) is accepted.
 const aiScene& readAssimpScene(Assimp::Importer& importer, const std::filesystem::path& file,
-                                bool animationOnly = false);
+                               bool animationOnly = false);
 
 inline Eigen::Matrix4d toEigen(const aiMatrix4x4& m) {
   Eigen::Matrix4d e;

@@ -74,7 +74,7 @@ SourceAnimation readBvh(std::istream& in, const std::string& name) {
   std::string t = tok.expectAny("'ROOT'");
   if (t != "ROOT") tok.fail("expected 'ROOT', found '" + t + "'");
   // Recursive descent over ROOT/JOINT/End Site blocks with an explicit stack of open joints.
-  std::vector<int> open;    // joint index per open brace, -1 for an End Site
+  std::vector<int> open;  // joint index per open brace, -1 for an End Site
   auto beginJoint = [&](int parent) {
     const std::string jname = tok.expectAny("a joint name");
     if (anim.find(jname) >= 0) tok.fail("joint name '" + jname + "' repeats");
@@ -88,13 +88,20 @@ SourceAnimation readBvh(std::istream& in, const std::string& name) {
     std::vector<Channel> ch;
     for (int k = 0; k < int(n); ++k) {
       const std::string c = tok.expectAny("a channel name");
-      if (c == "Xposition") ch.push_back(Channel::Xpos);
-      else if (c == "Yposition") ch.push_back(Channel::Ypos);
-      else if (c == "Zposition") ch.push_back(Channel::Zpos);
-      else if (c == "Xrotation") ch.push_back(Channel::Xrot);
-      else if (c == "Yrotation") ch.push_back(Channel::Yrot);
-      else if (c == "Zrotation") ch.push_back(Channel::Zrot);
-      else tok.fail("unknown channel '" + c + "'");
+      if (c == "Xposition")
+        ch.push_back(Channel::Xpos);
+      else if (c == "Yposition")
+        ch.push_back(Channel::Ypos);
+      else if (c == "Zposition")
+        ch.push_back(Channel::Zpos);
+      else if (c == "Xrotation")
+        ch.push_back(Channel::Xrot);
+      else if (c == "Yrotation")
+        ch.push_back(Channel::Yrot);
+      else if (c == "Zrotation")
+        ch.push_back(Channel::Zrot);
+      else
+        tok.fail("unknown channel '" + c + "'");
     }
     anim.jointNames.push_back(jname);
     anim.parents.push_back(parent);
@@ -144,14 +151,24 @@ SourceAnimation readBvh(std::istream& in, const std::string& name) {
         char* end = nullptr;
         const double v = std::strtod(tokText.c_str(), &end);
         if (end == tokText.c_str() || *end != '\0')
-          tok.fail("frame " + std::to_string(f) + ", joint '" + anim.jointNames[j] + "': expected a number, found '" + tokText + "'");
+          tok.fail("frame " + std::to_string(f) + ", joint '" + anim.jointNames[j] + "': expected a number, found '" +
+                   tokText + "'");
         if (!std::isfinite(v))
-          tok.fail("frame " + std::to_string(f) + ", joint '" + anim.jointNames[j] + "': non-finite value '" + tokText + "'");
+          tok.fail("frame " + std::to_string(f) + ", joint '" + anim.jointNames[j] + "': non-finite value '" + tokText +
+                   "'");
         switch (c) {
-          case Channel::Xpos: x.translation.x() = float(v); break;
-          case Channel::Ypos: x.translation.y() = float(v); break;
-          case Channel::Zpos: x.translation.z() = float(v); break;
-          default: x.rotation = x.rotation * axisRotation(c, v); break;
+          case Channel::Xpos:
+            x.translation.x() = float(v);
+            break;
+          case Channel::Ypos:
+            x.translation.y() = float(v);
+            break;
+          case Channel::Zpos:
+            x.translation.z() = float(v);
+            break;
+          default:
+            x.rotation = x.rotation * axisRotation(c, v);
+            break;
         }
       }
       x.rotation.normalize();
@@ -159,7 +176,8 @@ SourceAnimation readBvh(std::istream& in, const std::string& name) {
     }
   }
   std::string extra;
-  if (tok.next(extra)) tok.fail("unexpected data after the " + std::to_string(anim.frames.size()) + " declared frames: '" + extra + "'");
+  if (tok.next(extra))
+    tok.fail("unexpected data after the " + std::to_string(anim.frames.size()) + " declared frames: '" + extra + "'");
   return anim;
 }
 

@@ -27,7 +27,8 @@ struct SkeletonBuild {
 SkeletonBuild buildSkeleton(const aiScene& scene, const std::string& file) {
   std::unordered_map<std::string, bool> isBone;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m)
-    for (unsigned b = 0; b < scene.mMeshes[m]->mNumBones; ++b) isBone[scene.mMeshes[m]->mBones[b]->mName.C_Str()] = true;
+    for (unsigned b = 0; b < scene.mMeshes[m]->mNumBones; ++b)
+      isBone[scene.mMeshes[m]->mBones[b]->mName.C_Str()] = true;
   if (isBone.empty()) throw Error(file + ": no skin (no mesh is bound to a skeleton)");
 
   SkeletonBuild out;
@@ -79,7 +80,8 @@ SkeletonBuild buildSkeleton(const aiScene& scene, const std::string& file) {
     for (int c = 0; c < 3; ++c) r.col(c) /= s[c];
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
     r = svd.matrixU() * svd.matrixV().transpose();
-    if (r.determinant() < 0) throw Error(file + ": joint '" + out.skeleton.joints[j].name + "' has a mirrored rest transform");
+    if (r.determinant() < 0)
+      throw Error(file + ": joint '" + out.skeleton.joints[j].name + "' has a mirrored rest transform");
     rigid[j].rotation = Quatf(Eigen::Quaterniond(r).normalized().cast<float>());
     rigid[j].translation = g.topRightCorner<3, 1>().cast<float>();
   }
@@ -99,7 +101,8 @@ std::string lower(std::string s) {
 
 // Sub-meshes of the first candidate name that matches a mesh name (or the name with a "-N"/"_N"
 // primitive suffix) or the name of a node that holds meshes.
-std::vector<unsigned> findMeshes(const aiScene& scene, const std::vector<std::string>& candidates, std::string& matched) {
+std::vector<unsigned> findMeshes(const aiScene& scene, const std::vector<std::string>& candidates,
+                                 std::string& matched) {
   std::vector<std::pair<std::string, unsigned>> named;  // lower-cased mesh or owning-node name, mesh index
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) named.push_back({lower(scene.mMeshes[m]->mName.C_Str()), m});
   std::vector<const aiNode*> stack{scene.mRootNode};
@@ -130,7 +133,8 @@ std::vector<unsigned> findMeshes(const aiScene& scene, const std::vector<std::st
 
 std::string meshList(const aiScene& scene) {
   std::string s;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) s += (m ? ", '" : "'") + std::string(scene.mMeshes[m]->mName.C_Str()) + "'";
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+    s += (m ? ", '" : "'") + std::string(scene.mMeshes[m]->mName.C_Str()) + "'";
   return s.empty() ? "none" : s;
 }
 
@@ -157,9 +161,11 @@ Mesh convertMeshes(const aiScene& scene, const std::vector<unsigned>& meshes, co
       bind[b] = sk.globalWithScale[size_t(j)] * toEigen(bone.mOffsetMatrix);
       for (unsigned w = 0; w < bone.mNumWeights; ++w) {
         const auto& vw = bone.mWeights[w];
-        if (vw.mVertexId >= m.mNumVertices) throw Error(what + ": skin weight for vertex " + std::to_string(vw.mVertexId) + " out of range");
+        if (vw.mVertexId >= m.mNumVertices)
+          throw Error(what + ": skin weight for vertex " + std::to_string(vw.mVertexId) + " out of range");
         if (!std::isfinite(vw.mWeight) || vw.mWeight < 0.f)
-          throw Error(what + ": vertex " + std::to_string(base + vw.mVertexId) + " has a negative or non-finite skin weight");
+          throw Error(what + ": vertex " + std::to_string(base + vw.mVertexId) +
+                      " has a negative or non-finite skin weight");
         if (vw.mWeight > 0.f) local[vw.mVertexId].push_back({int(b), double(vw.mWeight)});
       }
     }
@@ -169,7 +175,8 @@ Mesh convertMeshes(const aiScene& scene, const std::vector<unsigned>& meshes, co
       auto& inf = local[v];
       double total = 0;
       for (const auto& i : inf) total += i.weight;
-      if (inf.empty() || total <= 0) throw Error(what + ": vertex " + std::to_string(base + v) + " has no skin weights");
+      if (inf.empty() || total <= 0)
+        throw Error(what + ": vertex " + std::to_string(base + v) + " has no skin weights");
       Mat4d blend = Mat4d::Zero();
       for (const auto& i : inf) blend += (i.weight / total) * bind[size_t(i.joint)];
       const Eigen::Vector4d p(m.mVertices[v].x, m.mVertices[v].y, m.mVertices[v].z, 1.0);
@@ -185,7 +192,8 @@ Mesh convertMeshes(const aiScene& scene, const std::vector<unsigned>& meshes, co
     for (unsigned f = 0; f < m.mNumFaces; ++f) {
       const aiFace& face = m.mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      tris.push_back({uint32_t(base + face.mIndices[0]), uint32_t(base + face.mIndices[1]), uint32_t(base + face.mIndices[2])});
+      tris.push_back(
+          {uint32_t(base + face.mIndices[0]), uint32_t(base + face.mIndices[1]), uint32_t(base + face.mIndices[2])});
     }
   }
   if (tris.empty()) throw Error(what + " has no triangles");
@@ -209,7 +217,8 @@ Mesh convertMeshes(const aiScene& scene, const std::vector<unsigned>& meshes, co
   // Strongest influences first, at most kMaxInfluences, renormalised; the width is the widest vertex's.
   int width = 1;
   for (auto& inf : infl) {
-    std::stable_sort(inf.begin(), inf.end(), [](const Influence& a, const Influence& b) { return a.weight > b.weight; });
+    std::stable_sort(inf.begin(), inf.end(),
+                     [](const Influence& a, const Influence& b) { return a.weight > b.weight; });
     if (inf.size() > size_t(kMaxInfluences)) inf.resize(kMaxInfluences);
     width = std::max(width, int(inf.size()));
   }
@@ -246,10 +255,14 @@ Character importCharacter(const std::filesystem::path& path, const CharacterImpo
   c.name = path.stem().string();
   std::string matched;
   auto body = findMeshes(scene, options.bodyNames, matched);
-  if (body.empty()) throw Error(file + ": no body mesh (looked for a mesh or node named one of the body names; meshes here: " + meshList(scene) + ")");
+  if (body.empty())
+    throw Error(file + ": no body mesh (looked for a mesh or node named one of the body names; meshes here: " +
+                meshList(scene) + ")");
   c.body = convertMeshes(scene, body, sk, file + ": body mesh '" + matched + "'");
   auto garment = findMeshes(scene, options.garmentNames, matched);
-  if (garment.empty()) throw Error(file + ": no garment mesh (looked for 'shirt', 'garment', 'jersey'... ; meshes here: " + meshList(scene) + ")");
+  if (garment.empty())
+    throw Error(
+        file + ": no garment mesh (looked for 'shirt', 'garment', 'jersey'... ; meshes here: " + meshList(scene) + ")");
   const std::string garmentWhat = file + ": garment mesh '" + matched + "'";
   c.garment = convertMeshes(scene, garment, sk, garmentWhat);
   auto sim = findMeshes(scene, options.simulationMeshNames, matched);
@@ -260,7 +273,8 @@ Character importCharacter(const std::filesystem::path& path, const CharacterImpo
   const size_t nj = c.skeleton.size();
   c.body.validate(file + ": body mesh", nj);
   c.garment.validate(garmentWhat, nj);
-  if (c.garment.uvs.rows() == 0) throw Error(garmentWhat + " has no UVs (texture coordinates are needed for its normal map)");
+  if (c.garment.uvs.rows() == 0)
+    throw Error(garmentWhat + " has no UVs (texture coordinates are needed for its normal map)");
   if (c.simulationMesh) c.simulationMesh->validate(simWhat, nj);
   if (options.checkGarmentTopology) {
     checkGarmentTopology(c.garment, garmentWhat);

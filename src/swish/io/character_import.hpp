@@ -22,8 +22,8 @@ struct CharacterImportOptions {
   std::vector<std::string> bodyNames = {"body", "mannequin", "skin"};
   std::vector<std::string> garmentNames = {"garment", "shirt", "jersey", "tshirt", "t-shirt", "cloth"};
   // Optional; when none matches, Character::simulationMesh stays empty.
-  std::vector<std::string> simulationMeshNames = {"simulation", "garment_sim", "shirt_hi", "shirt_sim",
-                                                  "jersey_hi", "jersey_sim"};
+  std::vector<std::string> simulationMeshNames = {"simulation", "garment_sim", "shirt_hi",
+                                                  "shirt_sim",  "jersey_hi",   "jersey_sim"};
   // Joints that must exist (Error naming the missing ones otherwise).
   std::vector<std::string> requiredJoints = defaultInputJointNames();
   // Check the garment's (and simulation mesh's) topology: manifold edges, consistent winding, outward

@@ -77,7 +77,8 @@ std::string mmText(double v) {
 
 }  // namespace
 
-RgbCanvas::RgbCanvas(uint32_t w, uint32_t h, std::array<uint8_t, 3> fill) : width(w), height(h), rgb(size_t(w) * h * 3) {
+RgbCanvas::RgbCanvas(uint32_t w, uint32_t h, std::array<uint8_t, 3> fill)
+    : width(w), height(h), rgb(size_t(w) * h * 3) {
   for (size_t p = 0; p < size_t(w) * h; ++p) std::copy(fill.begin(), fill.end(), rgb.begin() + long(p * 3));
 }
 
@@ -134,12 +135,14 @@ void rasterizeMesh(RgbCanvas& canvas, int x0, int y0, int w, int h, const Points
   const float scale = 0.92f * std::min(float(w) / bw, float(h) / bh);
   const float cx = 0.5f * (lo.x() + hi.x()), cy = 0.5f * (lo.y() + hi.y());
   auto toPixel = [&](const Vec3f& p) {
-    return Vec3f(float(x0) + 0.5f * float(w) + (p.x() - cx) * scale, float(y0) + 0.5f * float(h) - (p.y() - cy) * scale, p.z());
+    return Vec3f(float(x0) + 0.5f * float(w) + (p.x() - cx) * scale, float(y0) + 0.5f * float(h) - (p.y() - cy) * scale,
+                 p.z());
   };
   std::vector<float> depth(size_t(w) * size_t(h), -std::numeric_limits<float>::infinity());
   const Vec3f light = Vec3f(0.35f, 0.5f, 0.8f).normalized();
   for (Eigen::Index t = 0; t < tris.rows(); ++t) {
-    const Vec3f a = pos.row(tris(t, 0)).transpose(), b = pos.row(tris(t, 1)).transpose(), c = pos.row(tris(t, 2)).transpose();
+    const Vec3f a = pos.row(tris(t, 0)).transpose(), b = pos.row(tris(t, 1)).transpose(),
+                c = pos.row(tris(t, 2)).transpose();
     if (!a.allFinite() || !b.allFinite() || !c.allFinite()) continue;
     Vec3f n = (b - a).cross(c - a);
     if (n.norm() == 0.f) continue;
@@ -176,7 +179,9 @@ PngImage heatMapFigure(const HeatMapFigure& f, std::vector<double>* errorsOut) {
   if (!f.model || !f.truth || !f.triangles) throw Error("heat map: model, truth and triangles are required");
   const Points3f& m = *f.model;
   const Points3f& t = *f.truth;
-  if (m.rows() != t.rows()) throw Error("heat map: the model has " + std::to_string(m.rows()) + " vertices, the truth " + std::to_string(t.rows()));
+  if (m.rows() != t.rows())
+    throw Error("heat map: the model has " + std::to_string(m.rows()) + " vertices, the truth " +
+                std::to_string(t.rows()));
   std::vector<double> err(size_t(m.rows()));
   for (Eigen::Index v = 0; v < m.rows(); ++v) err[size_t(v)] = 1000.0 * double((m.row(v) - t.row(v)).norm());
   double scale = f.scaleMm;

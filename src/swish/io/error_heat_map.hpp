@@ -37,16 +37,17 @@ int drawText(RgbCanvas& canvas, int x, int y, const std::string& text, std::arra
 
 // Flat-shaded triangles, per-vertex colours averaged per face, seen from +Z looking down -Z,
 // orthographic, framing the box [lo, hi] (x, y) inside the panel at (x0, y0) of size w x h.
-void rasterizeMesh(RgbCanvas& canvas, int x0, int y0, int w, int h, const Points3f& positions, const Triangles& triangles,
-                   const std::vector<std::array<uint8_t, 3>>& vertexColours, const Vec3f& lo, const Vec3f& hi);
+void rasterizeMesh(RgbCanvas& canvas, int x0, int y0, int w, int h, const Points3f& positions,
+                   const Triangles& triangles, const std::vector<std::array<uint8_t, 3>>& vertexColours,
+                   const Vec3f& lo, const Vec3f& hi);
 
 struct HeatMapFigure {
-  std::string title;          // drawn above the panels
+  std::string title;  // drawn above the panels
   const Points3f* model = nullptr;
   const Points3f* truth = nullptr;
   const Triangles* triangles = nullptr;
   uint32_t panelWidth = 300, panelHeight = 360;
-  double scaleMm = 0;         // 0: heatScaleMm of the errors' 99th percentile
+  double scaleMm = 0;  // 0: heatScaleMm of the errors' 99th percentile
 };
 
 // Three panels: the model, the truth (both shaded plain), the model coloured by each vertex's distance

@@ -18,7 +18,8 @@ std::string base64(const std::vector<uint8_t>& b) {
   std::string o;
   o.reserve((b.size() + 2) / 3 * 4);
   for (size_t i = 0; i < b.size(); i += 3) {
-    const uint32_t v = uint32_t(b[i]) << 16 | (i + 1 < b.size() ? uint32_t(b[i + 1]) << 8 : 0) | (i + 2 < b.size() ? b[i + 2] : 0);
+    const uint32_t v =
+        uint32_t(b[i]) << 16 | (i + 1 < b.size() ? uint32_t(b[i + 1]) << 8 : 0) | (i + 2 < b.size() ? b[i + 2] : 0);
     o += t[v >> 18 & 63];
     o += t[v >> 12 & 63];
     o += i + 1 < b.size() ? t[v >> 6 & 63] : '=';
@@ -43,8 +44,8 @@ class GltfBuilder {
     json["bufferViews"].push_back(v);
     return int(json["bufferViews"].size()) - 1;
   }
-  int accessor(const void* data, size_t count, int componentType, size_t componentSize, const char* type, int components,
-               std::optional<int> target, bool minMax = false) {
+  int accessor(const void* data, size_t count, int componentType, size_t componentSize, const char* type,
+               int components, std::optional<int> target, bool minMax = false) {
     const int v = view(data, count * componentSize * size_t(components), target);
     nlohmann::json a = {{"bufferView", v}, {"componentType", componentType}, {"count", count}, {"type", type}};
     if (minMax && componentType == kFloat && count > 0) {
@@ -106,7 +107,8 @@ void addAnimation(GltfBuilder& b, const GltfScene& scene, const GltfAnimation& a
   const Skeleton* sk = scene.skeleton;
   if (!sk) throw Error("glTF export: animation '" + a.name + "' needs the scene's skeleton");
   if (!a.frames || a.frames->empty()) throw Error("glTF export: animation '" + a.name + "' has no frames");
-  if (!(a.framesPerSecond > 0.f)) throw Error("glTF export: animation '" + a.name + "': frames per second must be positive");
+  if (!(a.framesPerSecond > 0.f))
+    throw Error("glTF export: animation '" + a.name + "': frames per second must be positive");
   const std::vector<Pose>& frames = *a.frames;
   const size_t n = frames.size();
   std::vector<float> times(n);
@@ -118,7 +120,8 @@ void addAnimation(GltfBuilder& b, const GltfScene& scene, const GltfAnimation& a
   }
   const int input = b.accessor(times.data(), n, kFloat, 4, "SCALAR", 1, std::nullopt, true);
   nlohmann::json samplers = nlohmann::json::array(), channels = nlohmann::json::array();
-  auto channel = [&](const std::vector<float>& values, const char* type, int components, size_t node, const char* path) {
+  auto channel = [&](const std::vector<float>& values, const char* type, int components, size_t node,
+                     const char* path) {
     const int output = b.accessor(values.data(), n, kFloat, 4, type, components, std::nullopt);
     samplers.push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
     channels.push_back({{"sampler", samplers.size() - 1}, {"target", {{"node", node}, {"path", path}}}});
@@ -159,13 +162,16 @@ void buildScene(GltfBuilder& b, const GltfScene& scene) {
     for (size_t j = 0; j < sk->size(); ++j) {
       const Joint& joint = sk->joints[j];
       nlohmann::json n = {{"name", joint.name}, {"translation", vecJson(joint.rest.translation)}};
-      if (!joint.rest.rotation.coeffs().isApprox(Quatf::Identity().coeffs(), 0.f)) n["rotation"] = quatJson(joint.rest.rotation);
+      if (!joint.rest.rotation.coeffs().isApprox(Quatf::Identity().coeffs(), 0.f))
+        n["rotation"] = quatJson(joint.rest.rotation);
       b.json["nodes"].push_back(n);
     }
     for (size_t j = 0; j < sk->size(); ++j) {
       const int p = sk->joints[j].parent;
-      if (p < 0) roots.push_back(j);
-      else b.json["nodes"][size_t(p)]["children"].push_back(j);
+      if (p < 0)
+        roots.push_back(j);
+      else
+        b.json["nodes"][size_t(p)]["children"].push_back(j);
     }
     Skeleton withBind = *sk;
     if (withBind.inverseBind.empty()) withBind.computeInverseBindFromRest();
@@ -176,7 +182,8 @@ void buildScene(GltfBuilder& b, const GltfScene& scene) {
     const int acc = b.accessor(ibm.data(), sk->size(), kFloat, 4, "MAT4", 16, std::nullopt);
     nlohmann::json joints = nlohmann::json::array();
     for (size_t j = 0; j < sk->size(); ++j) joints.push_back(j);
-    b.json["skins"] = nlohmann::json::array({{{"joints", joints}, {"inverseBindMatrices", acc}, {"skeleton", roots[0]}}});
+    b.json["skins"] =
+        nlohmann::json::array({{{"joints", joints}, {"inverseBindMatrices", acc}, {"skeleton", roots[0]}}});
     skin = 0;
   }
 
@@ -194,7 +201,8 @@ void buildScene(GltfBuilder& b, const GltfScene& scene) {
         throw Error("glTF export: the normal map of material '" + m.name + "' is not a PNG");
       const int v = b.view(png.data(), png.size(), std::nullopt);
       b.json["images"].push_back({{"bufferView", v}, {"mimeType", "image/png"}, {"name", m.name + "_normal"}});
-      if (!b.json.contains("samplers")) b.json["samplers"] = nlohmann::json::array({{{"magFilter", 9729}, {"minFilter", 9987}}});
+      if (!b.json.contains("samplers"))
+        b.json["samplers"] = nlohmann::json::array({{{"magFilter", 9729}, {"minFilter", 9987}}});
       b.json["textures"].push_back({{"source", b.json["images"].size() - 1}, {"sampler", 0}});
       mat["normalTexture"] = {{"index", b.json["textures"].size() - 1}};
     }
@@ -209,9 +217,12 @@ void buildScene(GltfBuilder& b, const GltfScene& scene) {
     const size_t n = m.vertexCount();
     nlohmann::json attrs;
     attrs["POSITION"] = b.accessor(m.positions.data(), n, kFloat, 4, "VEC3", 3, kArrayBuffer, true);
-    if (size_t(m.normals.rows()) == n && n) attrs["NORMAL"] = b.accessor(m.normals.data(), n, kFloat, 4, "VEC3", 3, kArrayBuffer);
-    if (size_t(m.tangents.rows()) == n && n) attrs["TANGENT"] = b.accessor(m.tangents.data(), n, kFloat, 4, "VEC4", 4, kArrayBuffer);
-    if (size_t(m.uvs.rows()) == n && n) attrs["TEXCOORD_0"] = b.accessor(m.uvs.data(), n, kFloat, 4, "VEC2", 2, kArrayBuffer);
+    if (size_t(m.normals.rows()) == n && n)
+      attrs["NORMAL"] = b.accessor(m.normals.data(), n, kFloat, 4, "VEC3", 3, kArrayBuffer);
+    if (size_t(m.tangents.rows()) == n && n)
+      attrs["TANGENT"] = b.accessor(m.tangents.data(), n, kFloat, 4, "VEC4", 4, kArrayBuffer);
+    if (size_t(m.uvs.rows()) == n && n)
+      attrs["TEXCOORD_0"] = b.accessor(m.uvs.data(), n, kFloat, 4, "VEC2", 2, kArrayBuffer);
     if (skinned) {
       const int inf = m.skin.influences;
       for (int set = 0; set * 4 < inf; ++set) {
@@ -222,19 +233,23 @@ void buildScene(GltfBuilder& b, const GltfScene& scene) {
             joints[v * 4 + size_t(k)] = m.skin.joints[v * size_t(inf) + size_t(set * 4 + k)];
             weights[v * 4 + size_t(k)] = m.skin.weights[v * size_t(inf) + size_t(set * 4 + k)];
           }
-        attrs["JOINTS_" + std::to_string(set)] = b.accessor(joints.data(), n, kUnsignedShort, 2, "VEC4", 4, kArrayBuffer);
+        attrs["JOINTS_" + std::to_string(set)] =
+            b.accessor(joints.data(), n, kUnsignedShort, 2, "VEC4", 4, kArrayBuffer);
         attrs["WEIGHTS_" + std::to_string(set)] = b.accessor(weights.data(), n, kFloat, 4, "VEC4", 4, kArrayBuffer);
       }
     }
     nlohmann::json prim = {{"attributes", attrs}, {"mode", 4}};
-    prim["indices"] = b.accessor(m.triangles.data(), m.triangleCount() * 3, kUnsignedInt, 4, "SCALAR", 1, kElementArrayBuffer);
+    prim["indices"] =
+        b.accessor(m.triangles.data(), m.triangleCount() * 3, kUnsignedInt, 4, "SCALAR", 1, kElementArrayBuffer);
     if (e.material) {
-      if (*e.material >= scene.materials.size()) throw Error("glTF export: mesh '" + e.name + "' refers to a missing material");
+      if (*e.material >= scene.materials.size())
+        throw Error("glTF export: mesh '" + e.name + "' refers to a missing material");
       prim["material"] = *e.material;
     }
     b.json["meshes"].push_back({{"name", e.name}, {"primitives", nlohmann::json::array({prim})}});
     nlohmann::json node = {{"name", e.name}, {"mesh", b.json["meshes"].size() - 1}};
-    if (skinned) node["skin"] = skin;
+    if (skinned)
+      node["skin"] = skin;
     else {
       const Eigen::Vector3d t = e.preciseTranslation.value_or(e.transform.translation.cast<double>());
       node["translation"] = {t.x(), t.y(), t.z()};
@@ -278,7 +293,8 @@ std::vector<uint8_t> encodeCharacterGlb(const Character& c, const std::vector<ui
   return encodeGlb(s);
 }
 
-void writeCharacterGlb(const std::filesystem::path& file, const Character& c, const std::vector<uint8_t>& garmentNormalMapPng) {
+void writeCharacterGlb(const std::filesystem::path& file, const Character& c,
+                       const std::vector<uint8_t>& garmentNormalMapPng) {
   writeFileAtomic(file, encodeCharacterGlb(c, garmentNormalMapPng));
 }
 

@@ -29,9 +29,9 @@ struct GltfMaterial {
 struct GltfMeshEntry {
   std::string name;
   const Mesh* mesh = nullptr;
-  bool skinned = true;          // ignored when the scene has no skeleton
+  bool skinned = true;             // ignored when the scene has no skeleton
   std::optional<size_t> material;  // index into GltfScene::materials
-  RigidTransform transform;     // node transform (unskinned meshes only; skinned ones follow the joints)
+  RigidTransform transform;        // node transform (unskinned meshes only; skinned ones follow the joints)
   // When set, the node's translation in double precision instead of transform.translation (unskinned
   // meshes only): a mesh kept local and placed 1e4 m away keeps its placement exact in the file.
   std::optional<Eigen::Vector3d> preciseTranslation = std::nullopt;
@@ -64,6 +64,7 @@ std::string encodeGltf(const GltfScene& scene);
 // "simulation", skinned to the skeleton; plain materials (the garment's with `garmentNormalMapPng`).
 void writeCharacterGlb(const std::filesystem::path& file, const Character& character,
                        const std::vector<uint8_t>& garmentNormalMapPng = {});
-std::vector<uint8_t> encodeCharacterGlb(const Character& character, const std::vector<uint8_t>& garmentNormalMapPng = {});
+std::vector<uint8_t> encodeCharacterGlb(const Character& character,
+                                        const std::vector<uint8_t>& garmentNormalMapPng = {});
 
 }  // namespace swish::io

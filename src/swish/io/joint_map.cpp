@@ -20,34 +20,70 @@ struct NamePair {
 // Variants within the CMU family itself: the BVH clips call the finger joint LFingers, exporters of
 // CMU-named rigs (MakeHuman's, the shared test character) call it LeftHandFinger1.
 constexpr NamePair kCmuVariants[] = {
-    {"lfingers", "LeftHandFinger1"}, {"rfingers", "RightHandFinger1"},
-    {"lefthandfinger1", "LFingers"}, {"righthandfinger1", "RFingers"},
+    {"lfingers", "LeftHandFinger1"},
+    {"rfingers", "RightHandFinger1"},
+    {"lefthandfinger1", "LFingers"},
+    {"righthandfinger1", "RFingers"},
 };
 
 constexpr NamePair kMixamoToCmu[] = {
-    {"hips", "Hips"},           {"spine", "LowerBack"},        {"spine1", "Spine"},
-    {"spine2", "Spine1"},       {"neck", "Neck"},              {"head", "Head"},
-    {"leftshoulder", "LeftShoulder"},   {"leftarm", "LeftArm"},      {"leftforearm", "LeftForeArm"},
-    {"lefthand", "LeftHand"},   {"lefthandthumb1", "LThumb"},  {"lefthandindex1", "LeftFingerBase"},
+    {"hips", "Hips"},
+    {"spine", "LowerBack"},
+    {"spine1", "Spine"},
+    {"spine2", "Spine1"},
+    {"neck", "Neck"},
+    {"head", "Head"},
+    {"leftshoulder", "LeftShoulder"},
+    {"leftarm", "LeftArm"},
+    {"leftforearm", "LeftForeArm"},
+    {"lefthand", "LeftHand"},
+    {"lefthandthumb1", "LThumb"},
+    {"lefthandindex1", "LeftFingerBase"},
     {"lefthandindex2", "LeftHandFinger1"},
-    {"rightshoulder", "RightShoulder"}, {"rightarm", "RightArm"},    {"rightforearm", "RightForeArm"},
-    {"righthand", "RightHand"}, {"righthandthumb1", "RThumb"}, {"righthandindex1", "RightFingerBase"},
+    {"rightshoulder", "RightShoulder"},
+    {"rightarm", "RightArm"},
+    {"rightforearm", "RightForeArm"},
+    {"righthand", "RightHand"},
+    {"righthandthumb1", "RThumb"},
+    {"righthandindex1", "RightFingerBase"},
     {"righthandindex2", "RightHandFinger1"},
-    {"leftupleg", "LeftUpLeg"}, {"leftleg", "LeftLeg"},        {"leftfoot", "LeftFoot"},
-    {"lefttoebase", "LeftToeBase"}, {"rightupleg", "RightUpLeg"}, {"rightleg", "RightLeg"},
-    {"rightfoot", "RightFoot"}, {"righttoebase", "RightToeBase"},
+    {"leftupleg", "LeftUpLeg"},
+    {"leftleg", "LeftLeg"},
+    {"leftfoot", "LeftFoot"},
+    {"lefttoebase", "LeftToeBase"},
+    {"rightupleg", "RightUpLeg"},
+    {"rightleg", "RightLeg"},
+    {"rightfoot", "RightFoot"},
+    {"righttoebase", "RightToeBase"},
 };
 
 constexpr NamePair kUnrealToCmu[] = {
-    {"pelvis", "Hips"},          {"spine01", "LowerBack"},     {"spine02", "Spine"},
-    {"spine03", "Spine1"},       {"neck01", "Neck"},           {"head", "Head"},
-    {"claviclel", "LeftShoulder"}, {"upperarml", "LeftArm"},   {"lowerarml", "LeftForeArm"},
-    {"handl", "LeftHand"},       {"thumb01l", "LThumb"},       {"index01l", "LeftFingerBase"},
-    {"clavicler", "RightShoulder"}, {"upperarmr", "RightArm"}, {"lowerarmr", "RightForeArm"},
-    {"handr", "RightHand"},      {"thumb01r", "RThumb"},       {"index01r", "RightFingerBase"},
-    {"thighl", "LeftUpLeg"},     {"calfl", "LeftLeg"},         {"footl", "LeftFoot"},
-    {"balll", "LeftToeBase"},    {"thighr", "RightUpLeg"},     {"calfr", "RightLeg"},
-    {"footr", "RightFoot"},      {"ballr", "RightToeBase"},
+    {"pelvis", "Hips"},
+    {"spine01", "LowerBack"},
+    {"spine02", "Spine"},
+    {"spine03", "Spine1"},
+    {"neck01", "Neck"},
+    {"head", "Head"},
+    {"claviclel", "LeftShoulder"},
+    {"upperarml", "LeftArm"},
+    {"lowerarml", "LeftForeArm"},
+    {"handl", "LeftHand"},
+    {"thumb01l", "LThumb"},
+    {"index01l", "LeftFingerBase"},
+    {"clavicler", "RightShoulder"},
+    {"upperarmr", "RightArm"},
+    {"lowerarmr", "RightForeArm"},
+    {"handr", "RightHand"},
+    {"thumb01r", "RThumb"},
+    {"index01r", "RightFingerBase"},
+    {"thighl", "LeftUpLeg"},
+    {"calfl", "LeftLeg"},
+    {"footl", "LeftFoot"},
+    {"balll", "LeftToeBase"},
+    {"thighr", "RightUpLeg"},
+    {"calfr", "RightLeg"},
+    {"footr", "RightFoot"},
+    {"ballr", "RightToeBase"},
 };
 
 constexpr int kDrivenByChain = -2;  // mapWith's mark while matching names: not free for a clip joint
@@ -134,7 +170,8 @@ JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& wha
     if (v.is_object() && v.contains("shares")) {
       const auto& sh = v.at("shares");
       if (!sh.is_array() || sh.size() != chain.joints.size())
-        fail(what, clipJoint + ".shares", "must hold one number per chain joint (" + std::to_string(chain.joints.size()) + ")");
+        fail(what, clipJoint + ".shares",
+             "must hold one number per chain joint (" + std::to_string(chain.joints.size()) + ")");
       double sum = 0.0;
       for (const auto& x : sh) {
         if (!x.is_number() || !(x.get<double>() >= 0.0 && x.get<double>() <= 1.0))
@@ -142,7 +179,8 @@ JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& wha
         chain.shares.push_back(x.get<float>());
         sum += x.get<double>();
       }
-      if (std::abs(sum - 1.0) > 1e-3) fail(what, clipJoint + ".shares", "must sum to 1 (they sum to " + std::to_string(sum) + ")");
+      if (std::abs(sum - 1.0) > 1e-3)
+        fail(what, clipJoint + ".shares", "must sum to 1 (they sum to " + std::to_string(sum) + ")");
     } else {
       chain.shares.assign(chain.joints.size(), 1.f / float(chain.joints.size()));
     }
@@ -190,23 +228,30 @@ std::string normaliseJointName(const std::string& name) {
 
 const char* jointNamingName(JointNaming n) {
   switch (n) {
-    case JointNaming::Auto: return "auto";
-    case JointNaming::Same: return "same names";
-    case JointNaming::Mixamo: return "Mixamo";
-    case JointNaming::Unreal: return "Unreal";
+    case JointNaming::Auto:
+      return "auto";
+    case JointNaming::Same:
+      return "same names";
+    case JointNaming::Mixamo:
+      return "Mixamo";
+    case JointNaming::Unreal:
+      return "Unreal";
   }
   return "?";
 }
 
-JointMapping mapJoints(const std::vector<std::string>& clip, const Skeleton& character, const JointMapOptions& options) {
+JointMapping mapJoints(const std::vector<std::string>& clip, const Skeleton& character,
+                       const JointMapOptions& options) {
   if (options.naming != JointNaming::Auto) return mapWith(clip, character, options.naming, options);
   // A Mixamo clip also matches many CMU names as they are (LeftArm...), but its spine is off by one:
   // prefer a convention only when it maps strictly more joints, and Mixamo when the clip has Spine2.
   JointMapping best = mapWith(clip, character, JointNaming::Same, options);
-  const bool hasSpine2 = std::any_of(clip.begin(), clip.end(), [](const std::string& n) { return normaliseJointName(n) == "spine2"; });
+  const bool hasSpine2 =
+      std::any_of(clip.begin(), clip.end(), [](const std::string& n) { return normaliseJointName(n) == "spine2"; });
   for (JointNaming n : {JointNaming::Mixamo, JointNaming::Unreal}) {
     JointMapping m = mapWith(clip, character, n, options);
-    if (m.mappedCount() > best.mappedCount() || (n == JointNaming::Mixamo && hasSpine2 && m.mappedCount() >= best.mappedCount()))
+    if (m.mappedCount() > best.mappedCount() ||
+        (n == JointNaming::Mixamo && hasSpine2 && m.mappedCount() >= best.mappedCount()))
       best = std::move(m);
   }
   return best;

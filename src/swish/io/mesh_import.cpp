@@ -13,7 +13,8 @@ std::vector<ImportedMesh> importMeshes(const std::filesystem::path& file) {
   // Where each mesh is placed: the global transform of the first node that uses it.
   std::vector<Eigen::Matrix4d> placement(scene.mNumMeshes, Eigen::Matrix4d::Zero());
   std::vector<std::string> nodeName(scene.mNumMeshes);
-  std::function<void(const aiNode*, const Eigen::Matrix4d&)> walk = [&](const aiNode* n, const Eigen::Matrix4d& parent) {
+  std::function<void(const aiNode*, const Eigen::Matrix4d&)> walk = [&](const aiNode* n,
+                                                                        const Eigen::Matrix4d& parent) {
     const Eigen::Matrix4d g = parent * toEigen(n->mTransformation);
     for (unsigned k = 0; k < n->mNumMeshes; ++k)
       if (n->mMeshes[k] < scene.mNumMeshes && placement[n->mMeshes[k]](3, 3) == 0.0) {

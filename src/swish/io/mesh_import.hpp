@@ -13,8 +13,8 @@
 namespace swish::io {
 
 struct ImportedMesh {
-  std::string name;      // the mesh's name, else its node's
-  Points3f positions;    // the file's units, node transforms applied (where the file places it)
+  std::string name;    // the mesh's name, else its node's
+  Points3f positions;  // the file's units, node transforms applied (where the file places it)
   Triangles triangles;
   // Morph targets / blend shapes (a geometry cache stored as one shape per frame), absolute positions
   // in the same vertex order and space, in file order, each with its name (may be empty).

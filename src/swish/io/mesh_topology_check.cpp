@@ -58,8 +58,10 @@ TopologyReport analyseTopology(const Mesh& mesh) {
   for (const auto& [key, e] : edges) {
     const uint32_t uses = e.forward + e.backward;
     if (uses == 1) ++r.boundaryEdges;
-    if (uses > 2) ++r.nonManifoldEdges;
-    else if (e.forward > 1 || e.backward > 1) ++r.inconsistentEdges;
+    if (uses > 2)
+      ++r.nonManifoldEdges;
+    else if (e.forward > 1 || e.backward > 1)
+      ++r.inconsistentEdges;
   }
   r.normalAgreement = withNormals ? double(agree) / double(withNormals) : 1.0;
   return r;

@@ -14,11 +14,11 @@ namespace swish::io {
 
 struct TopologyReport {
   size_t nonManifoldEdges = 0;
-  size_t inconsistentEdges = 0;   // shared edges traversed the same way by both triangles
+  size_t inconsistentEdges = 0;  // shared edges traversed the same way by both triangles
   size_t degenerateTriangles = 0;
   size_t boundaryEdges = 0;
-  double signedVolume = 0.0;      // about the centroid of the welded vertices
-  double normalAgreement = 1.0;   // fraction of triangles whose normal agrees with the stored normals
+  double signedVolume = 0.0;     // about the centroid of the welded vertices
+  double normalAgreement = 1.0;  // fraction of triangles whose normal agrees with the stored normals
 };
 
 TopologyReport analyseTopology(const Mesh& mesh);

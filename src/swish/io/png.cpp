@@ -59,11 +59,21 @@ void filterRow(int f, const uint8_t* row, const uint8_t* prev, size_t n, size_t 
     const int c = (prev && i >= bpp) ? prev[i - bpp] : 0;
     int pred = 0;
     switch (f) {
-      case 1: pred = a; break;
-      case 2: pred = b; break;
-      case 3: pred = (a + b) >> 1; break;
-      case 4: pred = paeth(a, b, c); break;
-      default: pred = 0; break;
+      case 1:
+        pred = a;
+        break;
+      case 2:
+        pred = b;
+        break;
+      case 3:
+        pred = (a + b) >> 1;
+        break;
+      case 4:
+        pred = paeth(a, b, c);
+        break;
+      default:
+        pred = 0;
+        break;
     }
     out[i] = uint8_t(row[i] - pred);
   }
@@ -98,9 +108,9 @@ void validatePngImage(const PngImage& im, const std::string& what) {
     throw Error(what + ": bit depth " + std::to_string(im.bitDepth) + " (supported: 8, 16)");
   const size_t expect = size_t(im.width) * im.height * im.channels;
   if (im.samples.size() != expect)
-    throw Error(what + ": " + std::to_string(im.samples.size()) + " samples for " + std::to_string(im.width) +
-                "x" + std::to_string(im.height) + "x" + std::to_string(im.channels) + " (" +
-                std::to_string(expect) + " expected)");
+    throw Error(what + ": " + std::to_string(im.samples.size()) + " samples for " + std::to_string(im.width) + "x" +
+                std::to_string(im.height) + "x" + std::to_string(im.channels) + " (" + std::to_string(expect) +
+                " expected)");
   if (im.bitDepth == 8)
     for (uint16_t s : im.samples)
       if (s > 255) throw Error(what + ": sample value " + std::to_string(s) + " does not fit 8 bits");
@@ -224,8 +234,8 @@ PngImage readPng(const std::filesystem::path& path) {
 
 PngImage encodeNormalMap(uint32_t width, uint32_t height, std::span<const float> xy, uint32_t bitDepth) {
   if (xy.size() != size_t(width) * height * 2)
-    throw Error("normal map encode: " + std::to_string(xy.size()) + " floats for " + std::to_string(width) +
-                "x" + std::to_string(height) + " texels (2 per texel expected)");
+    throw Error("normal map encode: " + std::to_string(xy.size()) + " floats for " + std::to_string(width) + "x" +
+                std::to_string(height) + " texels (2 per texel expected)");
   if (bitDepth != 8 && bitDepth != 16)
     throw Error("normal map encode: bit depth " + std::to_string(bitDepth) + " (supported: 8, 16)");
   PngImage im;

@@ -33,9 +33,7 @@ struct PngImage {
 
   uint16_t maxValue() const { return bitDepth == 16 ? 65535 : 255; }
   uint16_t& at(uint32_t x, uint32_t y, uint32_t c) { return samples[(size_t(y) * width + x) * channels + c]; }
-  uint16_t at(uint32_t x, uint32_t y, uint32_t c) const {
-    return samples[(size_t(y) * width + x) * channels + c];
-  }
+  uint16_t at(uint32_t x, uint32_t y, uint32_t c) const { return samples[(size_t(y) * width + x) * channels + c]; }
 };
 
 // Checks the image is consistent (sizes, depth, channels, sample range); throws Error naming `what`.

@@ -42,7 +42,8 @@ std::vector<ResolvedChain> resolveChains(const std::vector<JointChain>& chains, 
     Quatd q = Quatd::Identity();
     for (size_t i = 0; i < c.joints.size(); ++i) {
       const int j = character.find(c.joints[i]);
-      if (j < 0) throw Error(what + ": joint map chain [" + names + "]: the character has no joint '" + c.joints[i] + "'");
+      if (j < 0)
+        throw Error(what + ": joint map chain [" + names + "]: the character has no joint '" + c.joints[i] + "'");
       if (i > 0 && character.joints[size_t(j)].parent != int(r.joints.back()))
         throw Error(what + ": joint map chain [" + names + "]: '" + c.joints[i] + "' is not the child of '" +
                     c.joints[i - 1] + "' in the character");
@@ -52,7 +53,8 @@ std::vector<ResolvedChain> resolveChains(const std::vector<JointChain>& chains, 
       r.restUpTo.push_back(q);
     }
     if (map.sourceOf[r.joints.back()] < 0)
-      throw Error(what + ": joint map chain [" + names + "]: no clip joint drives its last joint '" + c.joints.back() + "'");
+      throw Error(what + ": joint map chain [" + names + "]: no clip joint drives its last joint '" + c.joints.back() +
+                  "'");
     r.parent = character.joints[r.joints.front()].parent;
     out.push_back(std::move(r));
   }
@@ -94,18 +96,17 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
   for (const auto& name : options.requiredJoints) {
     const int j = character.find(name);
     if (j < 0) throw Error(what + ": the character has no joint '" + name + "' (a required joint)");
-    const bool inChain = std::any_of(options.jointMap.chains.begin(), options.jointMap.chains.end(), [&](const JointChain& c) {
-      return std::find(c.joints.begin(), c.joints.end(), name) != c.joints.end();
-    });
+    const bool inChain = std::any_of(
+        options.jointMap.chains.begin(), options.jointMap.chains.end(),
+        [&](const JointChain& c) { return std::find(c.joints.begin(), c.joints.end(), name) != c.joints.end(); });
     if (map.sourceOf[size_t(j)] < 0 && j != 0 && !inChain) unmatched.push_back(name);
   }
   if (!unmatched.empty()) {
     std::string list, clipNames;
     for (const auto& n : unmatched) list += (list.empty() ? "'" : ", '") + n + "'";
     for (size_t i = 0; i < clip.jointNames.size() && i < 12; ++i) clipNames += (i ? ", " : "") + clip.jointNames[i];
-    throw Error(what + ": unknown joints: the clip has no joint for character joint(s) " + list +
-                " (clip joints: " + clipNames + (clip.jointNames.size() > 12 ? ", ..." : "") +
-                "); add pairs to the joint map");
+    throw Error(what + ": unknown joints: the clip has no joint for character joint(s) " + list + " (clip joints: " +
+                clipNames + (clip.jointNames.size() > 12 ? ", ..." : "") + "); add pairs to the joint map");
   }
 
   const std::vector<ResolvedChain> chains = resolveChains(options.jointMap.chains, character, map, what);
@@ -151,9 +152,12 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
     }
     std::optional<Quatd> k;
     if (dh.size() >= 2) k = kabsch(dh, ds);
-    if (k) align[h] = *k;
-    else if (!dh.empty()) align[h] = shortestArc(inherited * dh[0], ds[0]) * inherited;
-    else align[h] = inherited;
+    if (k)
+      align[h] = *k;
+    else if (!dh.empty())
+      align[h] = shortestArc(inherited * dh[0], ds[0]) * inherited;
+    else
+      align[h] = inherited;
   }
 
   float scale = options.rootTranslationScale;
@@ -180,12 +184,16 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
     for (size_t h = 0; h < nj; ++h) {
       const int parent = character.joints[h].parent;
       const int s = map.sourceOf[h];
-      if (s >= 0) global[h] = (g[size_t(s)].rotation.cast<double>() * constant[h]).normalized();
-      else global[h] = (parent < 0 ? Quatd::Identity() : global[size_t(parent)]) * character.joints[h].rest.rotation.cast<double>();
+      if (s >= 0)
+        global[h] = (g[size_t(s)].rotation.cast<double>() * constant[h]).normalized();
+      else
+        global[h] = (parent < 0 ? Quatd::Identity() : global[size_t(parent)]) *
+                    character.joints[h].rest.rotation.cast<double>();
       const Quatd local = parent < 0 ? global[h] : global[size_t(parent)].conjugate() * global[h];
       pose.local[h] = local.normalized().cast<float>();
       if (!pose.local[h].coeffs().allFinite())
-        throw Error(what + ", frame " + std::to_string(f) + ": non-finite rotation for joint '" + character.joints[h].name + "'");
+        throw Error(what + ", frame " + std::to_string(f) + ": non-finite rotation for joint '" +
+                    character.joints[h].name + "'");
     }
     for (const ResolvedChain& c : chains) shareChain(c, global, pose);
     const Vec3d d = g[size_t(rootSource)].translation.cast<double>() - root0;

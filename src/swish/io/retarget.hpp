@@ -12,8 +12,9 @@
 // rotation, except along a joint map chain (joint_map.hpp): there the rotation D the chain adds to its
 // rest rotations (global(last) = G_parent * D * Q_last, Q_i the product of the chain's rest locals up to
 // joint i) is shared out, local_i = Q_{i-1}^-1 * D^share_i * Q_i, so the last joint's global rotation
-// (and all below it) stays the clip's while the bend spreads over the chain. Root translation: the character's rest root plus the clip root's displacement from its
-// first frame, scaled by the ratio of the skeletons' mapped bone lengths (clip units -> metres).
+// (and all below it) stays the clip's while the bend spreads over the chain. Root translation: the character's rest
+// root plus the clip root's displacement from its first frame, scaled by the ratio of the skeletons' mapped bone
+// lengths (clip units -> metres).
 #include <string>
 #include <vector>
 

@@ -47,7 +47,9 @@ Vec3f sampleVector(const aiVectorKey* keys, unsigned n, double time) {
 }
 
 Quatf sampleRotation(const aiQuatKey* keys, unsigned n, double time) {
-  auto q = [&](unsigned k) { return Quatf(keys[k].mValue.w, keys[k].mValue.x, keys[k].mValue.y, keys[k].mValue.z).normalized(); };
+  auto q = [&](unsigned k) {
+    return Quatf(keys[k].mValue.w, keys[k].mValue.x, keys[k].mValue.y, keys[k].mValue.z).normalized();
+  };
   if (n == 1 || time <= keys[0].mTime) return q(0);
   for (unsigned k = 1; k < n; ++k)
     if (time <= keys[k].mTime) {

@@ -12,11 +12,20 @@ std::string xmlEscape(const std::string& s) {
   std::string o;
   for (char c : s) {
     switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
+      case '&':
+        o += "&amp;";
+        break;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
     }
   }
   return o;
@@ -38,7 +47,8 @@ std::vector<double> niceTicks(double lo, double hi, int count) {
   if (!(hi > lo)) return {lo};
   const double raw = (hi - lo) / count, mag = std::pow(10.0, std::floor(std::log10(raw)));
   const double step = mag * (raw / mag < 1.5 ? 1 : raw / mag < 3.5 ? 2 : raw / mag < 7.5 ? 5 : 10);
-  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) t.push_back(std::abs(v) < step * 1e-9 ? 0.0 : v);
+  for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step)
+    t.push_back(std::abs(v) < step * 1e-9 ? 0.0 : v);
   return t;
 }
 }  // namespace
@@ -67,7 +77,8 @@ std::string SvgPlot::render() const {
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  o << "<text x=\"" << width / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << xmlEscape(title) << "</text>\n";
+  o << "<text x=\"" << width / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << xmlEscape(title)
+    << "</text>\n";
   o << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
     << "\" fill=\"none\" stroke=\"#444\"/>\n";
   for (double t : niceTicks(x0, x1, 6)) {
@@ -82,8 +93,8 @@ std::string SvgPlot::render() const {
     yt = niceTicks(y0, y1, 5);
   for (double t : yt) {
     o << "<line x1=\"" << left - 5 << "\" y1=\"" << py(t) << "\" x2=\"" << left + pw << "\" y2=\"" << py(t)
-      << "\" stroke=\"#ddd\"/><text x=\"" << left - 8 << "\" y=\"" << py(t) + 4 << "\" text-anchor=\"end\">"
-      << fmt(t) << "</text>\n";
+      << "\" stroke=\"#ddd\"/><text x=\"" << left - 8 << "\" y=\"" << py(t) + 4 << "\" text-anchor=\"end\">" << fmt(t)
+      << "</text>\n";
   }
   o << "<text x=\"" << left + pw / 2 << "\" y=\"" << height - 10 << "\" text-anchor=\"middle\">" << xmlEscape(xLabel)
     << "</text>\n<text transform=\"translate(16," << top + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
@@ -119,11 +130,13 @@ std::string SvgBarChart::render() const {
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  o << "<text x=\"" << width / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << xmlEscape(title) << "</text>\n";
+  o << "<text x=\"" << width / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << xmlEscape(title)
+    << "</text>\n";
   for (size_t i = 0; i < labels.size(); ++i) {
     const double y = rowsTop + rowH * double(i), v = i < values.size() && std::isfinite(values[i]) ? values[i] : 0.0;
     const double w = v / top * (width - left - right);
-    o << "<text x=\"" << left - 6 << "\" y=\"" << y + 14 << "\" text-anchor=\"end\">" << xmlEscape(labels[i]) << "</text>\n"
+    o << "<text x=\"" << left - 6 << "\" y=\"" << y + 14 << "\" text-anchor=\"end\">" << xmlEscape(labels[i])
+      << "</text>\n"
       << "<rect x=\"" << left << "\" y=\"" << y + 3 << "\" width=\"" << w << "\" height=\"" << rowH - 6 << "\" fill=\""
       << kPalette[i % kPaletteSize] << "\"/>\n"
       << "<text x=\"" << left + w + 4 << "\" y=\"" << y + 14 << "\">" << fmt(v) << (unit.empty() ? "" : " ")

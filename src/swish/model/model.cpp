@@ -15,8 +15,7 @@ void Model::validate(const std::string& what) const {
     throw Error(what + ": " + part + ": " + problem);
   };
   skeleton.validate(what + ": skeleton");
-  if (skeleton.inverseBind.size() != skeleton.size())
-    fail("skeleton", "needs one inverse bind matrix per joint");
+  if (skeleton.inverseBind.size() != skeleton.size()) fail("skeleton", "needs one inverse bind matrix per joint");
   if (inputJoints.empty()) fail("input joints", "none given");
   for (uint32_t j : inputJoints)
     if (j >= skeleton.size()) fail("input joints", "index " + n2s(j) + " >= joint count " + n2s(skeleton.size()));
@@ -73,15 +72,15 @@ void Model::validate(const std::string& what) const {
     if (db.codebookSize == 0 || db.codebookSize > 65536)
       fail("normal maps", "codebook size " + n2s(db.codebookSize) + " outside 1..65536");
     if (db.codebook.size() != size_t(db.codebookSize) * 32)
-      fail("normal maps", "codebook holds " + n2s(db.codebook.size()) + " bytes, expected " +
-                              n2s(size_t(db.codebookSize) * 32));
+      fail("normal maps",
+           "codebook holds " + n2s(db.codebook.size()) + " bytes, expected " + n2s(size_t(db.codebookSize) * 32));
     if (db.indices.size() != size_t(db.mapCount()) * db.blocksPerMap())
       fail("normal maps", "holds " + n2s(db.indices.size()) + " block indices, expected " +
                               n2s(size_t(db.mapCount()) * db.blocksPerMap()));
     for (size_t i = 0; i < db.indices.size(); ++i)
       if (db.indices[i] >= db.codebookSize)
-        fail("normal maps", "block index " + n2s(i) + " = " + n2s(db.indices[i]) + " >= codebook size " +
-                                n2s(db.codebookSize));
+        fail("normal maps",
+             "block index " + n2s(i) + " = " + n2s(db.indices[i]) + " >= codebook size " + n2s(db.codebookSize));
     if (!db.keys.allFinite()) fail("normal maps", "keys have non-finite values");
   } else if (db.codeDims() != 0) {
     fail("normal maps", "keys have dimensions but no maps");
@@ -92,8 +91,10 @@ void Model::validate(const std::string& what) const {
     const BodyCapsule& cap = bodyProxy.capsules[c];
     if (cap.joint >= skeleton.size())
       fail("body proxy", "capsule " + n2s(c) + " joint " + n2s(cap.joint) + " >= joint count " + n2s(skeleton.size()));
-    if (!cap.a.allFinite() || !cap.b.allFinite()) fail("body proxy", "capsule " + n2s(c) + " has non-finite end points");
-    if (!(cap.radius > 0.f) || !(cap.radius < 10.f)) fail("body proxy", "capsule " + n2s(c) + " radius must be in (0, 10) metres");
+    if (!cap.a.allFinite() || !cap.b.allFinite())
+      fail("body proxy", "capsule " + n2s(c) + " has non-finite end points");
+    if (!(cap.radius > 0.f) || !(cap.radius < 10.f))
+      fail("body proxy", "capsule " + n2s(c) + " radius must be in (0, 10) metres");
   }
   if (!(temporalFilter.timeConstantSeconds >= 0.f) || !std::isfinite(temporalFilter.timeConstantSeconds))
     fail("temporal filter", "time constant must be finite and >= 0");

@@ -47,11 +47,11 @@ struct MeshPca {
 // texel t = (y%4)*4 + (x%4); X = codebook[(e*16 + t)*2 + 0] / 127, Y = codebook[(e*16 + t)*2 + 1] / 127
 // (snorm8, clamped to [-1, 1]); Z = sqrt(max(0, 1 - X^2 - Y^2)). Tangent space.
 struct NormalMapDatabase {
-  uint32_t width = 0, height = 0;   // multiples of 4
-  MatXf keys;                       // mapCount x codeDims: each map's normal-map PCA code
-  uint32_t codebookSize = 0;        // entries; indices are 16-bit so at most 65536
-  std::vector<int8_t> codebook;     // codebookSize * 16 texels * 2 channels
-  std::vector<uint16_t> indices;    // mapCount * blocksPerMap()
+  uint32_t width = 0, height = 0;  // multiples of 4
+  MatXf keys;                      // mapCount x codeDims: each map's normal-map PCA code
+  uint32_t codebookSize = 0;       // entries; indices are 16-bit so at most 65536
+  std::vector<int8_t> codebook;    // codebookSize * 16 texels * 2 channels
+  std::vector<uint16_t> indices;   // mapCount * blocksPerMap()
 
   uint32_t mapCount() const { return uint32_t(keys.rows()); }
   uint32_t codeDims() const { return uint32_t(keys.cols()); }
@@ -85,17 +85,17 @@ struct BodyProxy {
 inline constexpr size_t kMaxBodyCapsules = 64;
 
 struct Model {
-  Skeleton skeleton;                 // the character's skeleton (for FK and skinning)
-  std::vector<uint32_t> inputJoints; // skeleton joint indices forming Theta, in this order
-  Normalisation inputNorm;           // over Theta
-  Normalisation outputNorm;          // over Lambda
+  Skeleton skeleton;                  // the character's skeleton (for FK and skinning)
+  std::vector<uint32_t> inputJoints;  // skeleton joint indices forming Theta, in this order
+  Normalisation inputNorm;            // over Theta
+  Normalisation outputNorm;           // over Lambda
   Mlp mlp;
   MeshPca meshPca;
-  Mesh gameMesh;                     // rest positions, triangles, UVs, skin, rest normals+tangents
-  NormalMapDatabase normalMaps;      // may be empty (a model without normal maps)
+  Mesh gameMesh;                 // rest positions, triangles, UVs, skin, rest normals+tangents
+  NormalMapDatabase normalMaps;  // may be empty (a model without normal maps)
   TemporalFilterParams temporalFilter;
-  BodyProxy bodyProxy;               // may be empty (models of format 1.0, or baked without a body)
-  std::string metadata = "{}";       // free-form JSON: bake settings, errors measured at bake time
+  BodyProxy bodyProxy;          // may be empty (models of format 1.0, or baked without a body)
+  std::string metadata = "{}";  // free-form JSON: bake settings, errors measured at bake time
 
   int thetaSize() const { return int(inputJoints.size()) * 6; }
   int meshComponents() const { return meshPca.components(); }

@@ -83,7 +83,8 @@ std::vector<uint8_t> serializeValidated(const Model& model) {
 
 ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::string& sourceName) {
   auto fail = [&](const std::string& problem) -> void { throw Error(sourceName + ": " + problem); };
-  if (bytes.size() >= kModelFileMagic.size() && !std::equal(kModelFileMagic.begin(), kModelFileMagic.end(), bytes.begin()))
+  if (bytes.size() >= kModelFileMagic.size() &&
+      !std::equal(kModelFileMagic.begin(), kModelFileMagic.end(), bytes.begin()))
     fail("not a .swish model file (wrong magic bytes)");
   if (bytes.size() < kModelFileHeaderBytes)
     fail("file is " + std::to_string(bytes.size()) + " bytes, too short for the " +
@@ -100,8 +101,8 @@ ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::strin
     fail("format version " + versionText(info.majorVersion, info.minorVersion) + " is newer than this swish reads (" +
          std::to_string(kModelFileMajorVersion) + ".x); use a newer swish");
   if (info.majorVersion < kModelFileMajorVersion)
-    fail("format version " + versionText(info.majorVersion, info.minorVersion) + " is not supported (this swish reads " +
-         std::to_string(kModelFileMajorVersion) + ".x)");
+    fail("format version " + versionText(info.majorVersion, info.minorVersion) +
+         " is not supported (this swish reads " + std::to_string(kModelFileMajorVersion) + ".x)");
   const uint32_t sectionCount = header.u32("section count");
   info.totalBytes = header.u64("total size");
   header.u32("reserved");
@@ -112,7 +113,8 @@ ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::strin
          "): the file is corrupted");
   if (info.totalBytes != bytes.size())
     fail("header says the file is " + std::to_string(info.totalBytes) + " bytes but it is " +
-         std::to_string(bytes.size()) + (info.totalBytes > bytes.size() ? " (truncated)" : " (extra bytes at the end)"));
+         std::to_string(bytes.size()) +
+         (info.totalBytes > bytes.size() ? " (truncated)" : " (extra bytes at the end)"));
 
   ByteReader body(bytes.subspan(kModelFileHeaderBytes), sourceName, "file");
   body.checkCount(sectionCount, kModelSectionHeaderBytes, "section");
@@ -138,8 +140,8 @@ ModelFileInfo readModelFileInfo(std::span<const uint8_t> bytes, const std::strin
     const SectionCodec* codec = findCodec(sec.tag);
     sec.known = codec != nullptr;
     if (codec && codec->sinceMinor > info.minorVersion)
-      fail(where + ": a section of format " + versionText(kModelFileMajorVersion, codec->sinceMinor) + " in a version " +
-           versionText(info.majorVersion, info.minorVersion) + " file");
+      fail(where + ": a section of format " + versionText(kModelFileMajorVersion, codec->sinceMinor) +
+           " in a version " + versionText(info.majorVersion, info.minorVersion) + " file");
     // Sections unknown to this reader are legitimate only in a file of a newer minor version.
     if (!sec.known && info.minorVersion <= kModelFileMinorVersion)
       fail("unknown section '" + sec.tag + "' in a version " + versionText(info.majorVersion, info.minorVersion) +

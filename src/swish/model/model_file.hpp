@@ -83,11 +83,11 @@ Model loadModel(const std::filesystem::path& path);
 // after checking the magic, version, sizes and every checksum (Error otherwise), without parsing the
 // payloads.
 struct ModelFileSection {
-  std::string tag;       // 4 characters
-  uint64_t offset = 0;   // of the section header from the start of the file
+  std::string tag;      // 4 characters
+  uint64_t offset = 0;  // of the section header from the start of the file
   uint64_t payloadBytes = 0;
   uint32_t crc = 0;
-  bool known = true;     // false: a section of a newer minor version that this reader skips
+  bool known = true;  // false: a section of a newer minor version that this reader skips
 };
 struct ModelFileInfo {
   uint16_t majorVersion = 0, minorVersion = 0;

@@ -163,8 +163,8 @@ void readMesh(ByteReader& r, Model& m) {
   Mesh& g = m.gameMesh;
   const uint32_t n = r.u32("vertex count"), triangles = r.u32("triangle count"), flags = r.u32("attribute flags");
   if (flags & ~kAllAttributes) r.fail("unknown attribute flags " + std::to_string(flags));
-  const uint64_t perVertex = 12 + (flags & kHasNormals ? 12 : 0) + (flags & kHasTangents ? 16 : 0) +
-                             (flags & kHasUvs ? 8 : 0);
+  const uint64_t perVertex =
+      12 + (flags & kHasNormals ? 12 : 0) + (flags & kHasTangents ? 16 : 0) + (flags & kHasUvs ? 8 : 0);
   r.checkCount(n, perVertex, "vertex");  // all vertex attributes at once, before any allocation
   g.positions.resize(n, 3);
   r.f32s(g.positions.data(), size_t(n) * 3, "vertex position");
@@ -289,12 +289,18 @@ void readMetadata(ByteReader& r, Model& m) {
 
 const std::vector<SectionCodec>& sectionCodecs() {
   static const std::vector<SectionCodec> codecs = {
-      {"SKEL", writeSkeleton, readSkeleton},       {"INPJ", writeInputJoints, readInputJoints},
-      {"NRMI", writeInputNorm, readInputNorm},     {"NRMO", writeOutputNorm, readOutputNorm},
-      {"MLP ", writeMlp, readMlp},                 {"MPCA", writeMeshPca, readMeshPca},
-      {"MESH", writeMesh, readMesh},               {"SKIN", writeSkin, readSkin},
-      {"NMDB", writeNormalMaps, readNormalMaps},   {"TFLT", writeTemporalFilter, readTemporalFilter},
-      {"BPRX", writeBodyProxy, readBodyProxy, 1},  {"META", writeMetadata, readMetadata},
+      {"SKEL", writeSkeleton, readSkeleton},
+      {"INPJ", writeInputJoints, readInputJoints},
+      {"NRMI", writeInputNorm, readInputNorm},
+      {"NRMO", writeOutputNorm, readOutputNorm},
+      {"MLP ", writeMlp, readMlp},
+      {"MPCA", writeMeshPca, readMeshPca},
+      {"MESH", writeMesh, readMesh},
+      {"SKIN", writeSkin, readSkin},
+      {"NMDB", writeNormalMaps, readNormalMaps},
+      {"TFLT", writeTemporalFilter, readTemporalFilter},
+      {"BPRX", writeBodyProxy, readBodyProxy, 1},
+      {"META", writeMetadata, readMetadata},
   };
   return codecs;
 }

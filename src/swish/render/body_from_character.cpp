@@ -18,7 +18,8 @@ std::optional<BodyMesh> bodyFromCharacter(const Character& c, const api::ModelIn
   for (size_t j = 0; j < model.jointNames.size(); ++j) modelJoint[model.jointNames[j]] = uint16_t(j);
   BodyMesh out;
   out.positions.assign(b.positions.data(), b.positions.data() + b.positions.size());
-  if (size_t(b.normals.rows()) == b.vertexCount()) out.normals.assign(b.normals.data(), b.normals.data() + b.normals.size());
+  if (size_t(b.normals.rows()) == b.vertexCount())
+    out.normals.assign(b.normals.data(), b.normals.data() + b.normals.size());
   out.triangles.assign(b.triangles.data(), b.triangles.data() + b.triangles.size());
   out.influences = uint32_t(b.skin.influences);
   out.weights = b.skin.weights;
@@ -35,7 +36,8 @@ std::optional<BodyMesh> bodyFromCharacter(const Character& c, const api::ModelIn
         out.joints[i] = 0;  // an unused influence slot
         continue;
       }
-      why = "joint '" + c.skeleton.joints[j].name + "' skins the body of '" + c.name + "' but is not in the model's skeleton";
+      why = "joint '" + c.skeleton.joints[j].name + "' skins the body of '" + c.name +
+            "' but is not in the model's skeleton";
       return std::nullopt;
     }
     out.joints[i] = it->second;

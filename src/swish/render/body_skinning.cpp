@@ -30,8 +30,11 @@ std::vector<float> vertexNormals(const std::vector<float>& p, const std::vector<
 }
 
 BodySkinner::BodySkinner(const BodyMesh& b)
-    : rest_(b.positions), restNormals_(b.normals.empty() ? vertexNormals(b.positions, b.triangles) : b.normals), weights_(b.weights),
-      joints_(b.joints), influences_(b.influences) {}
+    : rest_(b.positions),
+      restNormals_(b.normals.empty() ? vertexNormals(b.positions, b.triangles) : b.normals),
+      weights_(b.weights),
+      joints_(b.joints),
+      influences_(b.influences) {}
 
 void BodySkinner::skin(const std::vector<api::Mat4>& mats, float* out) const {
   const size_t n = vertexCount();

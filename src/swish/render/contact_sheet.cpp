@@ -7,7 +7,8 @@
 
 namespace swish::render {
 
-PreviewImage renderFramePng(PreviewRenderer& preview, const api::CharacterPose& pose, const std::filesystem::path& path) {
+PreviewImage renderFramePng(PreviewRenderer& preview, const api::CharacterPose& pose,
+                            const std::filesystem::path& path) {
   PreviewImage img = preview.render(pose, {{true, true}});
   writePreviewPng(path.string(), img, preview.options().background);
   return img;
@@ -15,10 +16,12 @@ PreviewImage renderFramePng(PreviewRenderer& preview, const api::CharacterPose& 
 
 PreviewImage makeContactSheet(const std::vector<PreviewImage>& frames, const ContactSheetOptions& o) {
   if (frames.empty()) throw api::Error(api::ErrorCode::InvalidArgument, "contact sheet: no frames");
-  if (o.columns == 0 || o.thumbnailWidth == 0) throw api::Error(api::ErrorCode::InvalidArgument, "contact sheet: columns and thumbnail width must be >= 1");
+  if (o.columns == 0 || o.thumbnailWidth == 0)
+    throw api::Error(api::ErrorCode::InvalidArgument, "contact sheet: columns and thumbnail width must be >= 1");
   const uint32_t fw = frames[0].width, fh = frames[0].height;
   for (const auto& f : frames)
-    if (f.width != fw || f.height != fh) throw api::Error(api::ErrorCode::InvalidArgument, "contact sheet: frames differ in size");
+    if (f.width != fw || f.height != fh)
+      throw api::Error(api::ErrorCode::InvalidArgument, "contact sheet: frames differ in size");
   const uint32_t tw = std::min(o.thumbnailWidth, fw);
   const uint32_t th = std::max<uint32_t>(1, uint32_t(std::lround(double(fh) * tw / fw)));
   const uint32_t cols = std::min<uint32_t>(o.columns, uint32_t(frames.size()));
@@ -51,7 +54,8 @@ PreviewImage makeContactSheet(const std::vector<PreviewImage>& frames, const Con
   return sheet;
 }
 
-void writeContactSheet(const std::vector<PreviewImage>& frames, const std::filesystem::path& path, const ContactSheetOptions& o) {
+void writeContactSheet(const std::vector<PreviewImage>& frames, const std::filesystem::path& path,
+                       const ContactSheetOptions& o) {
   writePreviewPng(path.string(), makeContactSheet(frames, o), o.background);
 }
 

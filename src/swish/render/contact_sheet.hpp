@@ -18,7 +18,8 @@ namespace swish::render {
 
 // Renders one frame of `pose` (normal map on, body when there is one), writes it as an RGB PNG
 // (atomically) and returns the image, e.g. for a contact sheet.
-PreviewImage renderFramePng(PreviewRenderer& preview, const api::CharacterPose& pose, const std::filesystem::path& path);
+PreviewImage renderFramePng(PreviewRenderer& preview, const api::CharacterPose& pose,
+                            const std::filesystem::path& path);
 
 struct ContactSheetOptions {
   uint32_t columns = 4;
@@ -29,6 +30,7 @@ struct ContactSheetOptions {
 
 // A grid of the frames in order, left to right then top to bottom. Frames must share one size.
 PreviewImage makeContactSheet(const std::vector<PreviewImage>& frames, const ContactSheetOptions& options = {});
-void writeContactSheet(const std::vector<PreviewImage>& frames, const std::filesystem::path& path, const ContactSheetOptions& options = {});
+void writeContactSheet(const std::vector<PreviewImage>& frames, const std::filesystem::path& path,
+                       const ContactSheetOptions& options = {});
 
 }  // namespace swish::render

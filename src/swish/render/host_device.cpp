@@ -14,10 +14,14 @@ namespace swish::render {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& why) { throw api::Error(api::ErrorCode::DeviceUnsupported, "host device: " + why); }
+[[noreturn]] void fail(const std::string& why) {
+  throw api::Error(api::ErrorCode::DeviceUnsupported, "host device: " + why);
+}
 
 void check(VkResult r, const char* call) {
-  if (r != VK_SUCCESS) throw api::Error(api::ErrorCode::VulkanFailure, std::string("host device: ") + call + " returned " + std::to_string(int(r)));
+  if (r != VK_SUCCESS)
+    throw api::Error(api::ErrorCode::VulkanFailure,
+                     std::string("host device: ") + call + " returned " + std::to_string(int(r)));
 }
 
 std::string lower(std::string s) {
@@ -48,7 +52,8 @@ bool layerAvailable(const char* name) {
 
 }  // namespace
 
-VKAPI_ATTR VkBool32 VKAPI_CALL HostDevice::onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+VKAPI_ATTR VkBool32 VKAPI_CALL HostDevice::onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                                     VkDebugUtilsMessageTypeFlagsEXT,
                                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   auto* self = static_cast<HostDevice*>(user);
   std::lock_guard lock(self->mutex_);
@@ -84,7 +89,8 @@ HostDevice::HostDevice(const HostDeviceOptions& options) {
   check(r, "vkCreateInstance");
   try {
     if (options.validation) {
-      auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+      auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
       if (!create) fail("VK_EXT_debug_utils is missing");
       check(create(instance_, &mi, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
     }
@@ -105,17 +111,20 @@ HostDevice::HostDevice(const HostDeviceOptions& options) {
         if (isIndex ? std::to_string(i) != want : lower(p.deviceName).find(lower(want)) == std::string::npos) continue;
       }
       std::string why = api::unsuitableReason(pds[i]);
-      if (why.empty() && graphicsComputeFamily(pds[i]) < 0) why = std::string(p.deviceName) + " has no graphics+compute queue";
+      if (why.empty() && graphicsComputeFamily(pds[i]) < 0)
+        why = std::string(p.deviceName) + " has no graphics+compute queue";
       if (!why.empty()) {
         reasons += "; " + why;
         continue;
       }
-      const int score = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ? 3
+      const int score = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? 3
                         : p.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? 2
-                        : p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : 1;
+                        : p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU            ? 0
+                                                                                 : 1;
       if (score > bestScore) best = int(i), bestScore = score;
     }
-    if (best < 0) fail("no usable Vulkan device" + (want.empty() ? std::string() : " matching '" + want + "'") + reasons);
+    if (best < 0)
+      fail("no usable Vulkan device" + (want.empty() ? std::string() : " matching '" + want + "'") + reasons);
     physical_ = pds[best];
     family_ = uint32_t(graphicsComputeFamily(physical_));
 
@@ -147,7 +156,8 @@ void HostDevice::release() {
   if (device_) vkDestroyDevice(device_, nullptr);
   device_ = VK_NULL_HANDLE;
   if (messenger_) {
-    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
     if (destroy) destroy(instance_, messenger_, nullptr);
     messenger_ = VK_NULL_HANDLE;
   }
@@ -178,7 +188,8 @@ uint32_t HostDevice::memoryType(uint32_t typeBits, VkMemoryPropertyFlags flags) 
   vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
   for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
     if ((typeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & flags) == flags) return i;
-  throw api::Error(api::ErrorCode::DeviceUnsupported, "host device: no memory type with the properties the preview needs");
+  throw api::Error(api::ErrorCode::DeviceUnsupported,
+                   "host device: no memory type with the properties the preview needs");
 }
 
 }  // namespace swish::render

@@ -8,7 +8,9 @@ namespace swish::render {
 
 namespace {
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
 float dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 Vec3 normalize(const Vec3& a) {
   const float l = std::sqrt(dot(a, a));
@@ -32,8 +34,8 @@ api::Mat4 viewProjection(const PreviewCamera& c, float aspect) {
   const Vec3 s = normalize(cross(f, c.up));
   const Vec3 u = cross(s, f);
   // Right-handed view: camera looks down -Z.
-  const api::Mat4 view = {s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0,
-                          -dot(s, c.eye), -dot(u, c.eye), dot(f, c.eye), 1};
+  const api::Mat4 view = {s[0], u[0], -f[0], 0, s[1],           u[1],           -f[1],         0,
+                          s[2], u[2], -f[2], 0, -dot(s, c.eye), -dot(u, c.eye), dot(f, c.eye), 1};
   const float t = 1.f / std::tan(c.verticalFovDegrees * 3.14159265f / 360.f);
   const float n = c.nearPlane, fa = c.farPlane;
   // Vulkan: y flipped (framebuffer y down), depth 0 at near, 1 at far.

@@ -15,7 +15,8 @@ namespace {
 
 Owned<VkShaderModule> shaderModule(VkDevice dev, const char* name) {
   const shaders::EmbeddedShader* s = shaders::find(name);
-  if (!s) throw api::Error(api::ErrorCode::Internal, std::string("preview renderer: shader ") + name + " is not embedded");
+  if (!s)
+    throw api::Error(api::ErrorCode::Internal, std::string("preview renderer: shader ") + name + " is not embedded");
   VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   ci.codeSize = s->wordCount * 4;
   ci.pCode = s->words;
@@ -39,7 +40,9 @@ Owned<VkPipeline> makePipeline(VkDevice dev, VkPipelineLayout layout, const char
   std::vector<VkVertexInputBindingDescription> bindings;
   std::vector<VkVertexInputAttributeDescription> attrs;
   for (uint32_t i = 0; i < attributes.size(); ++i) {
-    const uint32_t size = attributes[i] == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : attributes[i] == VK_FORMAT_R32G32B32_SFLOAT ? 12 : 8;
+    const uint32_t size = attributes[i] == VK_FORMAT_R32G32B32A32_SFLOAT ? 16
+                          : attributes[i] == VK_FORMAT_R32G32B32_SFLOAT  ? 12
+                                                                         : 8;
     bindings.push_back({i, size, VK_VERTEX_INPUT_RATE_VERTEX});
     attrs.push_back({i, i, attributes[i], 0});
   }
@@ -65,7 +68,8 @@ Owned<VkPipeline> makePipeline(VkDevice dev, VkPipelineLayout layout, const char
   ds.depthWriteEnable = VK_TRUE;
   ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
   VkPipelineColorBlendAttachmentState cba{};
-  cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  cba.colorWriteMask =
+      VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
   VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   cb.attachmentCount = 1;
   cb.pAttachments = &cba;
@@ -99,15 +103,18 @@ Owned<VkPipeline> makePipeline(VkDevice dev, VkPipelineLayout layout, const char
 
 PreviewPipelines::PreviewPipelines(HostDevice& device) : device_(device.device()) {
   VkDevice dev = device_;
-  VkDescriptorSetLayoutBinding b{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  VkDescriptorSetLayoutBinding b{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT,
+                                 nullptr};
   VkDescriptorSetLayoutCreateInfo slci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   slci.bindingCount = 1;
   slci.pBindings = &b;
   VkDescriptorSetLayout sl;
   vkCheck(vkCreateDescriptorSetLayout(dev, &slci, nullptr, &sl), "vkCreateDescriptorSetLayout");
-  setLayout_ = Owned<VkDescriptorSetLayout>(sl, [dev](VkDescriptorSetLayout h) { vkDestroyDescriptorSetLayout(dev, h, nullptr); });
+  setLayout_ = Owned<VkDescriptorSetLayout>(
+      sl, [dev](VkDescriptorSetLayout h) { vkDestroyDescriptorSetLayout(dev, h, nullptr); });
 
-  const VkPushConstantRange pcr{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(PreviewPushConstants)};
+  const VkPushConstantRange pcr{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                sizeof(PreviewPushConstants)};
   VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   plci.setLayoutCount = 1;
   plci.pSetLayouts = &sl;
@@ -144,9 +151,11 @@ PreviewPipelines::PreviewPipelines(HostDevice& device) : device_(device.device()
   dsai.pSetLayouts = &sl;
   vkCheck(vkAllocateDescriptorSets(dev, &dsai, &set_), "vkAllocateDescriptorSets");
 
-  jersey_ = makePipeline(dev, pl, "preview_jersey.vert", "preview_jersey.frag",
-                         {VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT});
-  body_ = makePipeline(dev, pl, "preview_body.vert", "preview_body.frag", {VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32_SFLOAT});
+  jersey_ = makePipeline(
+      dev, pl, "preview_jersey.vert", "preview_jersey.frag",
+      {VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT});
+  body_ = makePipeline(dev, pl, "preview_body.vert", "preview_body.frag",
+                       {VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32_SFLOAT});
 }
 
 void PreviewPipelines::bindNormalMaps(VkImageView view, VkImageLayout layout) {

@@ -16,8 +16,9 @@ namespace swish::render {
 
 namespace {
 
-VkImageMemoryBarrier2 imageBarrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess, VkImageLayout from, VkImageLayout to) {
+VkImageMemoryBarrier2 imageBarrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 srcStage,
+                                   VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess,
+                                   VkImageLayout from, VkImageLayout to) {
   VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
   b.srcStageMask = srcStage;
   b.srcAccessMask = srcAccess;
@@ -31,7 +32,8 @@ VkImageMemoryBarrier2 imageBarrier(VkImage image, VkImageAspectFlags aspect, VkP
   return b;
 }
 
-void pipelineBarrier(VkCommandBuffer cmd, std::span<const VkBufferMemoryBarrier2> buffers, std::span<const VkImageMemoryBarrier2> images) {
+void pipelineBarrier(VkCommandBuffer cmd, std::span<const VkBufferMemoryBarrier2> buffers,
+                     std::span<const VkImageMemoryBarrier2> images) {
   VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   di.bufferMemoryBarrierCount = uint32_t(buffers.size());
   di.pBufferMemoryBarriers = buffers.data();
@@ -71,7 +73,12 @@ struct PreviewRenderer::State {
   api::FrameReport lastReport;
 
   State(HostDevice& d, api::Runtime rt, api::Model m, PreviewOptions o)
-      : dev(&d), runtime(std::move(rt)), model(m), batch(m.createBatch({1, o.framesInFlight, true, o.pushOut})), opts(std::move(o)), pipes(d) {}
+      : dev(&d),
+        runtime(std::move(rt)),
+        model(m),
+        batch(m.createBatch({1, o.framesInFlight, true, o.pushOut})),
+        opts(std::move(o)),
+        pipes(d) {}
 
   void submitAndWait() {
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -124,9 +131,11 @@ void BodyMesh::validate(size_t jointCount) const {
   for (uint32_t t : triangles)
     if (t >= n) bad("triangle index " + std::to_string(t) + " >= vertex count " + std::to_string(n));
   if (influences < 1 || influences > 8) bad(std::to_string(influences) + " influences per vertex; 1..8 supported");
-  if (joints.size() != n * influences || weights.size() != n * influences) bad("skin joints/weights must be vertexCount * influences");
+  if (joints.size() != n * influences || weights.size() != n * influences)
+    bad("skin joints/weights must be vertexCount * influences");
   for (uint16_t j : joints)
-    if (j >= jointCount) bad("skin joint " + std::to_string(j) + " is not in the model's skeleton of " + std::to_string(jointCount));
+    if (j >= jointCount)
+      bad("skin joint " + std::to_string(j) + " is not in the model's skeleton of " + std::to_string(jointCount));
   for (float v : positions)
     if (!std::isfinite(v)) bad("non-finite position");
 }
@@ -156,7 +165,8 @@ PreviewRenderer::PreviewRenderer(HostDevice& device, api::Runtime runtime, api::
   vkCheck(vkCreateFence(dev, &fci, nullptr, &fence), "vkCreateFence");
   s.fence = Owned<VkFence>(fence, [dev](VkFence h) { vkDestroyFence(dev, h, nullptr); });
 
-  s.jerseyIndices = filled(device, info.triangleIndices.data(), info.triangleIndices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  s.jerseyIndices =
+      filled(device, info.triangleIndices.data(), info.triangleIndices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   if (info.uvs.empty()) {
     const std::vector<float> zeros(size_t(info.vertexCount) * 2, 0.f);
     s.zeroUvs = filled(device, zeros.data(), zeros.size() * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
@@ -164,7 +174,8 @@ PreviewRenderer::PreviewRenderer(HostDevice& device, api::Runtime runtime, api::
   if (s.opts.body) {
     s.body.emplace(*s.opts.body);
     s.bodyVertices = makeMappedBuffer(device, s.body->vertexCount() * 24, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-    s.bodyIndices = filled(device, s.opts.body->triangles.data(), s.opts.body->triangles.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    s.bodyIndices = filled(device, s.opts.body->triangles.data(), s.opts.body->triangles.size() * 4,
+                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   }
 
   // The fixed camera: the body's rest pose when there is one (the whole mannequin), else the jersey's.
@@ -173,7 +184,8 @@ PreviewRenderer::PreviewRenderer(HostDevice& device, api::Runtime runtime, api::
     s.cam = *s.opts.camera;
   } else {
     Vec3 lo, hi;
-    boundsOf(s.opts.body ? std::span<const float>(s.opts.body->positions) : std::span<const float>(info.restPositions), lo, hi);
+    boundsOf(s.opts.body ? std::span<const float>(s.opts.body->positions) : std::span<const float>(info.restPositions),
+             lo, hi);
     s.cam = frameBox(lo, hi, aspect);
   }
   s.viewProj = render::viewProjection(s.cam, aspect);
@@ -207,7 +219,8 @@ PreviewImage PreviewRenderer::render(const api::CharacterPose& pose, const std::
   State& s = *s_;
   if (variants.empty()) throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: no variant to draw");
   const uint32_t w = s.opts.width, h = s.opts.height, total = w * uint32_t(variants.size());
-  if (total > 16384) throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: too many variants side by side");
+  if (total > 16384)
+    throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: too many variants side by side");
   s.ensureTarget(total);
   if (s.body) s.body->skin(s.model.skinningMatrices(pose), static_cast<float*>(s.bodyVertices.data));
 
@@ -222,11 +235,12 @@ PreviewImage PreviewRenderer::render(const api::CharacterPose& pose, const std::
                                 VK_ACCESS_2_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL));
-  images.push_back(imageBarrier(s.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                                VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
-                                VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL));
+  images.push_back(
+      imageBarrier(s.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
+                   VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL));
   pipelineBarrier(s.cmd, bufferBarriers, images);
   const bool maps = out.normalMaps.has_value();
   s.pipes.bindNormalMaps(maps ? out.normalMaps->view : s.dummyMap.view.get(), VK_IMAGE_LAYOUT_GENERAL);
@@ -273,21 +287,24 @@ PreviewImage PreviewRenderer::render(const api::CharacterPose& pose, const std::
     vkCmdPushConstants(s.cmd, s.pipes.layout(), stages, 0, sizeof pc, &pc);
     const VkBuffer bufs[4] = {out.positions.buffer, out.normals.buffer, out.tangents.buffer,
                               out.uvs.buffer ? out.uvs.buffer : s.zeroUvs.buffer.get()};
-    const VkDeviceSize offs[4] = {out.positions.offset, out.normals.offset, out.tangents.offset, out.uvs.buffer ? out.uvs.offset : 0};
+    const VkDeviceSize offs[4] = {out.positions.offset, out.normals.offset, out.tangents.offset,
+                                  out.uvs.buffer ? out.uvs.offset : 0};
     vkCmdBindVertexBuffers(s.cmd, 0, 4, bufs, offs);
     vkCmdBindIndexBuffer(s.cmd, s.jerseyIndices.buffer.get(), 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(s.cmd, uint32_t(s.model.info().triangleIndices.size()), 1, 0, 0, 0);
   }
   vkCmdEndRendering(s.cmd);
 
-  const auto toCopy = imageBarrier(s.color.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                   VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
-                                   VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  const auto toCopy =
+      imageBarrier(s.color.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                   VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+                   VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   pipelineBarrier(s.cmd, {}, std::span(&toCopy, 1));
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {total, h, 1};
-  vkCmdCopyImageToBuffer(s.cmd, s.color.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.readback.buffer.get(), 1, &region);
+  vkCmdCopyImageToBuffer(s.cmd, s.color.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.readback.buffer.get(), 1,
+                         &region);
   VkBufferMemoryBarrier2 toHost{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
   toHost.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
   toHost.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;

@@ -34,12 +34,12 @@ struct BodyMesh {
 };
 
 struct PreviewOptions {
-  uint32_t width = 480, height = 640;     // of one view
-  std::optional<BodyMesh> body;           // absent: the jersey alone
-  std::optional<PreviewCamera> camera;    // absent: framing the rest-pose body (or the jersey) from the front
+  uint32_t width = 480, height = 640;   // of one view
+  std::optional<BodyMesh> body;         // absent: the jersey alone
+  std::optional<PreviewCamera> camera;  // absent: framing the rest-pose body (or the jersey) from the front
   std::array<float, 3> jerseyColor{0.72f, 0.12f, 0.14f};
   std::array<float, 3> bodyColor{0.62f, 0.62f, 0.64f};
-  std::array<float, 3> background{0.93f, 0.94f, 0.96f};  // used when flattening to RGB
+  std::array<float, 3> background{0.93f, 0.94f, 0.96f};      // used when flattening to RGB
   std::array<float, 3> lightDirection{0.45f, 0.55f, 0.70f};  // towards the key light
   uint32_t framesInFlight = 2;
   bool pushOut = true;  // api::BatchOptions::pushOut: the garment pushed out of the model's body proxy

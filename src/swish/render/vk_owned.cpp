@@ -11,7 +11,8 @@ namespace swish::render {
 
 void vkCheck(VkResult r, const char* call) {
   if (r != VK_SUCCESS)
-    throw api::Error(api::ErrorCode::VulkanFailure, std::string("preview renderer: ") + call + " returned " + std::to_string(int(r)));
+    throw api::Error(api::ErrorCode::VulkanFailure,
+                     std::string("preview renderer: ") + call + " returned " + std::to_string(int(r)));
 }
 
 MappedBuffer makeMappedBuffer(HostDevice& d, VkDeviceSize size, VkBufferUsageFlags usage) {
@@ -29,7 +30,8 @@ MappedBuffer makeMappedBuffer(HostDevice& d, VkDeviceSize size, VkBufferUsageFla
   vkGetBufferMemoryRequirements(dev, buf, &req);
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
-  mai.memoryTypeIndex = d.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  mai.memoryTypeIndex =
+      d.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   VkDeviceMemory mem;
   vkCheck(vkAllocateMemory(dev, &mai, nullptr, &mem), "vkAllocateMemory");
   b.memory = Owned<VkDeviceMemory>(mem, [dev](VkDeviceMemory h) { vkFreeMemory(dev, h, nullptr); });

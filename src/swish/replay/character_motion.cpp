@@ -17,7 +17,8 @@ CharacterMotion::CharacterMotion(std::shared_ptr<const AnimationClip> clip, cons
   lastRoot_ = skeleton.restPose().rootTranslation;
 }
 
-CharacterMotion::CharacterMotion(std::shared_ptr<const PoseStream> stream, const Skeleton& skeleton, std::string character)
+CharacterMotion::CharacterMotion(std::shared_ptr<const PoseStream> stream, const Skeleton& skeleton,
+                                 std::string character)
     : stream_(std::move(stream)), skeleton_(&skeleton), character_(std::move(character)) {
   if (!stream_ || stream_->frames.empty()) throw Error("character '" + character_ + "': the pose stream has no frames");
   streamJointOf_.assign(skeleton.size(), -1);
@@ -52,7 +53,8 @@ Pose CharacterMotion::streamPose(double seconds, uint32_t frame, std::vector<Pos
   size_t f = size_t(std::llround(std::max(0.0, seconds * s.framesPerSecond)));
   if (f >= s.frames.size()) {
     if (!reportedEnd_)
-      issues.push_back({frame, character_, "", "the pose stream ends after " + std::to_string(s.frames.size()) + " frames",
+      issues.push_back({frame, character_, "",
+                        "the pose stream ends after " + std::to_string(s.frames.size()) + " frames",
                         "its last frame is held"});
     reportedEnd_ = true;
     f = s.frames.size() - 1;
@@ -63,7 +65,8 @@ Pose CharacterMotion::streamPose(double seconds, uint32_t frame, std::vector<Pos
     const int sj = streamJointOf_[j];
     if (sj < 0) {
       if (!reportedUnnamed_)
-        issues.push_back({frame, character_, skeleton_->joints[j].name, "joint not in the pose stream", "rest rotation"});
+        issues.push_back(
+            {frame, character_, skeleton_->joints[j].name, "joint not in the pose stream", "rest rotation"});
       continue;
     }
     if (!sf.present[size_t(sj)]) {
@@ -85,9 +88,8 @@ void CharacterMotion::sanitise(Pose& p, uint32_t frame, std::vector<PoseIssue>& 
       p.local[j] = skeleton_->joints[j].rest.rotation;
     } else {
       if (s.status == QuatStatus::Renormalised)
-        issues.push_back({frame, character_, skeleton_->joints[j].name, "non-unit quaternion (norm " +
-                                                                            std::to_string(p.local[j].norm()) + ")",
-                          "normalised"});
+        issues.push_back({frame, character_, skeleton_->joints[j].name,
+                          "non-unit quaternion (norm " + std::to_string(p.local[j].norm()) + ")", "normalised"});
       p.local[j] = s.q;
     }
   }

@@ -26,9 +26,9 @@
 namespace swish::replay {
 
 struct PoseIssue {
-  uint32_t frame = 0;       // scene frame
+  uint32_t frame = 0;  // scene frame
   std::string character;
-  std::string joint;        // "" for the whole pose (root, stream end)
+  std::string joint;  // "" for the whole pose (root, stream end)
   std::string problem;
   std::string action;
 };
@@ -36,8 +36,8 @@ struct PoseIssue {
 class CharacterMotion {
  public:
   // `clip` must already be on `skeleton` (io::importAnimation); shared between characters.
-  CharacterMotion(std::shared_ptr<const AnimationClip> clip, const runtime::SceneClip& playback, const Skeleton& skeleton,
-                  std::string character);
+  CharacterMotion(std::shared_ptr<const AnimationClip> clip, const runtime::SceneClip& playback,
+                  const Skeleton& skeleton, std::string character);
   CharacterMotion(std::shared_ptr<const PoseStream> stream, const Skeleton& skeleton, std::string character);
 
   // The pose at scene time `seconds` (scene frame `frame`, for reports), sanitised; issues appended.

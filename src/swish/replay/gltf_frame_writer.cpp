@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "swish/core/error.hpp"
-#include "swish/io/gltf_export.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/io/gltf_export.hpp"
 
 namespace swish::replay {
 

@@ -32,13 +32,14 @@ CharacterCheck compareInstance(const runtime::ReferenceFrameOutputs& gpu, const 
   if (i < gpu.normals.size() && i < cpu.normals.size())
     for (Eigen::Index v = 0; v < gp.rows(); ++v) {
       c.maxNormalErrorDeg = std::max(c.maxNormalErrorDeg, angleDeg(gpu.normals[i].row(v), cpu.normals[i].row(v)));
-      c.maxTangentErrorDeg = std::max(
-          c.maxTangentErrorDeg, angleDeg(gpu.tangents[i].row(v).head<3>(), cpu.tangents[i].row(v).head<3>()));
+      c.maxTangentErrorDeg =
+          std::max(c.maxTangentErrorDeg, angleDeg(gpu.tangents[i].row(v).head<3>(), cpu.tangents[i].row(v).head<3>()));
     }
   if (i < gpu.normalMaps.size() && i < cpu.normalMaps.size()) {
     const auto& a = gpu.normalMaps[i].xy;
     const auto& b = cpu.normalMaps[i].xy;
-    for (size_t t = 0; t < std::min(a.size(), b.size()); ++t) c.maxMapErrorSteps = std::max(c.maxMapErrorSteps, std::abs(int(a[t]) - int(b[t])));
+    for (size_t t = 0; t < std::min(a.size(), b.size()); ++t)
+      c.maxMapErrorSteps = std::max(c.maxMapErrorSteps, std::abs(int(a[t]) - int(b[t])));
     if (a.size() != b.size()) c.maxMapErrorSteps = 65535;
   }
   c.ok = c.maxPositionErrorMm <= kPositionToleranceMm && c.maxNormalErrorDeg <= kFrameToleranceDeg &&

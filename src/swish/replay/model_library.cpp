@@ -129,13 +129,14 @@ std::map<std::string, const Model*> ModelLibrary::modelMap() const {
 }
 
 std::shared_ptr<const AnimationClip> ModelLibrary::clip(const fs::path& file, const std::string& key,
-                                                       const nlohmann::json& jointMap, const std::string& what) {
+                                                        const nlohmann::json& jointMap, const std::string& what) {
   auto& slot = clips_[{file.string(), key, jointMap.dump()}];
   if (!slot) {
     io::AnimationImportOptions o;
     if (!jointMap.is_null()) o.retarget.jointMap = io::parseJointMap(jointMap, what);
     o.retarget.requiredJoints.clear();  // a model's input joints are checked below, by the caller's model
-    for (uint32_t j : at(key).model.inputJoints) o.retarget.requiredJoints.push_back(at(key).model.skeleton.joints[j].name);
+    for (uint32_t j : at(key).model.inputJoints)
+      o.retarget.requiredJoints.push_back(at(key).model.skeleton.joints[j].name);
     slot = std::make_shared<AnimationClip>(io::importAnimation(file, at(key).model.skeleton, o));
   }
   return slot;

@@ -8,9 +8,9 @@
 //      clip /usr/share/assimp/models/BVH/01_01.bvh, and every report says so (ModelEntry::label).
 #include <filesystem>
 #include <map>
-#include <tuple>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -22,9 +22,9 @@
 namespace swish::replay {
 
 struct ModelEntry {
-  std::string key;              // SceneCharacter::model
-  std::filesystem::path file;   // empty for the procedural stand-in
-  std::string label;            // what reports print about where the model came from
+  std::string key;             // SceneCharacter::model
+  std::filesystem::path file;  // empty for the procedural stand-in
+  std::string label;           // what reports print about where the model came from
   bool procedural = false;
   Model model;
 };
@@ -44,7 +44,8 @@ class ModelLibrary {
   // JSON form; null: by naming convention), imported once per (file, model, joint map). `what` names
   // the joint map in errors ("scene.json: characters[2].animation.jointMap").
   std::shared_ptr<const AnimationClip> clip(const std::filesystem::path& file, const std::string& key,
-                                            const nlohmann::json& jointMap = nullptr, const std::string& what = "jointMap");
+                                            const nlohmann::json& jointMap = nullptr,
+                                            const std::string& what = "jointMap");
 
  private:
   std::vector<std::unique_ptr<ModelEntry>> entries_;

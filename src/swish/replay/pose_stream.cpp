@@ -65,7 +65,8 @@ PoseStream readPoseStream(const std::filesystem::path& file) {
       if (rj[r].is_null()) continue;
       const std::string ra = at + ".rotations[" + std::to_string(r) + "]";
       if (!rj[r].is_array() || rj[r].size() != 4) throw Error(ra + ": must be [x, y, z, w] or null");
-      frame.rotations[r] = Quatf(component(rj[r][3], ra), component(rj[r][0], ra), component(rj[r][1], ra), component(rj[r][2], ra));
+      frame.rotations[r] =
+          Quatf(component(rj[r][3], ra), component(rj[r][0], ra), component(rj[r][1], ra), component(rj[r][2], ra));
       frame.present[r] = true;
     }
     s.frames.push_back(std::move(frame));

@@ -24,9 +24,9 @@
 namespace swish::replay {
 
 struct PoseStreamFrame {
-  Vec3f root = Vec3f::Zero();             // NaN components when the file had null
-  std::vector<Quatf> rotations;           // per stream joint
-  std::vector<bool> present;              // false: the joint was missing in this frame
+  Vec3f root = Vec3f::Zero();    // NaN components when the file had null
+  std::vector<Quatf> rotations;  // per stream joint
+  std::vector<bool> present;     // false: the joint was missing in this frame
 };
 
 struct PoseStream {

@@ -61,7 +61,8 @@ Mesh makeJerseyTube(const Skeleton& sk, const ProceduralModelSpec& spec) {
       const size_t i = size_t(r) * cols + c;
       // Slightly wider at the chest than at the waist, like a jersey.
       const float flare = 0.9f + 0.2f * v;
-      m.positions.row(Eigen::Index(i)) = Vec3f(centre.x() + flare * rx * std::sin(a), y, centre.z() + flare * rz * std::cos(a));
+      m.positions.row(Eigen::Index(i)) =
+          Vec3f(centre.x() + flare * rx * std::sin(a), y, centre.z() + flare * rz * std::cos(a));
       m.uvs.row(Eigen::Index(i)) = Vec2f(u, 1.f - v);
       m.skin.joints[2 * i] = j0;
       m.skin.joints[2 * i + 1] = j1;
@@ -146,7 +147,8 @@ Model makeProceduralModel(const Skeleton& skeleton, const ProceduralModelSpec& s
     for (const auto& n : missing) list += (list.empty() ? "" : ", ") + n;
     throw Error("procedural model: the skeleton lacks the joints " + list);
   }
-  if (spec.mapSize % 4 || spec.mapSize == 0) throw Error("procedural model: the map size must be a positive multiple of 4");
+  if (spec.mapSize % 4 || spec.mapSize == 0)
+    throw Error("procedural model: the map size must be a positive multiple of 4");
   Rng rng(spec.seed);
   Model m;
   m.skeleton = skeleton;
@@ -183,8 +185,8 @@ Model makeProceduralModel(const Skeleton& skeleton, const ProceduralModelSpec& s
     for (Eigen::Index i = 0; i < m.normalMaps.keys.size(); ++i) m.normalMaps.keys.data()[i] = float(rng.normal());
   }
   m.temporalFilter.timeConstantSeconds = 0.1f;
-  m.metadata = std::string("{\"generator\": \"swish::replay::makeProceduralModel\", \"label\": \"") + kProceduralModelLabel +
-               "\", \"seed\": " + std::to_string(spec.seed) + "}";
+  m.metadata = std::string("{\"generator\": \"swish::replay::makeProceduralModel\", \"label\": \"") +
+               kProceduralModelLabel + "\", \"seed\": " + std::to_string(spec.seed) + "}";
   m.validate("procedural model");
   return m;
 }

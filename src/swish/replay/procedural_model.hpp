@@ -15,14 +15,14 @@
 namespace swish::replay {
 
 struct ProceduralModelSpec {
-  uint32_t rings = 48;            // along the torso
-  uint32_t segments = 64;         // around it
-  uint32_t meshComponents = 30;   // K
+  uint32_t rings = 48;           // along the torso
+  uint32_t segments = 64;        // around it
+  uint32_t meshComponents = 30;  // K
   uint32_t hiddenLayers = 5;
   uint32_t hiddenWidth = 32;
-  uint32_t normalMaps = 16;       // database maps
+  uint32_t normalMaps = 16;  // database maps
   uint32_t codeDims = 8;
-  uint32_t mapSize = 128;         // texels a side, multiple of 4
+  uint32_t mapSize = 128;  // texels a side, multiple of 4
   uint32_t codebookSize = 256;
   uint64_t seed = 2021;
 };

@@ -32,8 +32,8 @@ void ProgressBar::draw(bool force) {
   bar.resize(size_t(width), '.');
   char truth[64] = "";
   if (truthTotal_ > 0) std::snprintf(truth, sizeof truth, ", truth %u/%u poses", truthDone_, truthTotal_);
-  std::fprintf(stderr, "\r%s [%s] %u/%u frames%s, %.1f s, about %.1f s left   ", label_.c_str(), bar.c_str(), done_, total_,
-               truth, elapsed, left);
+  std::fprintf(stderr, "\r%s [%s] %u/%u frames%s, %.1f s, about %.1f s left   ", label_.c_str(), bar.c_str(), done_,
+               total_, truth, elapsed, left);
   std::fflush(stderr);
 }
 

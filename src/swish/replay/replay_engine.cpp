@@ -124,7 +124,8 @@ void ReplayEngine::Impl::setUp() {
     B.mlp.emplace(*B.model);
     if (B.planned->normalMaps) {
       B.search.emplace(B.model->normalMaps.keys);
-      B.filters.assign(B.planned->characters.size(), runtime::TemporalFilter(B.model->temporalFilter.timeConstantSeconds));
+      B.filters.assign(B.planned->characters.size(),
+                       runtime::TemporalFilter(B.model->temporalFilter.timeConstantSeconds));
       B.lastMap.assign(B.planned->characters.size(), 0);
     }
     for (uint32_t c : B.planned->characters) {
@@ -139,7 +140,8 @@ void ReplayEngine::Impl::setUp() {
             throw Error("the file's clip is '" + clip->name + "', not '" + ch.clip->clipName + "'");
           B.motions.emplace_back(clip, *ch.clip, B.model->skeleton, ch.name);
         } else {
-          B.motions.emplace_back(std::make_shared<PoseStream>(readPoseStream(*ch.poseStream)), B.model->skeleton, ch.name);
+          B.motions.emplace_back(std::make_shared<PoseStream>(readPoseStream(*ch.poseStream)), B.model->skeleton,
+                                 ch.name);
         }
       } catch (const Error& e) {
         throw Error(where + ": characters[" + std::to_string(c) + "] ('" + ch.name + "'): " + e.what());
@@ -180,7 +182,8 @@ void ReplayEngine::Impl::setUp() {
   }
   // The memory the device really takes: where it lays the normal-map images over the blend's output
   // (the same for every recorder on one device), no separate blended-maps buffer.
-  const auto withMaps = std::find_if(batches.begin(), batches.end(), [](const Batch& B) { return B.planned->normalMaps; });
+  const auto withMaps =
+      std::find_if(batches.begin(), batches.end(), [](const Batch& B) { return B.planned->normalMaps; });
   if (withMaps != batches.end() && withMaps->recorder->frame(0).normalMaps.sharesTexels()) {
     runtime::PlannerOptions po;
     po.normalMapsShareTexels = true;
@@ -269,7 +272,8 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
         const auto all = imgs.download(*ctx);
         const size_t per = size_t(imgs.width()) * imgs.height() * 2;
         for (uint32_t i = 0; i < B.planned->characters.size(); ++i)
-          prevMaps[b].push_back({imgs.width(), imgs.height(), std::vector<int16_t>(all.begin() + i * per, all.begin() + (i + 1) * per)});
+          prevMaps[b].push_back(
+              {imgs.width(), imgs.height(), std::vector<int16_t>(all.begin() + i * per, all.begin() + (i + 1) * per)});
       }
     auto t0 = Clock::now();
     VkCommandBuffer cmd = ctx->beginOneTime();
@@ -301,10 +305,10 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
           for (uint32_t i = 0; i < B.planned->characters.size(); ++i) {
             CharacterCheck c = compareInstance(gpuOut, cpuOut, i, B.planned->characters[i]);
             if (!c.ok)
-              result.failures.push_back("frame " + std::to_string(rec.frame) + ", character '" +
-                                        scene.characters[c.character].name + "': GPU output differs from the CPU reference (" +
-                                        std::to_string(c.maxPositionErrorMm) + " mm, " + std::to_string(c.maxNormalErrorDeg) +
-                                        " deg, " + std::to_string(c.maxMapErrorSteps) + " map steps)");
+              result.failures.push_back(
+                  "frame " + std::to_string(rec.frame) + ", character '" + scene.characters[c.character].name +
+                  "': GPU output differs from the CPU reference (" + std::to_string(c.maxPositionErrorMm) + " mm, " +
+                  std::to_string(c.maxNormalErrorDeg) + " deg, " + std::to_string(c.maxMapErrorSteps) + " map steps)");
             rec.checks.push_back(c);
           }
         }
@@ -351,7 +355,8 @@ void ReplayEngine::Impl::measurePenetration(FrameRecord& rec) {
     std::vector<CharacterPenetration> out(n);
     tbb::parallel_for(uint32_t(0), n, [&](uint32_t i) {
       bake::BodyCollider& c = B.colliders[i];
-      c.pose(std::vector<Mat4f>(B.inputs.skinMatrices.begin() + size_t(i) * jc, B.inputs.skinMatrices.begin() + size_t(i + 1) * jc));
+      c.pose(std::vector<Mat4f>(B.inputs.skinMatrices.begin() + size_t(i) * jc,
+                                B.inputs.skinMatrices.begin() + size_t(i + 1) * jc));
       out[i].character = B.planned->characters[i];
       out[i].model = bake::measurePenetration(c, runtime::referencePositions(m, B.inputs, i, false));
       if (pushed) {
@@ -384,9 +389,10 @@ void ReplayEngine::Impl::runTruth(ReplayResult& result) {
           const TruthJob& j = truthJobs[k];
           // Isolated: while the transfer's inner parallel loops wait, this thread must not pick up
           // another pose, whose second of simulation would then count in this pose's time.
-          tbb::this_task_arena::isolate(
-              [&] { out[k] = j.truth->measure(j.pose, j.positions, j.normalMap ? &*j.normalMap : nullptr,
-                                           j.withoutPushOut ? &*j.withoutPushOut : nullptr); });
+          tbb::this_task_arena::isolate([&] {
+            out[k] = j.truth->measure(j.pose, j.positions, j.normalMap ? &*j.normalMap : nullptr,
+                                      j.withoutPushOut ? &*j.withoutPushOut : nullptr);
+          });
           std::lock_guard<std::mutex> lock(mutex);
           ++truthDone;
           if (options.truthProgress) options.truthProgress(truthDone, truthTotal);
@@ -421,10 +427,12 @@ ReplayResult ReplayEngine::run() {
   const uint32_t every = I.options.truth.every;
   r.truthEvery = every;
   if (every == 0) {
-    r.truthNote = "no per-frame ground truth requested (--truth-every N); a baked model's held-out-pose errors (its "
-                  "metadata) are quoted under Models";
+    r.truthNote =
+        "no per-frame ground truth requested (--truth-every N); a baked model's held-out-pose errors (its "
+        "metadata) are quoted under Models";
   } else if (!I.plan.gpuWork || I.batches.empty()) {
-    r.truthNote = "--truth-every " + std::to_string(every) + ": no ground truth: no GPU work is planned (no character on "
+    r.truthNote = "--truth-every " + std::to_string(every) +
+                  ": no ground truth: no GPU work is planned (no character on "
                   "screen, or outputs that need no meshes), so there is no run-time output to measure";
   } else {
     // Per model: what its truth simulates, or why it has none.
@@ -432,8 +440,8 @@ ReplayResult ReplayEngine::run() {
     for (const Batch& B : I.batches) {
       if (!r.truthNote.empty()) r.truthNote += "; ";
       const bool ok = B.truth && B.truth->available();
-      r.truthNote += "model '" + B.planned->model + "': " + (ok ? "ground truth every " + std::to_string(every) +
-                                                                       " frames from " : "no ground truth: ") +
+      r.truthNote += "model '" + B.planned->model + "': " +
+                     (ok ? "ground truth every " + std::to_string(every) + " frames from " : "no ground truth: ") +
                      (B.truth ? B.truth->note() : std::string("not prepared"));
       if (ok) characters += uint32_t(B.planned->characters.size());
     }

@@ -45,7 +45,8 @@ struct ReplayOptions {
   bool pushOut = false;             // the run time's push-out of the body proxy (models that have one; --push-out)
   // Penetration of the garment into the body it was baked on (the CPU reference's positions, with and
   // without the push-out) on every Nth frame; 0: not measured.
-  uint32_t penetrationEvery = 30;  // the CPU measure poses a body collider per character: every frame would dwarf the replay
+  uint32_t penetrationEvery =
+      30;  // the CPU measure poses a body collider per character: every frame would dwarf the replay
   std::function<void(uint32_t framesDone, uint32_t framesTotal)> progress;
   // Truth simulations done of those planned (called from worker threads, one call at a time).
   std::function<void(uint32_t posesDone, uint32_t posesTotal)> truthProgress;
@@ -59,7 +60,7 @@ struct ReplayOptions {
 // Milliseconds; NaN where a stage did not run.
 struct FrameTimes {
   double pose = 0, theta = 0, mlp = 0, lookup = 0, record = 0;  // CPU stages (record: inputs + commands)
-  double gpuWait = 0;                                            // submit -> fence, wall clock
+  double gpuWait = 0;                                           // submit -> fence, wall clock
   double gpuDeform = 0, gpuTangents = 0, gpuDecode = 0, gpuBlend = 0, gpuTotal = 0;  // GPU timestamps
   double cpuTotal() const { return pose + theta + mlp + lookup + record; }
 };
@@ -93,8 +94,8 @@ struct FrameRecord {
   bool checked = false;
   std::vector<CharacterCheck> checks;  // when checked
   uint32_t poseIssues = 0;
-  bool truthFrame = false;             // on the --truth-every grid, with a model that has truth
-  std::vector<CharacterTruth> truth;   // when truthFrame: per on-screen character with truth, plan order
+  bool truthFrame = false;                        // on the --truth-every grid, with a model that has truth
+  std::vector<CharacterTruth> truth;              // when truthFrame: per on-screen character with truth, plan order
   std::vector<CharacterPenetration> penetration;  // per on-screen character with a body, plan order (measured frames)
   double maxPositionErrorMm() const;
   double maxNormalErrorDeg() const;
@@ -125,11 +126,11 @@ struct ReplayResult {
   TruthSummary truthOverall;
   // Penetration (ReplayOptions::penetrationEvery).
   uint32_t penetrationEvery = 0;
-  std::string penetrationNote;                      // which body, or why none
-  bool pushOut = false;                             // the push-out ran (some model has a proxy and it was on)
+  std::string penetrationNote;                              // which body, or why none
+  bool pushOut = false;                                     // the push-out ran (some model has a proxy and it was on)
   std::vector<PenetrationSummary> penetrationPerCharacter;  // per scene character (empty when none measured)
   PenetrationSummary penetrationOverall;
-  double penetrationSeconds = 0;                    // wall time of the measurements
+  double penetrationSeconds = 0;  // wall time of the measurements
   bool failed() const { return !failures.empty() || issueCount > 0; }
 };
 

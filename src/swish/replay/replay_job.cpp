@@ -69,8 +69,8 @@ ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions
   if (out.meshes) fs::create_directories(staging.path / "meshes");
   if (out.normalMaps) fs::create_directories(staging.path / "normal_maps");
   if (out.normalMaps || out.meshes) {
-    eo.onCharacterOutput = [&, user = options.engine.onCharacterOutput](uint32_t frame, uint32_t c,
-                                                                        const runtime::ReferenceFrameOutputs& o, uint32_t i) {
+    eo.onCharacterOutput = [&, user = options.engine.onCharacterOutput](
+                               uint32_t frame, uint32_t c, const runtime::ReferenceFrameOutputs& o, uint32_t i) {
       if (out.meshes) {
         if (frame != pendingFrame) flushMeshes();
         pendingFrame = frame;

@@ -116,9 +116,8 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   if (truth) {
     // The truth simulations (a couple of seconds each) in parallel; the figures in frame order.
     std::vector<TruthMeasurement> measured(heatJobs.size());
-    tbb::parallel_for(size_t(0), heatJobs.size(), [&](size_t k) {
-      measured[k] = truth->measure(heatJobs[k].pose, heatJobs[k].model, nullptr);
-    });
+    tbb::parallel_for(size_t(0), heatJobs.size(),
+                      [&](size_t k) { measured[k] = truth->measure(heatJobs[k].pose, heatJobs[k].model, nullptr); });
     std::vector<render::PreviewImage> figures;
     for (size_t k = 0; k < heatJobs.size(); ++k) {
       if (!measured[k].summary.ok) {
@@ -128,8 +127,8 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
       }
       io::HeatMapFigure fig;
       char title[96];
-      std::snprintf(title, sizeof title, "frame %u  mean %.1f mm  max %.1f mm", heatJobs[k].frame, measured[k].summary.meanMm,
-                    measured[k].summary.maxMm);
+      std::snprintf(title, sizeof title, "frame %u  mean %.1f mm  max %.1f mm", heatJobs[k].frame,
+                    measured[k].summary.meanMm, measured[k].summary.maxMm);
       fig.title = title;
       fig.model = &heatJobs[k].model;
       fig.truth = &measured[k].truthPositions;

@@ -19,13 +19,13 @@ struct ReplayRenderOptions {
   uint32_t character = 0;   // scene character index
   uint32_t maxFrames = 16;  // frames are spread evenly over the scene when it has more
   uint32_t width = 320, height = 426;
-  std::string device;       // as --device
+  std::string device;  // as --device
   bool validation = false;
   // With truth.every > 0 (`--truth-every N`): the drawn frames are taken on the truth grid, and each also
   // gets an error figure heat_NNNN.png (model, truth, per-vertex error heat map with its mm legend;
   // io/error_heat_map.hpp) and heat_sheet.png; the truth is simulated again here (as the replay's).
   TruthOptions truth;
-  bool pushOut = false;     // as the replay's --push-out
+  bool pushOut = false;  // as the replay's --push-out
 };
 
 struct ReplayRenderResult {
@@ -33,7 +33,7 @@ struct ReplayRenderResult {
   std::filesystem::path contactSheet;
   std::vector<std::filesystem::path> heatMaps;  // per frame with truth
   std::filesystem::path heatSheet;              // empty without truth
-  std::string note;  // e.g. why no body was drawn, or why there are no heat maps
+  std::string note;                             // e.g. why no body was drawn, or why there are no heat maps
 };
 
 // Writes `directory`/frame_NNNN.png and `directory`/contact_sheet.png. Throws Error naming the scene

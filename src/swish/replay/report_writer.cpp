@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "swish/io/svg_plot.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/io/svg_plot.hpp"
 #include "swish/runtime/scene_file.hpp"
 
 namespace swish::replay {
@@ -60,7 +60,8 @@ json truthJson(const TruthSummary& t) {
   json j{{"samples", t.samples}, {"failed", t.failed}, {"seconds", t.seconds}, {"cpuSeconds", t.cpuSeconds}};
   if (t.samples > 0) {
     j["meanMm"] = t.meanMm, j["p95Mm"] = t.p95Mm, j["maxMm"] = t.maxMm;
-    if (t.comparedWithout) j["withoutPushOut"] = {{"meanMm", t.meanMmWithout}, {"p95Mm", t.p95MmWithout}, {"maxMm", t.maxMmWithout}};
+    if (t.comparedWithout)
+      j["withoutPushOut"] = {{"meanMm", t.meanMmWithout}, {"p95Mm", t.p95MmWithout}, {"maxMm", t.maxMmWithout}};
     if (t.normalMaps) j["normalMeanDeg"] = t.meanDeg, j["normalP95Deg"] = t.p95Deg, j["normalMaxDeg"] = t.maxDeg;
   }
   return j;
@@ -107,10 +108,15 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
   j["models"] = json::array();
   for (const auto& e : models.entries()) {
     const Model& m = e->model;
-    j["models"].push_back({{"key", e->key}, {"label", e->label}, {"procedural", e->procedural},
-                           {"vertices", m.gameMesh.vertexCount()}, {"triangles", m.gameMesh.triangleCount()},
-                           {"joints", m.skeleton.size()}, {"inputJoints", m.inputJoints.size()},
-                           {"meshComponents", m.meshComponents()}, {"normalMaps", m.normalMaps.mapCount()},
+    j["models"].push_back({{"key", e->key},
+                           {"label", e->label},
+                           {"procedural", e->procedural},
+                           {"vertices", m.gameMesh.vertexCount()},
+                           {"triangles", m.gameMesh.triangleCount()},
+                           {"joints", m.skeleton.size()},
+                           {"inputJoints", m.inputJoints.size()},
+                           {"meshComponents", m.meshComponents()},
+                           {"normalMaps", m.normalMaps.mapCount()},
                            {"mapSize", m.normalMaps.width}});
     // The bake measures the model on its held-out poses through the runtime path (metadata "errors",
     // see part2_training.cpp): the ground-truth error of this model, quoted beside the run times.
@@ -125,24 +131,40 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
     j["truth"]["wallSeconds"] = r.truthWallSeconds;
     j["truth"]["overall"] = truthJson(r.truthOverall);
   }
-  j["penetration"] = {{"every", r.penetrationEvery}, {"note", r.penetrationNote}, {"pushOut", r.pushOut},
-                      {"visibleDepthMm", bake::kVisiblePenetrationMm}, {"seconds", r.penetrationSeconds}};
+  j["penetration"] = {{"every", r.penetrationEvery},
+                      {"note", r.penetrationNote},
+                      {"pushOut", r.pushOut},
+                      {"visibleDepthMm", bake::kVisiblePenetrationMm},
+                      {"seconds", r.penetrationSeconds}};
   if (!r.penetrationPerCharacter.empty()) j["penetration"]["overall"] = penetrationJson(r.penetrationOverall);
   j["frames"] = json::array();
   std::vector<json> perChar(scene.characters.size());
   for (size_t c = 0; c < scene.characters.size(); ++c)
-    perChar[c] = {{"name", scene.characters[c].name}, {"model", scene.characters[c].model}, {"onScreen", scene.onScreen(c)},
-                  {"checks", 0}, {"maxPositionErrorMm", 0.0}, {"maxNormalErrorDeg", 0.0}, {"maxMapErrorSteps", 0}, {"poseIssues", 0}};
+    perChar[c] = {{"name", scene.characters[c].name},
+                  {"model", scene.characters[c].model},
+                  {"onScreen", scene.onScreen(c)},
+                  {"checks", 0},
+                  {"maxPositionErrorMm", 0.0},
+                  {"maxNormalErrorDeg", 0.0},
+                  {"maxMapErrorSteps", 0},
+                  {"poseIssues", 0}};
   for (const auto& f : r.frames) {
     json t;
     for (const auto& s : stageColumns()) t[s.key] = f.times.*s.field;
     t["cpuTotal"] = f.times.cpuTotal();
-    json fj{{"frame", f.frame}, {"times", t}, {"gpuDispatches", f.gpuDispatches}, {"checked", f.checked}, {"poseIssues", f.poseIssues}};
+    json fj{{"frame", f.frame},
+            {"times", t},
+            {"gpuDispatches", f.gpuDispatches},
+            {"checked", f.checked},
+            {"poseIssues", f.poseIssues}};
     if (f.truthFrame) {
       fj["truth"] = json::array();
       for (const auto& c : f.truth) {
-        json t{{"character", scene.characters[c.character].name}, {"ok", c.ok}, {"seconds", c.seconds},
-               {"cpuSeconds", c.cpuSeconds}, {"limbCorrections", c.limbCorrections}};
+        json t{{"character", scene.characters[c.character].name},
+               {"ok", c.ok},
+               {"seconds", c.seconds},
+               {"cpuSeconds", c.cpuSeconds},
+               {"limbCorrections", c.limbCorrections}};
         if (c.ok) {
           t["meanMm"] = c.meanMm, t["p95Mm"] = c.p95Mm, t["maxMm"] = c.maxMm;
           if (c.comparedWithout)
@@ -163,13 +185,15 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
       }
     }
     if (f.checked)
-      fj["gpuVsCpu"] = {{"maxPositionErrorMm", f.maxPositionErrorMm()}, {"maxNormalErrorDeg", f.maxNormalErrorDeg()},
+      fj["gpuVsCpu"] = {{"maxPositionErrorMm", f.maxPositionErrorMm()},
+                        {"maxNormalErrorDeg", f.maxNormalErrorDeg()},
                         {"maxMapErrorSteps", f.maxMapErrorSteps()}};
     for (const auto& c : f.checks) {
       json& pc = perChar[c.character];
       pc["checks"] = pc["checks"].get<int>() + 1;
       pc["maxPositionErrorMm"] = std::max(pc["maxPositionErrorMm"].get<double>(), c.maxPositionErrorMm);
-      pc["maxNormalErrorDeg"] = std::max({pc["maxNormalErrorDeg"].get<double>(), c.maxNormalErrorDeg, c.maxTangentErrorDeg});
+      pc["maxNormalErrorDeg"] =
+          std::max({pc["maxNormalErrorDeg"].get<double>(), c.maxNormalErrorDeg, c.maxTangentErrorDeg});
       pc["maxMapErrorSteps"] = std::max(pc["maxMapErrorSteps"].get<int>(), c.maxMapErrorSteps);
     }
     j["frames"].push_back(fj);
@@ -180,7 +204,8 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
   for (size_t c = 0; c < r.truthPerCharacter.size() && c < perChar.size(); ++c)
     perChar[c]["truth"] = truthJson(r.truthPerCharacter[c]);
   for (size_t c = 0; c < r.penetrationPerCharacter.size() && c < perChar.size(); ++c)
-    if (r.penetrationPerCharacter[c].model.frames > 0) perChar[c]["penetration"] = penetrationJson(r.penetrationPerCharacter[c]);
+    if (r.penetrationPerCharacter[c].model.frames > 0)
+      perChar[c]["penetration"] = penetrationJson(r.penetrationPerCharacter[c]);
   j["characters"] = perChar;
   json summary;
   for (const auto& s : stageColumns()) {
@@ -211,7 +236,11 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
   j["failures"] = r.failures;
   j["issues"] = json::array();
   for (const auto& i : r.issues)
-    j["issues"].push_back({{"frame", i.frame}, {"character", i.character}, {"joint", i.joint}, {"problem", i.problem}, {"action", i.action}});
+    j["issues"].push_back({{"frame", i.frame},
+                           {"character", i.character},
+                           {"joint", i.joint},
+                           {"problem", i.problem},
+                           {"action", i.action}});
   return j;
 }
 
@@ -224,12 +253,13 @@ std::string reportMarkdown(const json& j) {
   s << "## Models\n\n";
   for (const auto& m : j["models"])
     s << "- `" << m["key"].get<std::string>() << "`: " << m["label"].get<std::string>() << " -- " << m["vertices"]
-      << " vertices, " << m["joints"] << " joints (" << m["inputJoints"] << " in Theta), K = " << m["meshComponents"] << ", "
-      << m["normalMaps"] << " normal maps of " << m["mapSize"] << " px\n";
+      << " vertices, " << m["joints"] << " joints (" << m["inputJoints"] << " in Theta), K = " << m["meshComponents"]
+      << ", " << m["normalMaps"] << " normal maps of " << m["mapSize"] << " px\n";
   for (const auto& m : j["models"]) {
     if (!m.contains("heldOutErrors")) continue;
     const json& e = m["heldOutErrors"];
-    s << "  - ground truth from the bake (" << e.value("held_out_poses", 0) << " held-out poses, simulated): vertex error";
+    s << "  - ground truth from the bake (" << e.value("held_out_poses", 0)
+      << " held-out poses, simulated): vertex error";
     if (e.contains("vertex_total"))
       s << " mean " << fmt(num(e["vertex_total"]["mean_mm"])) << " mm, p95 " << fmt(num(e["vertex_total"]["p95_mm"]))
         << " mm, max " << fmt(num(e["vertex_total"]["max_mm"])) << " mm";
@@ -239,12 +269,14 @@ std::string reportMarkdown(const json& j) {
     s << "\n";
   }
   int fewest = INT_MAX, most = 0;  // dispatches recorded per frame (the VQ decode only for new maps)
-  for (const auto& f : j["frames"]) fewest = std::min(fewest, f["gpuDispatches"].get<int>()), most = std::max(most, f["gpuDispatches"].get<int>());
+  for (const auto& f : j["frames"])
+    fewest = std::min(fewest, f["gpuDispatches"].get<int>()), most = std::max(most, f["gpuDispatches"].get<int>());
   s << "\n## Plan\n\nAt most " << j["plan"]["gpuDispatchesPerFrame"] << " GPU dispatches per frame (recorded: "
-    << (j["frames"].empty() ? std::string("no frames") : std::to_string(fewest) + " to " + std::to_string(most)) << "), "
-    << fmt(num(j["plan"]["gpuBytes"]) / 1048576.0, "%.2f") << " MiB of GPU memory, " << j["plan"]["rot6JointsPerFrame"]
-    << " joints converted to 6D per frame.\n\nLeft out:\n\n";
-  for (const auto& l : j["plan"]["leftOut"]) s << "- " << l["what"].get<std::string>() << " -- because " << l["why"].get<std::string>() << "\n";
+    << (j["frames"].empty() ? std::string("no frames") : std::to_string(fewest) + " to " + std::to_string(most))
+    << "), " << fmt(num(j["plan"]["gpuBytes"]) / 1048576.0, "%.2f") << " MiB of GPU memory, "
+    << j["plan"]["rot6JointsPerFrame"] << " joints converted to 6D per frame.\n\nLeft out:\n\n";
+  for (const auto& l : j["plan"]["leftOut"])
+    s << "- " << l["what"].get<std::string>() << " -- because " << l["why"].get<std::string>() << "\n";
   if (j["plan"]["leftOut"].empty()) s << "- nothing\n";
   s << "\n## Error against run time\n\n";
   s << "Ground truth: " << (j["truth"]["available"].get<bool>() ? "available" : "not available") << " -- "
@@ -253,26 +285,27 @@ std::string reportMarkdown(const json& j) {
     const json& t = j["truth"]["overall"];
     const double poses = num(t["samples"]) + num(t["failed"]);
     const double frames = num(j["truth"]["frames"]);
-    s << "Ground truth every " << j["truth"]["every"] << " frames: " << t["samples"] << " character poses simulated and measured on "
-      << j["truth"]["frames"] << " frames, " << t["failed"] << " more whose simulation failed (the bake leaves such poses out too); "
+    s << "Ground truth every " << j["truth"]["every"] << " frames: " << t["samples"]
+      << " character poses simulated and measured on " << j["truth"]["frames"] << " frames, " << t["failed"]
+      << " more whose simulation failed (the bake leaves such poses out too); "
       << fmt(poses > 0 ? num(t["cpuSeconds"]) / poses : NAN, "%.2f") << " s CPU per pose ("
       << fmt(poses > 0 ? num(t["seconds"]) / poses : NAN, "%.2f") << " s wall on its thread), "
       << fmt(num(j["truth"]["wallSeconds"]), "%.1f") << " s wall in all ("
       << fmt(frames > 0 ? num(j["truth"]["wallSeconds"]) / frames : NAN, "%.1f")
       << " s per truth frame), outside the timed stages below.\n\n";
     if (t.contains("meanMm")) {
-      s << "Run time against ground truth, character space (placement excluded): vertex error mean " << fmt(num(t["meanMm"]))
-        << " mm, p95 " << fmt(num(t["p95Mm"])) << " mm, max " << fmt(num(t["maxMm"])) << " mm";
+      s << "Run time against ground truth, character space (placement excluded): vertex error mean "
+        << fmt(num(t["meanMm"])) << " mm, p95 " << fmt(num(t["p95Mm"])) << " mm, max " << fmt(num(t["maxMm"])) << " mm";
       if (t.contains("normalMeanDeg"))
-        s << "; normal-map angular error mean " << fmt(num(t["normalMeanDeg"])) << " deg, p95 " << fmt(num(t["normalP95Deg"]))
-          << " deg, max " << fmt(num(t["normalMaxDeg"])) << " deg";
+        s << "; normal-map angular error mean " << fmt(num(t["normalMeanDeg"])) << " deg, p95 "
+          << fmt(num(t["normalP95Deg"])) << " deg, max " << fmt(num(t["normalMaxDeg"])) << " deg";
       s << ".\n\n";
       if (t.contains("withoutPushOut")) {
         const json& w = t["withoutPushOut"];
         s << "The same truth frames without the push-out (the CPU reference's positions): vertex error mean "
           << fmt(num(w["meanMm"])) << " mm, p95 " << fmt(num(w["p95Mm"])) << " mm, max " << fmt(num(w["maxMm"]))
-          << " mm: the push-out changes the mean by " << fmt(num(t["meanMm"]) - num(w["meanMm"]), "%+.3f") << " mm and the p95 by "
-          << fmt(num(t["p95Mm"]) - num(w["p95Mm"]), "%+.3f") << " mm.\n\n";
+          << " mm: the push-out changes the mean by " << fmt(num(t["meanMm"]) - num(w["meanMm"]), "%+.3f")
+          << " mm and the p95 by " << fmt(num(t["p95Mm"]) - num(w["p95Mm"]), "%+.3f") << " mm.\n\n";
       }
       s << "![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
     }
@@ -281,23 +314,27 @@ std::string reportMarkdown(const json& j) {
     const json& p = j["penetration"];
     s << "## Garment inside the body\n\nPenetration of the garment into the body it was baked on: "
       << p["note"].get<std::string>() << ". Measured on the CPU reference's positions"
-      << (num(p["every"]) > 1 ? " every " + std::to_string(p["every"].get<int>()) + " frames" : std::string(" every frame"))
+      << (num(p["every"]) > 1 ? " every " + std::to_string(p["every"].get<int>()) + " frames"
+                              : std::string(" every frame"))
       << ", per character: vertices inside the body (signed distance < 0), those deeper than "
-      << fmt(num(p["visibleDepthMm"]), "%g") << " mm (visible), the deepest. The run time's push-out of the body proxy was "
+      << fmt(num(p["visibleDepthMm"]), "%g")
+      << " mm (visible), the deepest. The run time's push-out of the body proxy was "
       << (p["pushOut"].get<bool>() ? "ON (what the GPU drew and the truth measured)" : "OFF") << ".\n\n";
     if (p.contains("overall")) {
-      s << "| positions | frames x characters | with any inside | with visible (> " << fmt(num(p["visibleDepthMm"]), "%g")
+      s << "| positions | frames x characters | with any inside | with visible (> "
+        << fmt(num(p["visibleDepthMm"]), "%g")
         << " mm) | vertices inside | share | visible vertices | deepest mm | p95 of per-frame deepest mm |\n"
         << "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
       auto row = [&](const char* label, const json& q) {
-        s << "| " << label << " | " << q["frames"] << " | " << q["framesWithInside"] << " | " << q["framesVisible"] << " | "
-          << q["inside"] << " | " << fmt(100.0 * num(q["share"]), "%.3f") << " % | " << q["visible"] << " | "
+        s << "| " << label << " | " << q["frames"] << " | " << q["framesWithInside"] << " | " << q["framesVisible"]
+          << " | " << q["inside"] << " | " << fmt(100.0 * num(q["share"]), "%.3f") << " % | " << q["visible"] << " | "
           << fmt(num(q["deepestMm"]), "%.2f") << " | " << fmt(num(q["deepestP95Mm"]), "%.2f") << " |\n";
       };
       row("model (no push-out)", p["overall"]["model"]);
       if (p["overall"].contains("pushed")) row("after the push-out", p["overall"]["pushed"]);
       s << "\n![garment inside the body per frame](plots/penetration_per_frame.svg)\n\n";
-      s << "Per character (deepest mm, frames with visible penetration):\n\n| character | model deepest | model frames visible | "
+      s << "Per character (deepest mm, frames with visible penetration):\n\n| character | model deepest | model frames "
+           "visible | "
            "pushed deepest | pushed frames visible |\n|---|---:|---:|---:|---:|\n";
       for (const auto& c : j["characters"]) {
         if (!c.contains("penetration")) continue;
@@ -316,50 +353,59 @@ std::string reportMarkdown(const json& j) {
     << " snorm16 steps.\n\n";
   s << "| stage | median ms / frame | p95 ms / frame |\n|---|---:|---:|\n";
   for (const auto& st : stageColumns())
-    s << "| " << st.label << " | " << fmt(num(sum["medianMs"][st.key])) << " | " << fmt(num(sum["p95Ms"][st.key])) << " |\n";
+    s << "| " << st.label << " | " << fmt(num(sum["medianMs"][st.key])) << " | " << fmt(num(sum["p95Ms"][st.key]))
+      << " |\n";
   s << "| CPU total | " << fmt(num(sum["medianMs"]["cpuTotal"])) << " | |\n\n";
   s << "![time per frame](plots/time_per_frame.svg)\n\n![time per stage](plots/time_per_stage.svg)\n\n"
     << "![GPU vs CPU error per frame](plots/error_per_frame.svg)\n\n![error against time](plots/error_vs_time.svg)\n\n";
-  s << "## Characters\n\n| character | model | on screen | checks | max position error mm | max normal error deg | max map error | pose issues |\n"
+  s << "## Characters\n\n| character | model | on screen | checks | max position error mm | max normal error deg | max "
+       "map error | pose issues |\n"
     << "|---|---|---|---:|---:|---:|---:|---:|\n";
   for (const auto& c : j["characters"])
-    s << "| " << c["name"].get<std::string>() << " | " << c["model"].get<std::string>() << " | " << (c["onScreen"].get<bool>() ? "yes" : "no")
-      << " | " << c["checks"] << " | " << fmt(num(c["maxPositionErrorMm"])) << " | " << fmt(num(c["maxNormalErrorDeg"])) << " | "
+    s << "| " << c["name"].get<std::string>() << " | " << c["model"].get<std::string>() << " | "
+      << (c["onScreen"].get<bool>() ? "yes" : "no") << " | " << c["checks"] << " | "
+      << fmt(num(c["maxPositionErrorMm"])) << " | " << fmt(num(c["maxNormalErrorDeg"])) << " | "
       << c["maxMapErrorSteps"] << " | " << c["poseIssues"] << " |\n";
   if (j["truth"].contains("overall")) {
-    s << "\n### Ground truth per character\n\n| character | measured | failed | mean mm | p95 mm | max mm | map mean deg | map p95 deg |\n"
+    s << "\n### Ground truth per character\n\n| character | measured | failed | mean mm | p95 mm | max mm | map mean "
+         "deg | map p95 deg |\n"
       << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const auto& c : j["characters"]) {
       if (!c.contains("truth")) continue;
       const json& t = c["truth"];
       if (num(t["samples"]) + num(t["failed"]) == 0) continue;
       auto cell = [&](const char* k) { return t.contains(k) ? fmt(num(t[k])) : std::string("-"); };
-      s << "| " << c["name"].get<std::string>() << " | " << t["samples"] << " | " << t["failed"] << " | " << cell("meanMm") << " | "
-        << cell("p95Mm") << " | " << cell("maxMm") << " | " << cell("normalMeanDeg") << " | " << cell("normalP95Deg") << " |\n";
+      s << "| " << c["name"].get<std::string>() << " | " << t["samples"] << " | " << t["failed"] << " | "
+        << cell("meanMm") << " | " << cell("p95Mm") << " | " << cell("maxMm") << " | " << cell("normalMeanDeg") << " | "
+        << cell("normalP95Deg") << " |\n";
     }
     size_t failures = 0;
     for (const auto& f : j["frames"])
       for (const auto& t : f.value("truth", json::array()))
         if (!t["ok"].get<bool>() && ++failures <= 50)
-          s << (failures == 1 ? "\nTruth simulations that failed (no truth for that frame and character):\n\n" : "") << "- frame "
-            << f["frame"] << ", " << t["character"].get<std::string>() << ": " << t.value("failure", std::string()) << "\n";
+          s << (failures == 1 ? "\nTruth simulations that failed (no truth for that frame and character):\n\n" : "")
+            << "- frame " << f["frame"] << ", " << t["character"].get<std::string>() << ": "
+            << t.value("failure", std::string()) << "\n";
     if (failures > 50) s << "- ... (" << failures << " in all; every one in report.json)\n";
   }
-  s << "\n## Bad poses and failures\n\n" << sum["poseIssues"] << " pose issues, " << sum["failures"] << " check failures.\n\n";
+  s << "\n## Bad poses and failures\n\n"
+    << sum["poseIssues"] << " pose issues, " << sum["failures"] << " check failures.\n\n";
   size_t shown = 0;
   for (const auto& i : j["issues"]) {
     if (++shown > 50) {
       s << "- ... (all in report.json)\n";
       break;
     }
-    s << "- frame " << i["frame"] << ", " << i["character"].get<std::string>() << (i["joint"].get<std::string>().empty() ? "" : ", joint " + i["joint"].get<std::string>())
-      << ": " << i["problem"].get<std::string>() << " -> " << i["action"].get<std::string>() << "\n";
+    s << "- frame " << i["frame"] << ", " << i["character"].get<std::string>()
+      << (i["joint"].get<std::string>().empty() ? "" : ", joint " + i["joint"].get<std::string>()) << ": "
+      << i["problem"].get<std::string>() << " -> " << i["action"].get<std::string>() << "\n";
   }
   for (const auto& f : j["failures"]) s << "- " << f.get<std::string>() << "\n";
   return s.str();
 }
 
-void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, const ModelLibrary& models, const ReplayResult& r) {
+void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, const ModelLibrary& models,
+                 const ReplayResult& r) {
   const json j = reportJson(scene, models, r);
   std::filesystem::create_directories(dir / "plots");
   using io::PlotSeries;
@@ -408,10 +454,11 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
                       plot("GPU vs CPU reference, worst character", "scene frame", "error", {pos, deg}));
   std::vector<PlotSeries> vsTimeSeries{vsTime};
   if (!truthVsTime.x.empty()) vsTimeSeries.push_back(truthVsTime);
-  writeTextFileAtomic(dir / "plots/error_vs_time.svg",
-                      plot(truthVsTime.x.empty() ? "Error against run time (checked frames)"
-                                                 : "Error against run time (checked frames: GPU vs CPU; truth frames: vs ground truth)",
-                           "CPU + GPU ms per frame", "position error (mm)", vsTimeSeries));
+  writeTextFileAtomic(
+      dir / "plots/error_vs_time.svg",
+      plot(truthVsTime.x.empty() ? "Error against run time (checked frames)"
+                                 : "Error against run time (checked frames: GPU vs CPU; truth frames: vs ground truth)",
+           "CPU + GPU ms per frame", "position error (mm)", vsTimeSeries));
   if (!truthMean.x.empty()) {
     std::vector<PlotSeries> ts{truthMean, truthMax};
     if (!truthDeg.x.empty()) ts.push_back(truthDeg);
@@ -433,12 +480,15 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
       }
       deepModel.x.push_back(f.frame), deepModel.y.push_back(dm);
       visModel.x.push_back(f.frame), visModel.y.push_back(vm / 10.0);
-      if (pushed) deepPushed.x.push_back(f.frame), deepPushed.y.push_back(dp), visPushed.x.push_back(f.frame), visPushed.y.push_back(vp / 10.0);
+      if (pushed)
+        deepPushed.x.push_back(f.frame), deepPushed.y.push_back(dp), visPushed.x.push_back(f.frame),
+            visPushed.y.push_back(vp / 10.0);
     }
     std::vector<PlotSeries> ps{deepModel, visModel};
     if (!deepPushed.x.empty()) ps.push_back(deepPushed), ps.push_back(visPushed);
-    writeTextFileAtomic(dir / "plots/penetration_per_frame.svg",
-                        plot("Garment inside the body, worst character per frame", "scene frame", "mm; vertices / 10", ps));
+    writeTextFileAtomic(
+        dir / "plots/penetration_per_frame.svg",
+        plot("Garment inside the body, worst character per frame", "scene frame", "mm; vertices / 10", ps));
   }
   io::SvgBarChart stages;
   stages.title = "Median time per stage", stages.unit = "ms";

@@ -10,8 +10,8 @@
 
 #include "swish/bake/pipeline/bake_config.hpp"
 #include "swish/bake/pipeline/baked_character.hpp"
-#include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
+#include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 
@@ -39,7 +39,8 @@ std::string fmtNum(const char* f, double v) {
 
 template <class A, class B>
 bool near(const A& a, const B& b) {
-  return a.rows() == b.rows() && a.cols() == b.cols() && (a.size() == 0 || (a - b).cwiseAbs().maxCoeff() <= kSameTolerance);
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         (a.size() == 0 || (a - b).cwiseAbs().maxCoeff() <= kSameTolerance);
 }
 
 }  // namespace
@@ -52,17 +53,20 @@ std::string characterDifference(const Model& model, const Character& ch) {
   for (size_t j = 0; j < a.size(); ++j) {
     const Joint& x = a.joints[j];
     const Joint& y = b.joints[j];
-    if (x.name != y.name || x.parent != y.parent) return "joint " + std::to_string(j) + " is '" + y.name + "', the model's '" + x.name + "'";
-    const bool sameRotation = (x.rest.rotation.coeffs() - y.rest.rotation.coeffs()).cwiseAbs().maxCoeff() <= kSameTolerance ||
-                              (x.rest.rotation.coeffs() + y.rest.rotation.coeffs()).cwiseAbs().maxCoeff() <= kSameTolerance;
+    if (x.name != y.name || x.parent != y.parent)
+      return "joint " + std::to_string(j) + " is '" + y.name + "', the model's '" + x.name + "'";
+    const bool sameRotation =
+        (x.rest.rotation.coeffs() - y.rest.rotation.coeffs()).cwiseAbs().maxCoeff() <= kSameTolerance ||
+        (x.rest.rotation.coeffs() + y.rest.rotation.coeffs()).cwiseAbs().maxCoeff() <= kSameTolerance;
     if (!near(x.rest.translation, y.rest.translation) || !sameRotation)
       return "joint '" + x.name + "' has another rest transform";
   }
   const Mesh& m = model.gameMesh;
   const Mesh& g = ch.garment;
   if (m.vertexCount() != g.vertexCount() || m.triangleCount() != g.triangleCount())
-    return "the game mesh has " + std::to_string(g.vertexCount()) + " vertices and " + std::to_string(g.triangleCount()) +
-           " triangles, the model's " + std::to_string(m.vertexCount()) + " and " + std::to_string(m.triangleCount());
+    return "the game mesh has " + std::to_string(g.vertexCount()) + " vertices and " +
+           std::to_string(g.triangleCount()) + " triangles, the model's " + std::to_string(m.vertexCount()) + " and " +
+           std::to_string(m.triangleCount());
   if (m.triangles != g.triangles) return "the game mesh's triangles differ";
   if (!near(m.positions, g.positions)) return "the game mesh's rest positions differ";
   if (!near(m.uvs, g.uvs)) return "the game mesh's UVs differ";
@@ -91,8 +95,9 @@ std::unique_ptr<Character> rebuildBakeCharacter(const ModelEntry& entry, std::st
   }
   bake::BakedCharacter baked = bake::findBakedCharacter(entry.model.metadata, entry.file);
   if (baked.kind == bake::BakedCharacter::Kind::Unknown) {
-    note = "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character and "
-           "cloth settings of its source simulation are unknown";
+    note =
+        "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character and "
+        "cloth settings of its source simulation are unknown";
     return nullptr;
   }
   if (!baked.problem.empty()) {
@@ -163,17 +168,17 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
   if (normalMaps_ && (ps.transfer.normalMap.width != entry.model.normalMaps.width ||
                       ps.transfer.normalMap.height != entry.model.normalMaps.height)) {
     normalMaps_ = false;
-    mapNote = "; normal maps not measured: the bake's are " + std::to_string(ps.transfer.normalMap.width) + " px, the model's " +
-              std::to_string(entry.model.normalMaps.width);
+    mapNote = "; normal maps not measured: the bake's are " + std::to_string(ps.transfer.normalMap.width) +
+              " px, the model's " + std::to_string(entry.model.normalMaps.width);
   }
   const bake::ClothSimSettings& cs = ps.simulation;
-  note_ = "the bake's source simulation of character '" + character_->name + "' (" + how + "): " +
-          std::to_string(simulator_->solver().mesh().vertexCount()) + " simulation vertices, preset '" + cs.material.name +
-          "', " + std::to_string(cs.substeps) + " substeps x " + std::to_string(cs.iterations) + " iterations at " +
-          fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) + " s transition + " +
-          fmtNum("%g", cs.settleSeconds) + " s settle, limb clearance " + fmtNum("%g", 1000.0 * ps.limbClearance.clearance) +
-          " mm, smoothing " + std::to_string(ps.transfer.smoothing.iterations) + " x " +
-          fmtNum("%g", ps.transfer.smoothing.strength) +
+  note_ = "the bake's source simulation of character '" + character_->name + "' (" + how +
+          "): " + std::to_string(simulator_->solver().mesh().vertexCount()) + " simulation vertices, preset '" +
+          cs.material.name + "', " + std::to_string(cs.substeps) + " substeps x " + std::to_string(cs.iterations) +
+          " iterations at " + fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) +
+          " s transition + " + fmtNum("%g", cs.settleSeconds) + " s settle, limb clearance " +
+          fmtNum("%g", 1000.0 * ps.limbClearance.clearance) + " mm, smoothing " +
+          std::to_string(ps.transfer.smoothing.iterations) + " x " + fmtNum("%g", ps.transfer.smoothing.strength) +
           (overridden.empty() ? std::string() : "; overridden for this run (not the bake's):" + overridden) + mapNote;
 }
 
@@ -193,7 +198,8 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
                         std::to_string(shape.gameMeshPreSkin.rows());
   } else {
     // Skinned as the run time skins the prediction: the model's skeleton and weights, the whole pose.
-    const Points3f truth = skinPositions(shape.gameMeshPreSkin, model_->gameMesh.skin, model_->skeleton.skinningMatrices(pose));
+    const Points3f truth =
+        skinPositions(shape.gameMeshPreSkin, model_->gameMesh.skin, model_->skeleton.skinningMatrices(pose));
     auto distances = [&](const Points3f& p) {
       std::vector<double> mm(size_t(truth.rows()));
       for (Eigen::Index v = 0; v < truth.rows(); ++v) {
@@ -213,7 +219,8 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
       m.summary.comparedWithout = true;
       m.summary.meanMmWithout = w.mean, m.summary.p95MmWithout = w.p95, m.summary.maxMmWithout = w.max;
     }
-    if (normalMaps_ && normalMap && normalMap->width == shape.normalMap.width && normalMap->height == shape.normalMap.height) {
+    if (normalMaps_ && normalMap && normalMap->width == shape.normalMap.width &&
+        normalMap->height == shape.normalMap.height) {
       const bake::NormalMapImage shown{normalMap->width, normalMap->height, runtime::xyAsFloat(*normalMap)};
       m.angles = std::make_unique<bake::AngularErrorAccumulator>();
       m.angles->addMaps(shape.normalMap, shown);

@@ -39,18 +39,18 @@ struct TruthOptions {
 
 // One character on one truth frame.
 struct CharacterTruth {
-  uint32_t character = 0;   // scene character index
-  bool ok = false;          // a truth shape was simulated and measured
-  std::string failure;      // why not (the simulation failed: the bake leaves such poses out too)
-  double meanMm = 0, p95Mm = 0, maxMm = 0;                   // per-vertex distance to the truth
+  uint32_t character = 0;                   // scene character index
+  bool ok = false;                          // a truth shape was simulated and measured
+  std::string failure;                      // why not (the simulation failed: the bake leaves such poses out too)
+  double meanMm = 0, p95Mm = 0, maxMm = 0;  // per-vertex distance to the truth
   // The same for the positions without the push-out (the CPU reference), when it ran.
   bool comparedWithout = false;
   double meanMmWithout = 0, p95MmWithout = 0, maxMmWithout = 0;
-  bool normalMap = false;                                    // the normal map was measured
-  double meanDeg = 0, p95Deg = 0, maxDeg = 0;                // per-texel angle to the truth map
-  uint32_t limbCorrections = 0;  // limbs limb clearance turned out of the trunk before simulating
-  double seconds = 0;            // this pose's clearance + simulation + transfer + bake: wall time on its thread
-  double cpuSeconds = 0;         // the same in CPU time of that thread (what a shared machine does not inflate)
+  bool normalMap = false;                      // the normal map was measured
+  double meanDeg = 0, p95Deg = 0, maxDeg = 0;  // per-texel angle to the truth map
+  uint32_t limbCorrections = 0;                // limbs limb clearance turned out of the trunk before simulating
+  double seconds = 0;     // this pose's clearance + simulation + transfer + bake: wall time on its thread
+  double cpuSeconds = 0;  // the same in CPU time of that thread (what a shared machine does not inflate)
 };
 
 // A measurement with what pooling needs: every vertex distance and the texel-angle histogram.
@@ -64,10 +64,10 @@ struct TruthMeasurement {
 
 // Pooled over (frame, character) pairs: one character's truth frames, or all of them.
 struct TruthSummary {
-  uint32_t samples = 0;  // measured pairs
-  uint32_t failed = 0;   // pairs whose truth simulation failed (not measured)
-  double meanMm = 0, p95Mm = 0, maxMm = 0;     // over every vertex of every measured pair
-  bool comparedWithout = false;                // every measured pair also measured without the push-out
+  uint32_t samples = 0;                     // measured pairs
+  uint32_t failed = 0;                      // pairs whose truth simulation failed (not measured)
+  double meanMm = 0, p95Mm = 0, maxMm = 0;  // over every vertex of every measured pair
+  bool comparedWithout = false;             // every measured pair also measured without the push-out
   double meanMmWithout = 0, p95MmWithout = 0, maxMmWithout = 0;
   bool normalMaps = false;
   double meanDeg = 0, p95Deg = 0, maxDeg = 0;  // over every texel of every measured map

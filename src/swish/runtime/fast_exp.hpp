@@ -21,12 +21,12 @@ inline constexpr float kSeluAlpha = 1.6732632423543772f;
 
 namespace fast_exp_detail {
 inline constexpr float kLog2e = 1.44269504088896341f;
-inline constexpr float kLn2Hi = 0.693359375f;       // few significant bits: n * kLn2Hi is exact
-inline constexpr float kLn2Lo = -2.12194440e-4f;    // ln 2 - kLn2Hi
-inline constexpr float kMinX = -104.f;              // below: the result rounds to 0
-inline constexpr float kMaxX = 89.f;                // above: the result overflows to +inf
-inline constexpr float kP0 = 1.9875691500e-4f, kP1 = 1.3981999507e-3f, kP2 = 8.3334519073e-3f,
-                       kP3 = 4.1665795894e-2f, kP4 = 1.6666665459e-1f, kP5 = 5.0000001201e-1f;
+inline constexpr float kLn2Hi = 0.693359375f;     // few significant bits: n * kLn2Hi is exact
+inline constexpr float kLn2Lo = -2.12194440e-4f;  // ln 2 - kLn2Hi
+inline constexpr float kMinX = -104.f;            // below: the result rounds to 0
+inline constexpr float kMaxX = 89.f;              // above: the result overflows to +inf
+inline constexpr float kP0 = 1.9875691500e-4f, kP1 = 1.3981999507e-3f, kP2 = 8.3334519073e-3f, kP3 = 4.1665795894e-2f,
+                       kP4 = 1.6666665459e-1f, kP5 = 5.0000001201e-1f;
 inline float pow2i(int32_t e) { return std::bit_cast<float>(uint32_t(e + 127) << 23); }  // e in [-126, 127]
 }  // namespace fast_exp_detail
 

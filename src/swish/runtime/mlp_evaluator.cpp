@@ -40,9 +40,12 @@ float inputLimitFor(const MlpLayer& L) {
 
 const char* toString(CpuKernel k) {
   switch (k) {
-    case CpuKernel::Auto: return "auto";
-    case CpuKernel::Portable: return "portable";
-    case CpuKernel::Avx2Fma: return "avx2+fma";
+    case CpuKernel::Auto:
+      return "auto";
+    case CpuKernel::Portable:
+      return "portable";
+    case CpuKernel::Avx2Fma:
+      return "avx2+fma";
   }
   return "?";
 }
@@ -199,7 +202,8 @@ void MlpEvaluator::evaluateBatch(std::span<const float> theta, std::span<float> 
   if (lambda.size() != count * out)
     throw Error("mlp evaluator: lambda holds " + n2s(lambda.size()) + " floats, expected " + n2s(count) + " x " +
                 n2s(outputSize_));
-  runBatch(theta, count, [&](size_t i, const float* row) { std::memcpy(lambda.data() + i * out, row, out * sizeof(float)); });
+  runBatch(theta, count,
+           [&](size_t i, const float* row) { std::memcpy(lambda.data() + i * out, row, out * sizeof(float)); });
 }
 
 void MlpEvaluator::evaluateBatchSplit(std::span<const float> theta, std::span<float> meshWeights,

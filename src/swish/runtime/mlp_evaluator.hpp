@@ -62,7 +62,9 @@ class MlpEvaluator {
                           size_t count) const;
 
   // Views of one instance's Lambda.
-  std::span<const float> meshWeightsOf(std::span<const float> lambda) const { return lambda.first(size_t(meshComponents_)); }
+  std::span<const float> meshWeightsOf(std::span<const float> lambda) const {
+    return lambda.first(size_t(meshComponents_));
+  }
   std::span<const float> normalCodeOf(std::span<const float> lambda) const {
     return lambda.subspan(size_t(meshComponents_), size_t(normalCodeDims()));
   }

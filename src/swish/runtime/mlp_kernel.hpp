@@ -15,8 +15,8 @@
 namespace swish::runtime {
 
 struct PackedDenseLayer {
-  int inputs = 0;             // k runs over [0, inputs)
-  int outputsPadded = 0;      // multiple of 8
+  int inputs = 0;                   // k runs over [0, inputs)
+  int outputsPadded = 0;            // multiple of 8
   const float* weightsT = nullptr;  // inputs x outputsPadded
   const float* bias = nullptr;      // outputsPadded (zeros in the padding)
   // Hidden layer: SELU, then min(activationLimit, .) so the next layer's sums cannot overflow (see
@@ -42,8 +42,7 @@ void denseLayerPortable(const PackedDenseLayer& layer, const float* in, size_t i
                         size_t outStride);
 
 // Only callable when cpuHasAvx2Fma() is true.
-void normaliseInputAvx2(const PackedInputNormalisation& n, const float* x, size_t count, float* out,
-                        size_t outStride);
+void normaliseInputAvx2(const PackedInputNormalisation& n, const float* x, size_t count, float* out, size_t outStride);
 void denseLayerAvx2(const PackedDenseLayer& layer, const float* in, size_t inStride, size_t count, float* out,
                     size_t outStride);
 // The AVX2 exp on an array (n any size), for tests of the vector exp against std::exp.

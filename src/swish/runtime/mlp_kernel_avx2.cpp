@@ -29,7 +29,8 @@ SWISH_AVX2 inline __m256 exp8(__m256 x) {
   using namespace fast_exp_detail;
   x = _mm256_max_ps(_mm256_set1_ps(kMinX), x);
   x = _mm256_min_ps(_mm256_set1_ps(kMaxX), x);
-  const __m256 nf = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(kLog2e)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  const __m256 nf =
+      _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(kLog2e)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
   __m256 r = _mm256_fnmadd_ps(nf, _mm256_set1_ps(kLn2Hi), x);
   r = _mm256_fnmadd_ps(nf, _mm256_set1_ps(kLn2Lo), r);
   __m256 p = _mm256_set1_ps(kP0);
@@ -72,8 +73,8 @@ SWISH_AVX2 inline void storeEpilogue(const PackedDenseLayer& L, __m256 acc, floa
 // NI (1 or 2) instances x 32 outputs. Accumulators are named variables rather than an array: GCC keeps
 // an array of __m256 on the stack and stores it back every iteration.
 template <int NI>
-SWISH_AVX2 inline void tile32(const PackedDenseLayer& L, const float* in, size_t inStride, float* out,
-                              size_t outStride, int col0) {
+SWISH_AVX2 inline void tile32(const PackedDenseLayer& L, const float* in, size_t inStride, float* out, size_t outStride,
+                              int col0) {
   const float* b = L.bias + col0;
   __m256 a0 = _mm256_loadu_ps(b), a1 = _mm256_loadu_ps(b + 8), a2 = _mm256_loadu_ps(b + 16),
          a3 = _mm256_loadu_ps(b + 24);
@@ -114,8 +115,8 @@ SWISH_AVX2 inline void tile32(const PackedDenseLayer& L, const float* in, size_t
 // NI instances x 8 outputs: the remainder of widths that are not multiples of 32. Fewer independent
 // chains (latency-bound), acceptable off the paper's shapes.
 template <int NI>
-SWISH_AVX2 inline void tile8(const PackedDenseLayer& L, const float* in, size_t inStride, float* out,
-                             size_t outStride, int col0) {
+SWISH_AVX2 inline void tile8(const PackedDenseLayer& L, const float* in, size_t inStride, float* out, size_t outStride,
+                             int col0) {
   __m256 a = _mm256_loadu_ps(L.bias + col0), c = a;
   const float* w = L.weightsT + col0;
   const size_t wStride = size_t(L.outputsPadded);
@@ -163,9 +164,11 @@ SWISH_AVX2 void normaliseInputAvx2(const PackedInputNormalisation& n, const floa
       _mm256_storeu_ps(oi + k, _mm256_max_ps(lo, _mm256_min_ps(hi, v)));
     }
     if (full < size) {
-      const __m256 v = _mm256_mul_ps(_mm256_sub_ps(_mm256_maskload_ps(xi + full, tailMask), _mm256_loadu_ps(n.mean + full)),
-                                     _mm256_loadu_ps(n.invScale + full));
-      _mm256_storeu_ps(oi + full, _mm256_and_ps(_mm256_castsi256_ps(tailMask), _mm256_max_ps(lo, _mm256_min_ps(hi, v))));
+      const __m256 v =
+          _mm256_mul_ps(_mm256_sub_ps(_mm256_maskload_ps(xi + full, tailMask), _mm256_loadu_ps(n.mean + full)),
+                        _mm256_loadu_ps(n.invScale + full));
+      _mm256_storeu_ps(oi + full,
+                       _mm256_and_ps(_mm256_castsi256_ps(tailMask), _mm256_max_ps(lo, _mm256_min_ps(hi, v))));
     }
   }
 }
@@ -200,7 +203,9 @@ void denseLayerAvx2(const PackedDenseLayer&, const float*, size_t, size_t, float
 void normaliseInputAvx2(const PackedInputNormalisation&, const float*, size_t, float*, size_t) {
   throw Error("mlp: the AVX2 kernel does not exist on this architecture");
 }
-void expArrayAvx2(const float*, float*, size_t) { throw Error("mlp: the AVX2 kernel does not exist on this architecture"); }
+void expArrayAvx2(const float*, float*, size_t) {
+  throw Error("mlp: the AVX2 kernel does not exist on this architecture");
+}
 }  // namespace swish::runtime
 
 #endif

@@ -42,7 +42,8 @@ void denseLayerPortable(const PackedDenseLayer& L, const float* in, size_t inStr
         acc[o] = h > L.activationLimit ? L.activationLimit : h;  // SELU >= -1.76: only the top needs a bound
       }
     } else {
-      for (size_t o = 0; o < width; ++o) acc[o] = clampKeepNaN(acc[o] * L.outScale[o] + L.outMean[o], -FLT_MAX, FLT_MAX);
+      for (size_t o = 0; o < width; ++o)
+        acc[o] = clampKeepNaN(acc[o] * L.outScale[o] + L.outMean[o], -FLT_MAX, FLT_MAX);
     }
   }
 }

@@ -33,14 +33,29 @@ SWISH_AVX2 void squaredDistancesAvx2(const float* packed, size_t paddedMaps, uin
   size_t m = 0;
   for (; m + 64 <= paddedMaps; m += 64) blocks<8>(packed + m, paddedMaps, dims, code, dist + m);
   switch ((paddedMaps - m) / 8) {
-    case 7: blocks<7>(packed + m, paddedMaps, dims, code, dist + m); break;
-    case 6: blocks<6>(packed + m, paddedMaps, dims, code, dist + m); break;
-    case 5: blocks<5>(packed + m, paddedMaps, dims, code, dist + m); break;
-    case 4: blocks<4>(packed + m, paddedMaps, dims, code, dist + m); break;
-    case 3: blocks<3>(packed + m, paddedMaps, dims, code, dist + m); break;
-    case 2: blocks<2>(packed + m, paddedMaps, dims, code, dist + m); break;
-    case 1: blocks<1>(packed + m, paddedMaps, dims, code, dist + m); break;
-    default: break;
+    case 7:
+      blocks<7>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    case 6:
+      blocks<6>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    case 5:
+      blocks<5>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    case 4:
+      blocks<4>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    case 3:
+      blocks<3>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    case 2:
+      blocks<2>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    case 1:
+      blocks<1>(packed + m, paddedMaps, dims, code, dist + m);
+      break;
+    default:
+      break;
   }
 }
 

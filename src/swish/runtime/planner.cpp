@@ -15,9 +15,12 @@ uint64_t bufferBytes(uint64_t bytes) { return bytes == 0 ? 4 : bytes; }  // gpu:
 
 std::string humanBytes(uint64_t b) {
   char s[64];
-  if (b >= (1ull << 20)) std::snprintf(s, sizeof s, "%.2f MiB", double(b) / double(1ull << 20));
-  else if (b >= 1024) std::snprintf(s, sizeof s, "%.1f KiB", double(b) / 1024.0);
-  else std::snprintf(s, sizeof s, "%llu B", static_cast<unsigned long long>(b));
+  if (b >= (1ull << 20))
+    std::snprintf(s, sizeof s, "%.2f MiB", double(b) / double(1ull << 20));
+  else if (b >= 1024)
+    std::snprintf(s, sizeof s, "%.1f KiB", double(b) / 1024.0);
+  else
+    std::snprintf(s, sizeof s, "%llu B", static_cast<unsigned long long>(b));
   return s;
 }
 
@@ -31,7 +34,8 @@ std::string joinNames(const std::vector<std::string>& names, size_t max = 8) {
 }  // namespace
 
 std::vector<PlannedAllocation> modelAllocations(const Model& m, const std::string& owner, bool withMaps) {
-  const uint64_t n = m.gameMesh.vertexCount(), k = uint64_t(m.meshComponents()), infl = uint64_t(m.gameMesh.skin.influences);
+  const uint64_t n = m.gameMesh.vertexCount(), k = uint64_t(m.meshComponents()),
+                 infl = uint64_t(m.gameMesh.skin.influences);
   const MeshFrameTopology topo = buildFrameTopology(m.gameMesh.triangles, m.gameMesh.positions);
   std::vector<PlannedAllocation> a;
   auto add = [&](const char* name, uint64_t bytes) { a.push_back({owner, name, bufferBytes(bytes), false}); };
@@ -60,7 +64,9 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
   // The deform kernel reads the mesh weights as vec4 texels: K (at least 1) padded to a multiple of 4.
   const uint64_t kk = (std::max<uint64_t>(uint64_t(m.meshComponents()), 1) + 3) / 4 * 4, j = m.skeleton.size();
   std::vector<PlannedAllocation> a;
-  auto add = [&](const char* name, uint64_t bytes, bool image = false) { a.push_back({owner, name, bufferBytes(bytes), image}); };
+  auto add = [&](const char* name, uint64_t bytes, bool image = false) {
+    a.push_back({owner, name, bufferBytes(bytes), image});
+  };
   add("mesh weights", c * kk * 4);
   add("skin matrices", c * j * 48);  // the top three rows of each affine matrix
   add("positions", c * n * 12);
@@ -127,18 +133,20 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
 
     plan.stages.push_back({"pose + forward kinematics", "CPU", key, 0, inst * b.skeletonJoints,
                            std::to_string(inst) + " characters x " + std::to_string(b.skeletonJoints) + " joints"});
-    plan.stages.push_back({"Theta (6D rotations)", "CPU", key, 0, inst * b.thetaJoints,
-                           std::to_string(b.thetaJoints) + " of " + std::to_string(b.skeletonJoints) + " joints per character"});
+    plan.stages.push_back(
+        {"Theta (6D rotations)", "CPU", key, 0, inst * b.thetaJoints,
+         std::to_string(b.thetaJoints) + " of " + std::to_string(b.skeletonJoints) + " joints per character"});
     plan.stages.push_back({"MLP inference", "CPU", key, 0, inst,
                            "one batch of " + std::to_string(inst) + " (" + std::to_string(m.thetaSize()) + " -> " +
                                std::to_string(m.lambdaSize()) + ")"});
     if (b.normalMaps)
-      plan.stages.push_back({"nearest code + temporal filter", "CPU", key, 0, inst,
-                             std::to_string(inst) + " lookups over " + std::to_string(m.normalMaps.mapCount()) + " maps"});
+      plan.stages.push_back(
+          {"nearest code + temporal filter", "CPU", key, 0, inst,
+           std::to_string(inst) + " lookups over " + std::to_string(m.normalMaps.mapCount()) + " maps"});
     if (wantMeshes) {
       plan.stages.push_back({"deform (PCA + skinning)", "GPU", key, 1, inst * n,
-                             std::to_string(inst) + " instances x " + std::to_string(n) + " vertices, K = " +
-                                 std::to_string(m.meshComponents())});
+                             std::to_string(inst) + " instances x " + std::to_string(n) +
+                                 " vertices, K = " + std::to_string(m.meshComponents())});
       if (b.tangentFrames)
         plan.stages.push_back({"normals + tangents", "GPU", key, 2, inst * n,
                                "triangle terms, then a per-vertex gather: " + std::to_string(inst) + " instances"});
@@ -152,8 +160,8 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
       }
       for (const auto& a : modelAllocations(m, key, b.normalMaps)) plan.allocations.push_back(a);
       for (uint32_t s = 0; s < o.framesInFlight; ++s)
-        for (const auto& a : frameAllocations(m, key + " frame " + std::to_string(s), uint32_t(inst), b.tangentFrames, b.normalMaps,
-                                               o.normalMapsShareTexels))
+        for (const auto& a : frameAllocations(m, key + " frame " + std::to_string(s), uint32_t(inst), b.tangentFrames,
+                                              b.normalMaps, o.normalMapsShareTexels))
           plan.allocations.push_back(a);
     }
 
@@ -163,32 +171,36 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
     }
     std::vector<std::string> skipped;
     for (uint32_t j = 0; j < m.skeleton.size(); ++j)
-      if (std::find(m.inputJoints.begin(), m.inputJoints.end(), j) == m.inputJoints.end()) skipped.push_back(m.skeleton.joints[j].name);
+      if (std::find(m.inputJoints.begin(), m.inputJoints.end(), j) == m.inputJoints.end())
+        skipped.push_back(m.skeleton.joints[j].name);
     if (!skipped.empty())
-      plan.leftOut.push_back({key + ": 6D conversion of " + std::to_string(skipped.size()) + " of " +
-                                  std::to_string(m.skeleton.size()) + " joints (" + joinNames(skipped) + ")",
-                              "the model's network reads only its " + std::to_string(m.inputJoints.size()) + " input joints"});
+      plan.leftOut.push_back(
+          {key + ": 6D conversion of " + std::to_string(skipped.size()) + " of " + std::to_string(m.skeleton.size()) +
+               " joints (" + joinNames(skipped) + ")",
+           "the model's network reads only its " + std::to_string(m.inputJoints.size()) + " input joints"});
     if (inst > 1 && wantMeshes)
       plan.leftOut.push_back({key + ": " + std::to_string(inst - 1) + " of " + std::to_string(inst) +
-                                  " per-character dispatches of each GPU pass, and " + std::to_string(inst - 1) + " MLP calls",
+                                  " per-character dispatches of each GPU pass, and " + std::to_string(inst - 1) +
+                                  " MLP calls",
                               std::to_string(inst) + " characters share the model: one batch"});
     if (b.normalMaps && inst > b.maxDecodedMaps)
-      plan.leftOut.push_back({key + ": at least " + std::to_string(inst - b.maxDecodedMaps) + " of " + std::to_string(inst) +
-                                  " map decodes per frame",
+      plan.leftOut.push_back({key + ": at least " + std::to_string(inst - b.maxDecodedMaps) + " of " +
+                                  std::to_string(inst) + " map decodes per frame",
                               "a map selected by several characters is decoded once (the database has " +
                                   std::to_string(m.normalMaps.mapCount()) + " maps)"});
     if (wantMeshes && !b.normalMaps && !m.normalMaps.empty()) {
       uint64_t saved = 0;  // what the database would cost on the GPU
       for (const auto& a : modelAllocations(m, key, true)) saved += a.bytes;
       for (const auto& a : modelAllocations(m, key, false)) saved -= a.bytes;
-      plan.leftOut.push_back({key + ": normal-map lookup, VQ decode and blend; database not uploaded (" + humanBytes(saved) +
-                                  ") and no per-character normal maps",
+      plan.leftOut.push_back({key + ": normal-map lookup, VQ decode and blend; database not uploaded (" +
+                                  humanBytes(saved) + ") and no per-character normal maps",
                               "no output wants normal maps (outputs.render and outputs.normalMaps are off)"});
     } else if (wantMeshes && m.normalMaps.empty()) {
       plan.leftOut.push_back({key + ": normal-map lookup, decode and blend", "the model has no normal-map database"});
     }
     if (wantMeshes && !b.tangentFrames)
-      plan.leftOut.push_back({key + ": normals + tangents pass", "no output shades the mesh (outputs.render and outputs.normalMaps are off)"});
+      plan.leftOut.push_back({key + ": normals + tangents pass",
+                              "no output shades the mesh (outputs.render and outputs.normalMaps are off)"});
     plan.batches.push_back(std::move(b));
   }
   if (o.leaveOut && !wantMeshes)
@@ -198,7 +210,8 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
     const SceneCharacter& ch = scene.characters[c];
     const std::string why = !ch.visible ? std::string("marked off screen (visible: false)")
                                         : "placed " + std::to_string((ch.placement.translation - scene.camera).norm()) +
-                                              " m from the camera, beyond cullDistance " + std::to_string(*scene.cullDistance) + " m";
+                                              " m from the camera, beyond cullDistance " +
+                                              std::to_string(*scene.cullDistance) + " m";
     plan.leftOut.push_back({"character '" + ch.name + "': pose, Theta, MLP, lookup, mesh and normal-map work", why});
   }
   return plan;
@@ -235,7 +248,8 @@ std::string ReplayPlan::describe() const {
   for (const auto& st : stages) {
     s << "  [" << st.device << "] " << st.name;
     if (!st.batch.empty()) s << " <" << st.batch << ">";
-    if (st.device == "GPU") s << ": " << st.dispatchesPerFrame << (st.dispatchesPerFrame == 1 ? " dispatch" : " dispatches");
+    if (st.device == "GPU")
+      s << ": " << st.dispatchesPerFrame << (st.dispatchesPerFrame == 1 ? " dispatch" : " dispatches");
     s << " -- " << st.detail << "\n";
   }
   if (stages.empty()) s << "  (none)\n";
@@ -245,7 +259,8 @@ std::string ReplayPlan::describe() const {
   for (const auto& [owner, bytes] : perOwner) {
     s << "  " << owner << ": " << humanBytes(bytes) << "\n";
     for (const auto& a : allocations)
-      if (a.owner == owner) s << "    " << (a.image ? "image  " : "buffer ") << a.name << ": " << humanBytes(a.bytes) << "\n";
+      if (a.owner == owner)
+        s << "    " << (a.image ? "image  " : "buffer ") << a.name << ": " << humanBytes(a.bytes) << "\n";
   }
   s << "Left out (" << leftOut.size() << "):\n";
   for (const auto& l : leftOut) s << "  - " << l.what << "\n      because " << l.why << "\n";
@@ -261,14 +276,22 @@ nlohmann::json ReplayPlan::toJson() const {
   j["rot6JointsPerFrame"] = rot6JointsPerFrame();
   j["batches"] = nlohmann::json::array();
   for (const auto& b : batches)
-    j["batches"].push_back({{"model", b.model}, {"characters", b.characters}, {"tangentFrames", b.tangentFrames},
-                            {"normalMaps", b.normalMaps}, {"thetaJoints", b.thetaJoints}, {"skeletonJoints", b.skeletonJoints},
+    j["batches"].push_back({{"model", b.model},
+                            {"characters", b.characters},
+                            {"tangentFrames", b.tangentFrames},
+                            {"normalMaps", b.normalMaps},
+                            {"thetaJoints", b.thetaJoints},
+                            {"skeletonJoints", b.skeletonJoints},
                             {"maxDecodedMaps", b.maxDecodedMaps}});
   j["offScreen"] = offScreen;
   j["stages"] = nlohmann::json::array();
   for (const auto& s : stages)
-    j["stages"].push_back({{"name", s.name}, {"device", s.device}, {"batch", s.batch}, {"dispatchesPerFrame", s.dispatchesPerFrame},
-                           {"itemsPerFrame", s.itemsPerFrame}, {"detail", s.detail}});
+    j["stages"].push_back({{"name", s.name},
+                           {"device", s.device},
+                           {"batch", s.batch},
+                           {"dispatchesPerFrame", s.dispatchesPerFrame},
+                           {"itemsPerFrame", s.itemsPerFrame},
+                           {"detail", s.detail}});
   j["allocations"] = nlohmann::json::array();
   for (const auto& a : allocations)
     j["allocations"].push_back({{"owner", a.owner}, {"name", a.name}, {"bytes", a.bytes}, {"image", a.image}});

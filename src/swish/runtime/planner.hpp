@@ -42,22 +42,22 @@ struct PlannedBatch {
   std::vector<uint32_t> characters;  // scene character indices, instance i = characters[i]
   bool tangentFrames = false;
   bool normalMaps = false;
-  uint32_t thetaJoints = 0;          // joints converted to 6D per character
+  uint32_t thetaJoints = 0;  // joints converted to 6D per character
   uint32_t skeletonJoints = 0;
-  uint32_t maxDecodedMaps = 0;       // distinct maps per frame at most: min(characters, database maps)
+  uint32_t maxDecodedMaps = 0;  // distinct maps per frame at most: min(characters, database maps)
 };
 
 struct PlannedStage {
   std::string name;
-  std::string device;           // "CPU" or "GPU"
-  std::string batch;            // model of the batch ("" for all)
+  std::string device;               // "CPU" or "GPU"
+  std::string batch;                // model of the batch ("" for all)
   uint32_t dispatchesPerFrame = 0;  // GPU dispatches at most (0 for CPU stages)
-  uint64_t itemsPerFrame = 0;   // characters, joints, vertices or texels processed per frame
+  uint64_t itemsPerFrame = 0;       // characters, joints, vertices or texels processed per frame
   std::string detail;
 };
 
 struct PlannedAllocation {
-  std::string owner;   // model, or "<model> frame <slot>"
+  std::string owner;  // model, or "<model> frame <slot>"
   std::string name;
   uint64_t bytes = 0;
   bool image = false;
@@ -69,7 +69,7 @@ struct LeftOutWork {
 };
 
 struct ReplayPlan {
-  bool gpuWork = false;  // any deform at all
+  bool gpuWork = false;               // any deform at all
   std::vector<PlannedBatch> batches;  // only batches with at least one on-screen character
   std::vector<uint32_t> offScreen;    // scene character indices
   std::vector<PlannedStage> stages;
@@ -94,6 +94,7 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
 std::vector<PlannedAllocation> modelAllocations(const Model& model, const std::string& owner, bool withNormalMaps);
 // The bytes of one gpu::FrameResources for `instances` instances.
 std::vector<PlannedAllocation> frameAllocations(const Model& model, const std::string& owner, uint32_t instances,
-                                                bool tangentFrames, bool normalMaps, bool normalMapsShareTexels = false);
+                                                bool tangentFrames, bool normalMaps,
+                                                bool normalMapsShareTexels = false);
 
 }  // namespace swish::runtime

@@ -22,8 +22,8 @@ void FrameKernelInputs::validate(const Model& m) const {
   if (selectedMaps.empty()) return;
   if (m.normalMaps.empty()) throw Error("frame inputs: normal maps selected but the model has no normal-map database");
   if (selectedMaps.size() != n || blendAlpha.size() != n)
-    throw Error("frame inputs: " + std::to_string(selectedMaps.size()) + " selected maps and " + std::to_string(blendAlpha.size()) +
-                " blend weights for " + std::to_string(n) + " instances");
+    throw Error("frame inputs: " + std::to_string(selectedMaps.size()) + " selected maps and " +
+                std::to_string(blendAlpha.size()) + " blend weights for " + std::to_string(n) + " instances");
   for (size_t i = 0; i < n; ++i)
     if (selectedMaps[i] >= m.normalMaps.mapCount())
       throw Error("frame inputs: instance " + std::to_string(i) + " selected map " + std::to_string(selectedMaps[i]) +
@@ -31,7 +31,8 @@ void FrameKernelInputs::validate(const Model& m) const {
 }
 
 Points3f referencePositions(const Model& m, const FrameKernelInputs& in, uint32_t i, bool pushOut) {
-  if (i >= in.instanceCount) throw Error("reference positions: instance " + std::to_string(i) + " of " + std::to_string(in.instanceCount));
+  if (i >= in.instanceCount)
+    throw Error("reference positions: instance " + std::to_string(i) + " of " + std::to_string(in.instanceCount));
   const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
   if (in.meshWeights.size() < (i + 1) * k || in.skinMatrices.size() < (i + 1) * j)
     throw Error("reference positions: frame inputs too short for instance " + std::to_string(i));
@@ -46,7 +47,8 @@ Points3f referencePositions(const Model& m, const FrameKernelInputs& in, uint32_
   return out;
 }
 
-ReferenceFrameOutputs referenceFrame(const Model& m, const FrameKernelInputs& in, const std::vector<BlendedNormalMap>& prev) {
+ReferenceFrameOutputs referenceFrame(const Model& m, const FrameKernelInputs& in,
+                                     const std::vector<BlendedNormalMap>& prev) {
   in.validate(m);
   const MeshFrameTopology topo = buildFrameTopology(m.gameMesh.triangles, m.gameMesh.positions);
   ReferenceFrameOutputs out;
@@ -58,7 +60,8 @@ ReferenceFrameOutputs referenceFrame(const Model& m, const FrameKernelInputs& in
   }
   if (!in.selectedMaps.empty()) {
     if (!prev.empty() && prev.size() != in.instanceCount)
-      throw Error("reference frame: " + std::to_string(prev.size()) + " previous maps for " + std::to_string(in.instanceCount) + " instances");
+      throw Error("reference frame: " + std::to_string(prev.size()) + " previous maps for " +
+                  std::to_string(in.instanceCount) + " instances");
     const auto& db = m.normalMaps;
     for (uint32_t i = 0; i < in.instanceCount; ++i) {
       BlendedNormalMap map = prev.empty() ? BlendedNormalMap::zeros(db.width, db.height) : prev[i];

@@ -27,10 +27,10 @@ struct FrameKernelInputs {
 };
 
 struct ReferenceFrameOutputs {
-  std::vector<Points3f> positions;              // per instance, skinned
-  std::vector<Points3f> normals;                // per instance
-  std::vector<Points4f> tangents;               // per instance
-  std::vector<BlendedNormalMap> normalMaps;     // per instance (empty when no maps were selected)
+  std::vector<Points3f> positions;           // per instance, skinned
+  std::vector<Points3f> normals;             // per instance
+  std::vector<Points4f> tangents;            // per instance
+  std::vector<BlendedNormalMap> normalMaps;  // per instance (empty when no maps were selected)
 };
 
 // The skinned positions of one instance alone (PCA -> skinning -> push-out when `pushOut` and the model

@@ -7,7 +7,8 @@ namespace swish::runtime {
 Points3f referencePcaReconstruct(const MeshPca& pca, std::span<const float> weights) {
   const Eigen::Index k = pca.components();
   if (Eigen::Index(weights.size()) != k)
-    throw Error("PCA reconstruction: " + std::to_string(weights.size()) + " weights for " + std::to_string(k) + " components");
+    throw Error("PCA reconstruction: " + std::to_string(weights.size()) + " weights for " + std::to_string(k) +
+                " components");
   const Eigen::Index n = pca.mean.size() / 3;
   Points3f out(n, 3);
   for (Eigen::Index row = 0; row < 3 * n; ++row) {

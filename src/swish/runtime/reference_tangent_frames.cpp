@@ -4,7 +4,8 @@
 
 namespace swish::runtime {
 
-ReferenceTangentFrames referenceTangentFrames(const Points3f& deformed, const Mesh& rest, const MeshFrameTopology& topo) {
+ReferenceTangentFrames referenceTangentFrames(const Points3f& deformed, const Mesh& rest,
+                                              const MeshFrameTopology& topo) {
   if (deformed.rows() != rest.positions.rows())
     throw Error("tangent frames: " + std::to_string(deformed.rows()) + " deformed vertices for a mesh of " +
                 std::to_string(rest.positions.rows()));

@@ -11,6 +11,7 @@ struct ReferenceTangentFrames {
   Points4f tangents;  // N x 4 (w = bitangent sign)
 };
 
-ReferenceTangentFrames referenceTangentFrames(const Points3f& deformed, const Mesh& restMesh, const MeshFrameTopology& topology);
+ReferenceTangentFrames referenceTangentFrames(const Points3f& deformed, const Mesh& restMesh,
+                                              const MeshFrameTopology& topology);
 
 }  // namespace swish::runtime

@@ -6,7 +6,8 @@ namespace swish::runtime {
 
 DecodedNormalMap referenceVqDecode(const NormalMapDatabase& db, uint32_t map) {
   if (map >= db.mapCount())
-    throw Error("VQ decode: map " + std::to_string(map) + " is not in the database of " + std::to_string(db.mapCount()));
+    throw Error("VQ decode: map " + std::to_string(map) + " is not in the database of " +
+                std::to_string(db.mapCount()));
   DecodedNormalMap out;
   out.width = db.width;
   out.height = db.height;

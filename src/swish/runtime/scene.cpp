@@ -22,11 +22,16 @@ bool Scene::onScreen(size_t c) const {
 
 void Scene::validate() const {
   const std::string where = source.empty() ? std::string("scene") : source.string();
-  auto fail = [&](const std::string& path, const std::string& problem) { throw Error(where + ": " + path + ": " + problem); };
-  if (frameCount < 1 || frameCount > 10'000'000) fail("frames.count", "must be 1 to 10000000, is " + std::to_string(frameCount));
-  if (!(framesPerSecond > 0.0 && framesPerSecond <= 1000.0)) fail("frames.rate", "must be in (0, 1000] frames per second");
+  auto fail = [&](const std::string& path, const std::string& problem) {
+    throw Error(where + ": " + path + ": " + problem);
+  };
+  if (frameCount < 1 || frameCount > 10'000'000)
+    fail("frames.count", "must be 1 to 10000000, is " + std::to_string(frameCount));
+  if (!(framesPerSecond > 0.0 && framesPerSecond <= 1000.0))
+    fail("frames.rate", "must be in (0, 1000] frames per second");
   if (!camera.allFinite()) fail("camera.position", "must be finite");
-  if (cullDistance && !(*cullDistance > 0.0 && std::isfinite(*cullDistance))) fail("cullDistance", "must be a positive number of metres");
+  if (cullDistance && !(*cullDistance > 0.0 && std::isfinite(*cullDistance)))
+    fail("cullDistance", "must be a positive number of metres");
   if (outputs.gpuCheckEvery < 1) fail("outputs.gpuCheckEvery", "must be at least 1");
   if (characters.empty()) fail("characters", "a scene needs at least one character");
   std::set<std::string> names;

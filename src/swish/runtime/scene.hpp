@@ -34,9 +34,9 @@ struct ScenePlacement {
 // Motion from an animation clip file (BVH or anything io::readAnimationWithAssimp reads).
 struct SceneClip {
   std::filesystem::path file;
-  std::string clipName;        // empty: the file's (only) clip; else must match it
+  std::string clipName;            // empty: the file's (only) clip; else must match it
   double timeOffsetSeconds = 0.0;  // clip time at scene time 0 (wraps around the clip's length)
-  double speed = 1.0;          // playback speed, > 0
+  double speed = 1.0;              // playback speed, > 0
   // The clip's joint map (io/joint_map.hpp's JSON form: pairs and chains), inline or read from
   // jointMapFile; null: the names are matched by convention. The replay parses it (io::parseJointMap).
   nlohmann::json jointMap;
@@ -45,11 +45,11 @@ struct SceneClip {
 
 struct SceneCharacter {
   std::string name;
-  std::string model;           // kDefaultModelName, or a .swish file (resolved path)
+  std::string model;                                // kDefaultModelName, or a .swish file (resolved path)
   std::optional<SceneClip> clip;                    // exactly one of clip / poseStream
   std::optional<std::filesystem::path> poseStream;  // a recorded pose stream (pose_stream format)
   ScenePlacement placement;
-  bool visible = true;         // false: off screen, skips mesh and normal-map work
+  bool visible = true;  // false: off screen, skips mesh and normal-map work
 };
 
 // Outputs a scene asks for. What they need decides the work (planner.hpp):
@@ -68,8 +68,8 @@ struct SceneOutputs {
 
 struct Scene {
   std::string name;
-  std::filesystem::path source;     // the scene file, for messages ("<built-in>" for code-made scenes)
-  uint32_t firstFrame = 0;          // scene frames [firstFrame, firstFrame + frameCount)
+  std::filesystem::path source;  // the scene file, for messages ("<built-in>" for code-made scenes)
+  uint32_t firstFrame = 0;       // scene frames [firstFrame, firstFrame + frameCount)
   uint32_t frameCount = 1;
   double framesPerSecond = 30.0;
   Eigen::Vector3d camera = Eigen::Vector3d::Zero();

@@ -17,7 +17,8 @@ using nlohmann::json;
 // Walks the JSON with the path of the current node, so that every error says where it is.
 class Reader {
  public:
-  Reader(const json& j, std::string source, std::string path) : j_(j), source_(std::move(source)), path_(std::move(path)) {}
+  Reader(const json& j, std::string source, std::string path)
+      : j_(j), source_(std::move(source)), path_(std::move(path)) {}
 
   [[noreturn]] void fail(const std::string& problem) const {
     throw Error(source_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " + problem);
@@ -89,7 +90,8 @@ std::filesystem::path resolve(const std::filesystem::path& base, const std::stri
 
 void requireFile(const Reader& r, const std::filesystem::path& file) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) r.fail("file '" + file.string() + "' does not exist or is not a file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    r.fail("file '" + file.string() + "' does not exist or is not a file");
 }
 
 SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base, bool checkFiles) {
@@ -184,8 +186,10 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
   if (root.has("outputs")) {
     const Reader o = root.child("outputs");
     o.requireObject({"directory", "report", "render", "meshes", "normalMaps", "gpuCheckEvery"});
-    if (o.has("directory")) s.outputs.directory = resolve(base, o.child("directory").string());
-    else s.outputs.directory = resolve(base, s.outputs.directory.string());
+    if (o.has("directory"))
+      s.outputs.directory = resolve(base, o.child("directory").string());
+    else
+      s.outputs.directory = resolve(base, s.outputs.directory.string());
     if (o.has("report")) s.outputs.report = o.child("report").boolean();
     if (o.has("render")) s.outputs.render = o.child("render").boolean();
     if (o.has("meshes")) s.outputs.meshes = o.child("meshes").boolean();
@@ -220,17 +224,24 @@ json sceneToJson(const Scene& s) {
   j["frames"] = {{"start", s.firstFrame}, {"count", s.frameCount}, {"rate", s.framesPerSecond}};
   j["camera"] = {{"position", {s.camera.x(), s.camera.y(), s.camera.z()}}};
   if (s.cullDistance) j["cullDistance"] = *s.cullDistance;
-  j["outputs"] = {{"directory", s.outputs.directory.string()}, {"report", s.outputs.report},
-                  {"render", s.outputs.render},                {"meshes", s.outputs.meshes},
-                  {"normalMaps", s.outputs.normalMaps},        {"gpuCheckEvery", s.outputs.gpuCheckEvery}};
+  j["outputs"] = {{"directory", s.outputs.directory.string()},
+                  {"report", s.outputs.report},
+                  {"render", s.outputs.render},
+                  {"meshes", s.outputs.meshes},
+                  {"normalMaps", s.outputs.normalMaps},
+                  {"gpuCheckEvery", s.outputs.gpuCheckEvery}};
   j["characters"] = json::array();
   for (const SceneCharacter& c : s.characters) {
     json cj{{"name", c.name}, {"model", c.model}, {"visible", c.visible}};
     if (c.clip)
-      cj["animation"] = {{"file", c.clip->file.string()}, {"clip", c.clip->clipName},
-                         {"timeOffset", c.clip->timeOffsetSeconds}, {"speed", c.clip->speed}};
-    if (c.clip && !c.clip->jointMapFile.empty()) cj["animation"]["jointMap"] = c.clip->jointMapFile.string();
-    else if (c.clip && !c.clip->jointMap.is_null()) cj["animation"]["jointMap"] = c.clip->jointMap;
+      cj["animation"] = {{"file", c.clip->file.string()},
+                         {"clip", c.clip->clipName},
+                         {"timeOffset", c.clip->timeOffsetSeconds},
+                         {"speed", c.clip->speed}};
+    if (c.clip && !c.clip->jointMapFile.empty())
+      cj["animation"]["jointMap"] = c.clip->jointMapFile.string();
+    else if (c.clip && !c.clip->jointMap.is_null())
+      cj["animation"]["jointMap"] = c.clip->jointMap;
     if (c.poseStream) cj["poseStream"] = c.poseStream->string();
     const auto& t = c.placement.translation;
     cj["placement"] = {{"translation", {t.x(), t.y(), t.z()}}, {"yawDegrees", c.placement.yawDegrees}};

@@ -9,8 +9,7 @@ namespace swish::runtime {
 
 TemporalFilter::TemporalFilter(float timeConstantSeconds) : timeConstant_(timeConstantSeconds) {
   if (!(timeConstantSeconds >= 0.f) || !std::isfinite(timeConstantSeconds))
-    throw Error("temporal filter: time constant " + std::to_string(timeConstantSeconds) +
-                " s must be finite and >= 0");
+    throw Error("temporal filter: time constant " + std::to_string(timeConstantSeconds) + " s must be finite and >= 0");
 }
 
 float TemporalFilter::alphaFor(float dt, float timeConstant, bool* invalidDt) {

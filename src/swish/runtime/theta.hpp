@@ -24,8 +24,8 @@
 namespace swish::runtime {
 
 struct ThetaJointIssue {
-  uint32_t skeletonJoint = 0;  // index into the skeleton (what Pose::local is indexed by)
-  uint32_t inputSlot = 0;      // position among the model's input joints (Theta floats 6*slot .. 6*slot+5)
+  uint32_t skeletonJoint = 0;          // index into the skeleton (what Pose::local is indexed by)
+  uint32_t inputSlot = 0;              // position among the model's input joints (Theta floats 6*slot .. 6*slot+5)
   QuatStatus status = QuatStatus::Ok;  // Renormalised or Invalid
 };
 

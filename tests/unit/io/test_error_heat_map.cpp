@@ -42,7 +42,8 @@ TEST(ErrorHeatMap, FigureShowsTheErrorWhereItIs) {
   // In the heat panel (the third), the lower-right triangle (vertices 0, 1, 2: errors 0, 8, 8) is warmer
   // than the upper-left one (0, 8, 0): red minus blue, sampled inside each.
   auto px = [&](int x, int y) {
-    return std::array<int, 3>{png.at(uint32_t(x), uint32_t(y), 0), png.at(uint32_t(x), uint32_t(y), 1), png.at(uint32_t(x), uint32_t(y), 2)};
+    return std::array<int, 3>{png.at(uint32_t(x), uint32_t(y), 0), png.at(uint32_t(x), uint32_t(y), 1),
+                              png.at(uint32_t(x), uint32_t(y), 2)};
   };
   const int top = 24;
   const auto lowerRight = px(200 + 75, top + 70), upperLeft = px(200 + 25, top + 30);

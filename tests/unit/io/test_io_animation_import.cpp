@@ -42,8 +42,8 @@ const Character& sharedCharacter() {
   return c;
 }
 
-#define SKIP_WITHOUT_DATA()                                                                                   \
-  if (!fs::exists(kClip)) GTEST_SKIP() << kClip << " is absent (Debian package assimp-testmodels)";          \
+#define SKIP_WITHOUT_DATA()                                                                         \
+  if (!fs::exists(kClip)) GTEST_SKIP() << kClip << " is absent (Debian package assimp-testmodels)"; \
   if (!fs::exists(kCharacter)) GTEST_SKIP() << "the shared test character " << kCharacter << " is absent"
 
 }  // namespace
@@ -106,9 +106,11 @@ TEST(IoBvh, BadFilesNameFileAndLine) {
 
 TEST(IoJointMap, ConventionsMapOntoCmuNames) {
   Skeleton cmu;
-  for (const char* n : {"Hips", "LowerBack", "Spine", "Spine1", "Neck", "LeftArm"}) cmu.joints.push_back({n, int(cmu.joints.size()) - 1, {}});
+  for (const char* n : {"Hips", "LowerBack", "Spine", "Spine1", "Neck", "LeftArm"})
+    cmu.joints.push_back({n, int(cmu.joints.size()) - 1, {}});
   const auto mixamo = io::mapJoints({"mixamorig:Hips", "mixamorig:Spine", "mixamorig:Spine1", "mixamorig:Spine2",
-                                     "mixamorig:Neck", "mixamorig:LeftArm"}, cmu);
+                                     "mixamorig:Neck", "mixamorig:LeftArm"},
+                                    cmu);
   EXPECT_EQ(mixamo.naming, io::JointNaming::Mixamo);
   EXPECT_EQ(mixamo.sourceOf[size_t(cmu.find("LowerBack"))], 1);
   EXPECT_EQ(mixamo.sourceOf[size_t(cmu.find("Spine1"))], 3);
@@ -140,22 +142,24 @@ void checkCmuClipRetargetedOnto(const Character& c) {
   // The arms move: the upper arm's local rotation spans a large angle over the clip.
   const size_t arm = size_t(c.skeleton.find("LeftArm"));
   float maxAngle = 0;
-  for (const Pose& p : clip.frames) maxAngle = std::max(maxAngle, p.local[arm].angularDistance(clip.frames[0].local[arm]));
+  for (const Pose& p : clip.frames)
+    maxAngle = std::max(maxAngle, p.local[arm].angularDistance(clip.frames[0].local[arm]));
   EXPECT_GT(maxAngle, 0.3f);
 
   // Frame 0: every single-child bone of the character points where the clip's bone points.
   const io::SourceAnimation src = io::readBvh(kClip);
   const auto g = c.skeleton.globalTransforms(clip.frames[0]);
   const auto s = src.frameGlobals(0);
-  for (const char* pair : {"LeftArm>LeftForeArm", "LeftForeArm>LeftHand", "RightArm>RightForeArm",
-                           "LeftUpLeg>LeftLeg", "RightLeg>RightFoot", "Spine>Spine1", "Neck1>Head"}) {
+  for (const char* pair : {"LeftArm>LeftForeArm", "LeftForeArm>LeftHand", "RightArm>RightForeArm", "LeftUpLeg>LeftLeg",
+                           "RightLeg>RightFoot", "Spine>Spine1", "Neck1>Head"}) {
     const std::string p(pair);
     const std::string a = p.substr(0, p.find('>')), b = p.substr(p.find('>') + 1);
     for (const std::string& name : {a, b}) {
       ASSERT_GE(c.skeleton.find(name), 0) << name << " missing from the character";
       ASSERT_GE(src.find(name), 0) << name << " missing from the clip";
     }
-    const Vec3f dc = (g[size_t(c.skeleton.find(b))].translation - g[size_t(c.skeleton.find(a))].translation).normalized();
+    const Vec3f dc =
+        (g[size_t(c.skeleton.find(b))].translation - g[size_t(c.skeleton.find(a))].translation).normalized();
     const Vec3f ds = (s[size_t(src.find(b))].translation - s[size_t(src.find(a))].translation).normalized();
     EXPECT_GT(dc.dot(ds), 0.9999f) << a << " -> " << b;
   }

@@ -15,9 +15,9 @@
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/bake/character/default_character.hpp"
-#include "swish/io/gltf_export.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/character_import.hpp"
+#include "swish/io/gltf_export.hpp"
 #include "swish/io/mesh_topology_check.hpp"
 
 using namespace swish;
@@ -27,9 +27,9 @@ namespace {
 
 const fs::path kTestCharacter = test::sharedAsset("tshirt_lo.glb");
 
-#define SKIP_WITHOUT_SHARED_CHARACTER()                                                              \
-  if (!fs::exists(kTestCharacter))                                                                   \
-  GTEST_SKIP() << "the shared CC0 test character " << kTestCharacter                                 \
+#define SKIP_WITHOUT_SHARED_CHARACTER()                              \
+  if (!fs::exists(kTestCharacter))                                   \
+  GTEST_SKIP() << "the shared CC0 test character " << kTestCharacter \
                << " is absent (../shared/assets beside the project); this test needs it"
 
 using test::errorOf;

@@ -103,7 +103,8 @@ TEST(IoGltfExport, WellFormedDeterministicWithEmbeddedNormalMap) {
   EXPECT_EQ(j["materials"][1]["normalTexture"]["index"], 0);
   EXPECT_EQ(j["skins"][0]["joints"].size(), 31u);
   const auto& shirtAttrs = j["meshes"][1]["primitives"][0]["attributes"];
-  for (const char* k : {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "JOINTS_0", "WEIGHTS_0"}) EXPECT_TRUE(shirtAttrs.contains(k)) << k;
+  for (const char* k : {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "JOINTS_0", "WEIGHTS_0"})
+    EXPECT_TRUE(shirtAttrs.contains(k)) << k;
 
   std::vector<uint8_t> notPng = {1, 2, 3};
   EXPECT_THROW(io::encodeCharacterGlb(c, notPng), Error);

@@ -48,17 +48,18 @@ TEST(AtomicWrite, WritesNewFileAndReplacesExistingOne) {
 
 TEST(AtomicWrite, StaleNumberedOutputsOfAnEarlierRunAreRemovedAndNothingElse) {
   TempDir dir;
-  for (const char* n : {"pose_00001_front.png", "pose_00002_front.png", "pose_00002_normal_map.png", "pose_00007_front.png",
-                        "pose_notes.txt", "my_front.png", "preview.json"})
+  for (const char* n : {"pose_00001_front.png", "pose_00002_front.png", "pose_00002_normal_map.png",
+                        "pose_00007_front.png", "pose_notes.txt", "my_front.png", "preview.json"})
     swish::writeTextFileAtomic(dir / n, n);
   fs::create_directory(dir / "pose_00009_front.png");  // not a regular file: left alone
-  const std::vector<fs::path> written{dir / "pose_00002_front.png", dir / "pose_00002_normal_map.png", dir / "preview.json"};
+  const std::vector<fs::path> written{dir / "pose_00002_front.png", dir / "pose_00002_normal_map.png",
+                                      dir / "preview.json"};
   constexpr std::string_view suffixes[] = {"_front.png", "_normal_map.png"};
   EXPECT_EQ(swish::removeStaleOutputs(dir.path(), "pose_", suffixes, written), 2u);
   std::vector<std::string> left = dir.entries();
   std::sort(left.begin(), left.end());
   EXPECT_EQ(left, (std::vector<std::string>{"my_front.png", "pose_00002_front.png", "pose_00002_normal_map.png",
-                                                     "pose_00009_front.png", "pose_notes.txt", "preview.json"}));
+                                            "pose_00009_front.png", "pose_notes.txt", "preview.json"}));
   EXPECT_EQ(swish::removeStaleOutputs(dir / "absent", "pose_", suffixes, written), 0u);  // no folder: nothing to do
 }
 
@@ -370,7 +371,8 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
-  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN", "NMDB", "TFLT", "BPRX", "META"};
+  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA",
+                                "MESH", "SKIN", "NMDB", "TFLT", "BPRX", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());

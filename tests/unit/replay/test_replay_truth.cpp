@@ -17,9 +17,9 @@
 #include "support/paths.hpp"
 #include "support/random_model.hpp"
 #include "support/temp_dir.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/bake/pipeline/bake_config.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
-#include "swish/bake/character/default_character.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/replay/pose_stream.hpp"
 #include "swish/replay/replay_engine.hpp"
@@ -61,7 +61,8 @@ class ReplayTruth : public test::GpuTest {
     replay::PoseStream rest;
     for (const auto& j : model_.skeleton.joints) rest.joints.push_back(j.name);
     const Pose p = model_.skeleton.restPose();
-    for (int f = 0; f < 8; ++f) rest.frames.push_back({p.rootTranslation, p.local, std::vector<bool>(p.local.size(), true)});
+    for (int f = 0; f < 8; ++f)
+      rest.frames.push_back({p.rootTranslation, p.local, std::vector<bool>(p.local.size(), true)});
     replay::writePoseStream(*tmp_ / "rest.json", rest);
   }
   void TearDown() override {
@@ -70,7 +71,9 @@ class ReplayTruth : public test::GpuTest {
   }
 
   json character(const std::string& name, bool clip, std::array<double, 3> at = {0, 0, 0}) const {
-    json c{{"name", name}, {"model", defaultModelFile().string()}, {"placement", {{"translation", at}, {"yawDegrees", 0.0}}}};
+    json c{{"name", name},
+           {"model", defaultModelFile().string()},
+           {"placement", {{"translation", at}, {"yawDegrees", 0.0}}}};
     if (clip)
       c["animation"] = {{"file", test::debianMocap("01_01.bvh").string()}, {"timeOffset", 2.0}, {"speed", 1.0}};
     else
@@ -78,8 +81,10 @@ class ReplayTruth : public test::GpuTest {
     return c;
   }
   runtime::Scene scene(uint32_t frames, const json& characters) const {
-    json j{{"name", "truth"}, {"frames", {{"count", frames}, {"rate", 30}}},
-           {"outputs", {{"directory", "out"}, {"render", true}, {"gpuCheckEvery", 100}}}, {"characters", characters}};
+    json j{{"name", "truth"},
+           {"frames", {{"count", frames}, {"rate", 30}}},
+           {"outputs", {{"directory", "out"}, {"render", true}, {"gpuCheckEvery", 100}}},
+           {"characters", characters}};
     return runtime::parseScene(j, *tmp_ / "scene.json");
   }
   replay::ReplayResult run(const runtime::Scene& s, const replay::TruthOptions& truth) {
@@ -87,8 +92,8 @@ class ReplayTruth : public test::GpuTest {
     replay::ReplayOptions o;
     o.context = &ctx();
     o.truth = truth;
-    o.pushOut = true;          // runs where the model has a proxy (the committed one has none)
-    o.penetrationEvery = 1;    // every frame, every character
+    o.pushOut = true;        // runs where the model has a proxy (the committed one has none)
+    o.penetrationEvery = 1;  // every frame, every character
     replay::ReplayEngine engine(s, lib, o);
     return engine.run();
   }
@@ -274,7 +279,9 @@ TEST(ReplayTruthNote, ModelWithoutTruthReplaysWithTheNote) {
   const Pose p = test::makeRandomPose(rng, m.skeleton);
   st.frames.push_back({p.rootTranslation, p.local, std::vector<bool>(p.local.size(), true)});
   replay::writePoseStream(tmp / "s.json", st);
-  const json j{{"name", "n"}, {"frames", {{"count", 3}}}, {"outputs", {{"directory", "out"}}},
+  const json j{{"name", "n"},
+               {"frames", {{"count", 3}}},
+               {"outputs", {{"directory", "out"}}},
                {"characters", {{{"name", "a"}, {"model", "m.swish"}, {"poseStream", "s.json"}}}}};
   const runtime::Scene s = runtime::parseScene(j, tmp / "scene.json");
   replay::ModelLibrary lib(s);
@@ -337,8 +344,9 @@ TEST(ReplayTruthSettings, MetadataGivesBackTheBakeSettings) {
   EXPECT_EQ(a.transfer.normalMap.maxDistance, b.transfer.normalMap.maxDistance);
   EXPECT_EQ(a.transfer.normalMap.dilationRings, b.transfer.normalMap.dilationRings);
 
-  EXPECT_NE(test::errorOf([] { bake::poseShapeSettingsFromJson(json::parse(R"({"simulation": {"substeps": "8"}})"), "meta"); })
-                .find("meta.simulation.substeps"),
+  EXPECT_NE(test::errorOf([] {
+              bake::poseShapeSettingsFromJson(json::parse(R"({"simulation": {"substeps": "8"}})"), "meta");
+            }).find("meta.simulation.substeps"),
             std::string::npos);
 
   if (!fs::exists(defaultModelFile())) GTEST_SKIP() << "no committed default model";

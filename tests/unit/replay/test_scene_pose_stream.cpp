@@ -76,7 +76,8 @@ TEST(PoseStream, StructuralErrorsNameFileAndPath) {
   const std::string e = errorOf(head + R"([{"rotations": [[0, 0, 0, 1]]}, {"rotations": [[0, 0, 1]]}]})");
   EXPECT_NE(e.find(f.string()), std::string::npos) << e;
   EXPECT_NE(e.find("frames[1].rotations[0]: must be [x, y, z, w] or null"), std::string::npos) << e;
-  EXPECT_NE(errorOf(head + R"([{"rotations": [[0, 0, 0, "w"]]}]})").find("must be a number or null"), std::string::npos);
+  EXPECT_NE(errorOf(head + R"([{"rotations": [[0, 0, 0, "w"]]}]})").find("must be a number or null"),
+            std::string::npos);
 }
 
 TEST(CharacterMotion, BadPosesAreReplacedAndReported) {

@@ -10,8 +10,8 @@
 namespace {
 
 using namespace swish;
-using runtime::planReplay;
 using runtime::PlannerOptions;
+using runtime::planReplay;
 using runtime::ReplayPlan;
 using runtime::Scene;
 
@@ -126,7 +126,8 @@ TEST(Planner, OnlyInputJointsGoTo6D) {
   const ReplayPlan p = planReplay(sceneOf({"a.swish", "a.swish"}), f.models);
   EXPECT_EQ(p.rot6JointsPerFrame(), 2u * f.withMaps.inputJoints.size());
   EXPECT_LT(p.rot6JointsPerFrame(), 2u * f.withMaps.skeleton.size());
-  EXPECT_TRUE(mentions(p, "6D conversion of " + std::to_string(f.withMaps.skeleton.size() - f.withMaps.inputJoints.size())));
+  EXPECT_TRUE(
+      mentions(p, "6D conversion of " + std::to_string(f.withMaps.skeleton.size() - f.withMaps.inputJoints.size())));
 }
 
 TEST(Planner, OffScreenAndDistantCharactersSkipMeshAndNormalWork) {

@@ -23,7 +23,6 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-
 // Distance in units in the last place between two finite floats of the same sign region.
 int64_t ulpDistance(float a, float b) {
   auto key = [](float f) {
@@ -35,7 +34,9 @@ int64_t ulpDistance(float a, float b) {
 
 // ---- Plain double-precision reference, written for clarity, with a forward error bound. ----
 
-double seluD(double x) { return x > 0 ? 1.0507009873554805 * x : 1.0507009873554805 * 1.6732632423543772 * std::expm1(x); }
+double seluD(double x) {
+  return x > 0 ? 1.0507009873554805 * x : 1.0507009873554805 * 1.6732632423543772 * std::expm1(x);
+}
 
 struct Reference {
   std::vector<double> y;      // Lambda
@@ -86,7 +87,8 @@ Reference referenceMlp(const Mlp& mlp, const Normalisation& in, const Normalisat
   Reference r;
   for (size_t o = 0; o < a.size(); ++o) {
     r.y.push_back(a[o] * out.scale[o] + out.mean[o]);
-    r.bound.push_back(std::abs(double(out.scale[o])) * e[o] + 2 * u * (std::abs(a[o] * out.scale[o]) + std::abs(double(out.mean[o]))));
+    r.bound.push_back(std::abs(double(out.scale[o])) * e[o] +
+                      2 * u * (std::abs(a[o] * out.scale[o]) + std::abs(double(out.mean[o]))));
   }
   return r;
 }
@@ -147,9 +149,9 @@ TEST(RuntimeTheta, FollowsTheModelsJointOrderAndTheColumnConvention) {
 
 TEST(RuntimeTheta, ReportsRenormalisedAndInvalidJointsWithTheirSlots) {
   std::vector<Quatf> pose(5, Quatf::Identity());
-  pose[1] = Quatf(0, 0, 0, 3);            // non-unit: renormalised to 180 degrees about Z
-  pose[3] = Quatf(kNaN, 0, 0, 0);         // invalid: identity
-  pose[4] = Quatf(0, 0, 0, 0);            // invalid: identity (not even used below)
+  pose[1] = Quatf(0, 0, 0, 3);     // non-unit: renormalised to 180 degrees about Z
+  pose[3] = Quatf(kNaN, 0, 0, 0);  // invalid: identity
+  pose[4] = Quatf(0, 0, 0, 0);     // invalid: identity (not even used below)
   const std::vector<uint32_t> joints{3, 1, 0};
   std::vector<ThetaJointIssue> issues;
   ThetaReport report;
@@ -209,8 +211,8 @@ TEST(RuntimeFastExp, WithinTwoUlpOfCorrectlyRoundedExpOverTheNormalRange) {
 TEST(RuntimeFastExp, UnderflowOverflowAndNaN) {
   // Large negative inputs (what SELU sees for very negative pre-activations) go smoothly to 0 through
   // the subnormals; large positive ones overflow to +inf; NaN stays NaN.
-  std::vector<float> xs{-87.5f, -90.f, -95.f, -100.f, -103.f, -103.9f, -104.f, -110.f, -1e4f, -1e30f, -FLT_MAX, -kInf,
-                        88.72f, 88.8f, 89.f, 100.f, 1e30f, kInf, kNaN};
+  std::vector<float> xs{-87.5f,   -90.f, -95.f,  -100.f, -103.f, -103.9f, -104.f, -110.f, -1e4f, -1e30f,
+                        -FLT_MAX, -kInf, 88.72f, 88.8f,  89.f,   100.f,   1e30f,  kInf,   kNaN};
   std::vector<float> avx(xs.size());
   const bool haveAvx = cpuHasAvx2Fma();
   if (haveAvx) expArrayAvx2(xs.data(), avx.data(), xs.size());
@@ -285,8 +287,8 @@ TEST(RuntimeMlp, MatchesDoubleReferenceWithinTheForwardErrorBound) {
   Rng rng(seed);
   // The paper's network, and shapes that exercise every tile of the kernels (widths not multiples of 8
   // or 32, wider than 32, a single layer, one input).
-  const std::vector<std::vector<int>> shapes{{32, 32, 32, 32, 32, 32, 30}, {30, 5, 13, 40, 7}, {6, 64, 64, 3},
-                                             {1, 1}, {18, 33, 9}, {12, 96, 20}};
+  const std::vector<std::vector<int>> shapes{
+      {32, 32, 32, 32, 32, 32, 30}, {30, 5, 13, 40, 7}, {6, 64, 64, 3}, {1, 1}, {18, 33, 9}, {12, 96, 20}};
   for (const auto& widths : shapes) {
     const Mlp mlp = randomMlp(rng, widths);
     const Normalisation in = randomNorm(rng, widths.front()), out = randomNorm(rng, widths.back());

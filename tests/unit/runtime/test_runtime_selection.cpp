@@ -22,7 +22,6 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-
 // Brute force in double, lowest index on ties: the specification of the search.
 uint32_t nearestDouble(const MatXf& keys, const float* code, double* best = nullptr) {
   uint32_t idx = 0;
@@ -151,8 +150,8 @@ TEST(RuntimeTemporalFilter, AlphaFollowsTheExponentialAndItsEdgeCases) {
   const float tc = 0.1f;
   EXPECT_NEAR(TemporalFilter::alphaFor(1.f / 60, tc), 1 - std::exp(-1.0 / 6.0), 1e-7);
   EXPECT_NEAR(TemporalFilter::alphaFor(0.1f, tc), 1 - std::exp(-1.0), 1e-7);
-  EXPECT_EQ(TemporalFilter::alphaFor(0.f, tc), 0.f);         // dt = 0: nothing changes
-  EXPECT_EQ(TemporalFilter::alphaFor(1e6f, tc), 1.f);        // huge dt: the selection shows
+  EXPECT_EQ(TemporalFilter::alphaFor(0.f, tc), 0.f);   // dt = 0: nothing changes
+  EXPECT_EQ(TemporalFilter::alphaFor(1e6f, tc), 1.f);  // huge dt: the selection shows
   EXPECT_EQ(TemporalFilter::alphaFor(kInf, tc), 1.f);
   EXPECT_EQ(TemporalFilter::alphaFor(1.f / 60, 0.f), 1.f);   // time constant 0: no filtering
   EXPECT_EQ(TemporalFilter::alphaFor(1e-30f, 1e-38f), 1.f);  // dt / tc overflows float: still 1

@@ -178,7 +178,8 @@ TEST_F(SceneFileTest, AJointMapIsInlineOrAFile) {
 
 TEST(DefaultScene, FootballPlayParses) {
   const fs::path file = swish::test::sourceDir() / "assets/scenes/football.json";
-  const bool haveClips = fs::exists(swish::test::debianMocap("01_01.bvh")) && fs::exists(swish::test::debianMocap("01_03.bvh"));
+  const bool haveClips =
+      fs::exists(swish::test::debianMocap("01_01.bvh")) && fs::exists(swish::test::debianMocap("01_03.bvh"));
   const auto s = swish::runtime::loadScene(file, /*checkFiles=*/haveClips);
   EXPECT_EQ(s.characters.size(), 22u);
   size_t clip01 = 0;

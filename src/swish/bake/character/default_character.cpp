@@ -26,7 +26,8 @@ Skeleton buildSkeleton(const DefaultCharacterRecipe& r, std::map<std::string, Ve
       if (m == j.name) continue;
       joints.push_back({m, mirroredJointName(j.parent), mirrorX(j.head)});
     }
-  // Depth-first order, children in recipe order (mirrored joints after the originals): the order in which a glTF importer walks the exported nodes, so a round trip keeps indices.
+  // Depth-first order, children in recipe order (mirrored joints after the originals): the order in which a glTF
+  // importer walks the exported nodes, so a round trip keeps indices.
   {
     std::vector<RecipeJoint> ordered;
     std::vector<std::string> stack{joints[0].name};
@@ -47,7 +48,8 @@ Skeleton buildSkeleton(const DefaultCharacterRecipe& r, std::map<std::string, Ve
     Joint out;
     out.name = j.name;
     out.parent = j.parent.empty() ? -1 : s.find(j.parent);
-    if (!j.parent.empty() && out.parent < 0) throw Error("default character recipe: joint '" + j.name + "' has unknown parent");
+    if (!j.parent.empty() && out.parent < 0)
+      throw Error("default character recipe: joint '" + j.name + "' has unknown parent");
     out.rest.translation = out.parent < 0 ? j.head : Vec3f(j.head - heads.at(j.parent));
     s.joints.push_back(out);
   }
@@ -62,7 +64,8 @@ struct BodyPart {
   int ringsPerSpan, segments;
 };
 
-std::vector<BodyPart> buildParts(const DefaultCharacterRecipe& r, const Skeleton& s, const std::map<std::string, Vec3f>& heads) {
+std::vector<BodyPart> buildParts(const DefaultCharacterRecipe& r, const Skeleton& s,
+                                 const std::map<std::string, Vec3f>& heads) {
   std::vector<BodyPart> parts;
   auto make = [&](const RecipePart& p, bool mirrored) {
     std::vector<TubeStation> st;
@@ -163,7 +166,8 @@ SkinWeights packWeights(const std::vector<WeightMap>& weights, int influences) {
     std::vector<std::pair<float, int>> w;
     for (const auto& [j, x] : weights[v]) w.push_back({x, j});
     // Heaviest first; ties by joint index so the order is deterministic.
-    std::sort(w.begin(), w.end(), [](auto a, auto b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+    std::sort(w.begin(), w.end(),
+              [](auto a, auto b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
     if (w.size() > size_t(influences)) w.resize(size_t(influences));
     float total = 0;
     for (auto& x : w) total += x.first;
@@ -200,7 +204,8 @@ Character makeDefaultCharacter(const DefaultCharacterRecipe& recipe) {
   std::vector<RecipeBlend> blends;
   for (const RecipeBlend& b : recipe.blends) {
     blends.push_back(b);
-    if (b.mirror) blends.push_back({mirroredJointName(b.joint), mirroredJointName(b.at), mirrorX(b.offset), b.radius, false});
+    if (b.mirror)
+      blends.push_back({mirroredJointName(b.joint), mirroredJointName(b.at), mirrorX(b.offset), b.radius, false});
   }
   for (size_t v = 0; v < bodyWeights.size(); ++v) {
     const Vec3f p = c.body.positions.row(Eigen::Index(v)).transpose();
@@ -246,7 +251,8 @@ Character makeDefaultCharacter(const DefaultCharacterRecipe& recipe) {
       if (!visible[v]) continue;
       const float d2 = (c.body.positions.row(Eigen::Index(v)).transpose() - p).squaredNorm();
       if (nearest.size() < size_t(k) || d2 < nearest.back().first) {
-        nearest.insert(std::upper_bound(nearest.begin(), nearest.end(), std::make_pair(d2, uint32_t(v))), {d2, uint32_t(v)});
+        nearest.insert(std::upper_bound(nearest.begin(), nearest.end(), std::make_pair(d2, uint32_t(v))),
+                       {d2, uint32_t(v)});
         if (nearest.size() > size_t(k)) nearest.pop_back();
       }
     }

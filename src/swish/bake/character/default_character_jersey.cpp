@@ -60,7 +60,8 @@ Mesh buildJersey(const RecipeJersey& r, const SweptEllipseTube& torso, const std
       rowPos[size_t(i)] = p;
     }
     for (int i = 0; i <= N; ++i)
-      grid[size_t(row)][size_t(i)] = b.add(rowPos[size_t(i % N)], Vec2f(float(i) / float(N), vBase + height * float(row) / float(R)));
+      grid[size_t(row)][size_t(i)] =
+          b.add(rowPos[size_t(i % N)], Vec2f(float(i) / float(N), vBase + height * float(row) / float(R)));
   }
 
   // Armhole blocks: quads [col0, col0 + a) x [rowA, rowB).
@@ -162,7 +163,8 @@ Mesh buildJersey(const RecipeJersey& r, const SweptEllipseTube& torso, const std
         Vec3f p = p0;
         if (k > 0) {
           const float phi = phiSeam + direction * 2.f * float(M_PI) * arc[j] / arc[M];
-          const Vec3f onTube = s.center + (s.halfWidth + r.offset) * std::cos(phi) * s.e1 + (s.halfDepth + r.offset) * std::sin(phi) * s.e2;
+          const Vec3f onTube = s.center + (s.halfWidth + r.offset) * std::cos(phi) * s.e1 +
+                               (s.halfDepth + r.offset) * std::sin(phi) * s.e2;
           p = (1.f - blend) * p0 + blend * onTube;
           pushOutOfBody(p, bodyParts, r.clearance);
         }

@@ -131,13 +131,16 @@ T getOr(const nlohmann::json& j, const char* key, T fallback, const std::string&
 float positive(const nlohmann::json& j, const char* key, const std::string& what, float lo = 1e-6f, float hi = 10.f) {
   const float v = get<float>(j, key, what);
   if (!std::isfinite(v) || v < lo || v > hi)
-    throw Error(what + ": '" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    throw Error(what + ": '" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "]");
   return v;
 }
 
 int count(const nlohmann::json& j, const char* key, const std::string& what, int lo, int hi) {
   const int v = get<int>(j, key, what);
-  if (v < lo || v > hi) throw Error(what + ": '" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  if (v < lo || v > hi)
+    throw Error(what + ": '" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "]");
   return v;
 }
 
@@ -145,7 +148,8 @@ Vec3f vec3(const nlohmann::json& j, const char* key, const std::string& what) {
   const auto v = get<std::vector<float>>(j, key, what);
   if (v.size() != 3) throw Error(what + ": '" + key + "' must have 3 components");
   for (float x : v)
-    if (!std::isfinite(x) || std::abs(x) > 10.f) throw Error(what + ": '" + key + "' has a non-finite or huge component");
+    if (!std::isfinite(x) || std::abs(x) > 10.f)
+      throw Error(what + ": '" + key + "' has a non-finite or huge component");
   return {v[0], v[1], v[2]};
 }
 
@@ -171,8 +175,11 @@ DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, cons
     if (!names.insert(joint.name).second) throw Error(w + " '" + joint.name + "' repeats");
     r.joints.push_back(joint);
   }
-  if (r.joints.empty() || !r.joints[0].parent.empty()) throw Error(what + ": the first joint must be the root (parent \"\")");
-  auto known = [&](const std::string& n) { return names.count(n) || (r.mirrorSkeleton && names.count(mirroredJointName(n))); };
+  if (r.joints.empty() || !r.joints[0].parent.empty())
+    throw Error(what + ": the first joint must be the root (parent \"\")");
+  auto known = [&](const std::string& n) {
+    return names.count(n) || (r.mirrorSkeleton && names.count(mirroredJointName(n)));
+  };
 
   const auto& body = get<nlohmann::json>(j, "body", what);
   for (const auto& pj : get<nlohmann::json>(body, "parts", what + ": body")) {

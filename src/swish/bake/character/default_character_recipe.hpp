@@ -23,7 +23,7 @@ struct RecipeJoint {
 struct RecipeStation {
   std::string joint;  // the joint that skins this cross-section
   Vec3f center = Vec3f::Zero();
-  std::string at;     // when not empty: center = head(at) + offset
+  std::string at;  // when not empty: center = head(at) + offset
   Vec3f offset = Vec3f::Zero();
   float halfWidth = 0, halfDepth = 0;
 };
@@ -45,8 +45,8 @@ struct RecipeBlend {
 };
 
 struct RecipeJersey {
-  float offset = 0.015f;     // distance of the cloth from the body's cross-sections
-  float clearance = 0.01f;   // no cloth vertex closer to any body part than this
+  float offset = 0.015f;    // distance of the cloth from the body's cross-sections
+  float clearance = 0.01f;  // no cloth vertex closer to any body part than this
   int columns = 72, rows = 34;
   float hemY = 0.93f, collarY = 1.505f;
   float armholeBottomY = 1.31f, armholeTopY = 1.485f, armholeHalfWidth = 0.075f;

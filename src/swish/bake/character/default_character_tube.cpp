@@ -13,11 +13,13 @@ namespace {
 template <class T>
 T catmullRom(const T& p0, const T& p1, const T& p2, const T& p3, float t) {
   const float t2 = t * t, t3 = t2 * t;
-  return 0.5f * ((2.f * p1) + (-p0 + p2) * t + (2.f * p0 - 5.f * p1 + 4.f * p2 - p3) * t2 + (-p0 + 3.f * p1 - 3.f * p2 + p3) * t3);
+  return 0.5f * ((2.f * p1) + (-p0 + p2) * t + (2.f * p0 - 5.f * p1 + 4.f * p2 - p3) * t2 +
+                 (-p0 + 3.f * p1 - 3.f * p2 + p3) * t3);
 }
 Vec3f catmullRomDerivative(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2, const Vec3f& p3, float t) {
   const float t2 = t * t;
-  return 0.5f * ((-p0 + p2) + 2.f * (2.f * p0 - 5.f * p1 + 4.f * p2 - p3) * t + 3.f * (-p0 + 3.f * p1 - 3.f * p2 + p3) * t2);
+  return 0.5f *
+         ((-p0 + p2) + 2.f * (2.f * p0 - 5.f * p1 + 4.f * p2 - p3) * t + 3.f * (-p0 + 3.f * p1 - 3.f * p2 + p3) * t2);
 }
 
 }  // namespace
@@ -87,7 +89,8 @@ bool SweptEllipseTube::pushOut(Vec3f& p, float clearance) const {
   if (rho >= target) return false;
   const Vec3f q = p - s.center;
   const float axial = q.dot(s.tangent);
-  const bool beyond = (s.param <= dense_.front().param && axial < 0.f) || (s.param >= dense_.back().param && axial > 0.f);
+  const bool beyond =
+      (s.param <= dense_.front().param && axial < 0.f) || (s.param >= dense_.back().param && axial > 0.f);
   if (rho < 1e-4f) {  // on the axis: any way out
     p = s.center + s.e1 * s.halfWidth * target;
     return true;

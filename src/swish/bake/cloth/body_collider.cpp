@@ -68,8 +68,10 @@ BodyCollider::BodyCollider(const Mesh& body, float cellSize, const std::string& 
       uint32_t a = triangles_(t, k), b = triangles_(t, (k + 1) % 3);
       if (a > b) std::swap(a, b);
       auto [it, inserted] = edgeIndex.try_emplace((uint64_t(a) << 32) | b, uint32_t(edgeTriangles_.size()));
-      if (inserted) edgeTriangles_.push_back({int32_t(t), -1}), edgeUses.push_back(0);
-      else if (edgeTriangles_[it->second][1] < 0) edgeTriangles_[it->second][1] = int32_t(t);
+      if (inserted)
+        edgeTriangles_.push_back({int32_t(t), -1}), edgeUses.push_back(0);
+      else if (edgeTriangles_[it->second][1] < 0)
+        edgeTriangles_[it->second][1] = int32_t(t);
       ++edgeUses[it->second];
       triangleEdges_[size_t(t) * 3 + k] = it->second;
     }
@@ -168,7 +170,8 @@ void BodyCollider::rebuild() {
     }
     const Vec3f centre = (p[0] + p[1] + p[2]) / 3.f;
     const float r = std::max({(p[0] - centre).norm(), (p[1] - centre).norm(), (p[2] - centre).norm()});
-    triangleSpheres_[t] = Vec4f(centre.x(), centre.y(), centre.z(), r);  // not "<< centre, r": GCC 12 warns (-Warray-bounds) on that
+    triangleSpheres_[t] =
+        Vec4f(centre.x(), centre.y(), centre.z(), r);  // not "<< centre, r": GCC 12 warns (-Warray-bounds) on that
   }
   for (auto& n : vertexNormals_) n.normalize();
   for (auto& n : edgeNormals_) n.normalize();
@@ -208,8 +211,10 @@ void BodyCollider::rebuild() {
         for (int y = a[1]; y <= b[1]; ++y)
           for (int x = a[0]; x <= b[0]; ++x) {
             const size_t c = (size_t(z) * gridDims_[1] + y) * gridDims_[0] + x;
-            if (pass == 0) ++cellStart_[c + 1];
-            else cellTriangles_[fill[c]++] = uint32_t(t);
+            if (pass == 0)
+              ++cellStart_[c + 1];
+            else
+              cellTriangles_[fill[c]++] = uint32_t(t);
           }
     }
   }
@@ -261,9 +266,8 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
           size_t slot = 0;
           while (slot < partCount && parts[slot].key != key) ++slot;
           if (slot < partCount && lower > parts[slot].distance) continue;
-          const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
-                                                        positions_.row(triangles_(t, 1)),
-                                                        positions_.row(triangles_(t, 2)));
+          const ClosestOnTriangle q = closestOnTriangle(
+              p, positions_.row(triangles_(t, 0)), positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
           const float d = (p - q.point).norm();
           if (!(d <= maxDistance)) continue;
           if (slot == partCount) {
@@ -297,9 +301,12 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
   keep.fill(true);
   auto pseudoNormal = [&](const PartBest& pb) -> Vec3f {
     switch (pb.point.feature) {
-      case Feature::Face: return faceNormals_[size_t(pb.tri)];
-      case Feature::Vertex: return vertexNormals_[triangles_(pb.tri, pb.point.index)];
-      default: return edgeNormals_[triangleEdges_[size_t(pb.tri) * 3 + pb.point.index]];
+      case Feature::Face:
+        return faceNormals_[size_t(pb.tri)];
+      case Feature::Vertex:
+        return vertexNormals_[triangles_(pb.tri, pb.point.index)];
+      default:
+        return edgeNormals_[triangleEdges_[size_t(pb.tri) * 3 + pb.point.index]];
     }
   };
   for (size_t k = 0; k < partCount; ++k) {
@@ -322,8 +329,10 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
     if (signs[k] < 0.f && pb.distance > kWindingCheckDepth && windingNumber(p, int(pb.part)) < 0.5f) signs[k] = 1.f;
     for (size_t i = 0; i < partCount; ++i)
       if (i != k && parts[i].part == pb.part) {
-        if (signs[k] > 0.f) signs[i] = 1.f;
-        else keep[i] = false;
+        if (signs[k] > 0.f)
+          signs[i] = 1.f;
+        else
+          keep[i] = false;
       }
   }
   size_t kept = 0;
@@ -356,13 +365,15 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
 }
 
 float BodyCollider::windingNumber(const Vec3f& p, int part) const {
-  const auto r = std::find_if(partRanges_.begin(), partRanges_.end(), [&](const PartRange& x) { return int(x.part) == part; });
+  const auto r =
+      std::find_if(partRanges_.begin(), partRanges_.end(), [&](const PartRange& x) { return int(x.part) == part; });
   if (r == partRanges_.end() || !r->closed) return 1.f;  // nothing to check against: keep the pseudo-normal's answer
   // Sum of the triangles' solid angles seen from p (Van Oosterom & Strackee), over 4 pi.
   double omega = 0.0;
   for (uint32_t i = r->begin; i < r->end; ++i) {
     const uint32_t t = partTriangles_[i];
-    const Vec3f a = positions_.row(triangles_(t, 0)).transpose() - p, b = positions_.row(triangles_(t, 1)).transpose() - p,
+    const Vec3f a = positions_.row(triangles_(t, 0)).transpose() - p,
+                b = positions_.row(triangles_(t, 1)).transpose() - p,
                 c = positions_.row(triangles_(t, 2)).transpose() - p;
     const float la = a.norm(), lb = b.norm(), lc = c.norm();
     const float num = a.dot(b.cross(c));

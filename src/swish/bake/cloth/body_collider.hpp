@@ -41,13 +41,13 @@ namespace swish::bake {
 class BodyCollider {
  public:
   struct Hit {
-    bool found = false;          // false: no surface within the search distance
-    float signedDistance = 0.f;  // > 0 outside the body, < 0 inside
+    bool found = false;            // false: no surface within the search distance
+    float signedDistance = 0.f;    // > 0 outside the body, < 0 inside
     Vec3f point = Vec3f::Zero();   // closest point on the surface
     Vec3f normal = Vec3f::Zero();  // unit, pointing out of the body at `point`
-    int triangle = -1;  // the body triangle `point` lies on
-    int part = -1;      // the connected part that triangle belongs to
-    int region = -1;    // its contact region (closestRegions): the part's id unless the part is split
+    int triangle = -1;             // the body triangle `point` lies on
+    int part = -1;                 // the connected part that triangle belongs to
+    int region = -1;               // its contact region (closestRegions): the part's id unless the part is split
   };
 
   // Inside answers deeper than this (metres) are confirmed by the winding number (see above).
@@ -107,10 +107,10 @@ class BodyCollider {
   Points3f restPositions_;
   Triangles triangles_;
   SkinWeights skin_;
-  std::vector<uint32_t> triangleEdges_;  // 3 per triangle: edge index of sides ab, bc, ca
+  std::vector<uint32_t> triangleEdges_;                // 3 per triangle: edge index of sides ab, bc, ca
   std::vector<std::array<int32_t, 2>> edgeTriangles_;  // up to two triangles per edge (-1: none)
-  std::vector<uint32_t> triangleComponent_;  // connected part (by shared vertices) of each triangle
-  std::vector<uint32_t> triangleRegion_;     // contact region of each triangle (see closestRegions)
+  std::vector<uint32_t> triangleComponent_;            // connected part (by shared vertices) of each triangle
+  std::vector<uint32_t> triangleRegion_;               // contact region of each triangle (see closestRegions)
   bool splitsParts_ = false;
   // Each part's triangles (partTriangles_[begin, end)), and whether the part is closed (every edge
   // shared by two of its triangles): only a closed part has a winding number to trust.

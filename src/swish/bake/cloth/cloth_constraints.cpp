@@ -10,8 +10,7 @@
 
 namespace swish::bake {
 
-ClothConstraints buildClothConstraints(const SimulationMesh& mesh, const Points3f& x,
-                                       const ClothMaterial& mat) {
+ClothConstraints buildClothConstraints(const SimulationMesh& mesh, const Points3f& x, const ClothMaterial& mat) {
   validateClothMaterial(mat);
   const size_t nv = size_t(x.rows()), nt = size_t(mesh.triangles.rows());
   ClothConstraints c;
@@ -55,8 +54,8 @@ ClothConstraints buildClothConstraints(const SimulationMesh& mesh, const Points3
     if (!(rest > 0.f)) continue;  // welded duplicates cannot be constrained by a length
     // Each triangle's area is shared by its three edges.
     const double a = e.area / 3.0;
-    c.stretch.push_back({e.a, e.b, rest, float(1.0 / (mat.stretchModulus * a)),
-                         float(1.0 / (mat.compressionModulus * a))});
+    c.stretch.push_back(
+        {e.a, e.b, rest, float(1.0 / (mat.stretchModulus * a)), float(1.0 / (mat.compressionModulus * a))});
     if (e.opposite[1] < 0) continue;
     const uint32_t o0 = uint32_t(e.opposite[0]), o1 = uint32_t(e.opposite[1]);
     const float across = (x.row(o0) - x.row(o1)).norm();
@@ -84,14 +83,13 @@ ClothConstraints buildClothConstraints(const SimulationMesh& mesh, const Points3
     dm << e1.dot(weft), e2.dot(weft), e1.dot(warp), e2.dot(warp);
     if (!(std::abs(dm.determinant()) > 0.f)) continue;
     const Eigen::Matrix2f inv = dm.inverse();
-    c.shear.push_back({{v0, v1, v2}, inv(0, 0), inv(0, 1), inv(1, 0), inv(1, 1),
-                       float(1.0 / (mat.shearModulus * area[t]))});
+    c.shear.push_back(
+        {{v0, v1, v2}, inv(0, 0), inv(0, 1), inv(1, 0), inv(1, 1), float(1.0 / (mat.shearModulus * area[t]))});
   }
   return c;
 }
 
-std::vector<Tether> buildTethers(const SimulationMesh& mesh, const Points3f& x,
-                                 const std::vector<uint32_t>& attached) {
+std::vector<Tether> buildTethers(const SimulationMesh& mesh, const Points3f& x, const std::vector<uint32_t>& attached) {
   const size_t nv = size_t(x.rows());
   const std::vector<std::vector<uint32_t>> neighbours = buildVertexNeighbours(mesh.triangles, nv);
   std::vector<double> dist(nv, std::numeric_limits<double>::infinity());

@@ -15,7 +15,7 @@ namespace swish::bake {
 struct DistanceConstraint {
   uint32_t i, j;
   float rest;
-  float tensionCompliance;      // 1/J: 1 / (modulus * area the constraint stands for)
+  float tensionCompliance;  // 1/J: 1 / (modulus * area the constraint stands for)
   float compressionCompliance;
 };
 

@@ -66,8 +66,14 @@ std::vector<uint8_t> colliderJointGroups(const Skeleton& sk) {
   for (size_t j = 0; j < sk.size(); ++j)
     for (int a = int(j), guard = 0; a >= 0 && guard <= int(sk.size()); a = sk.joints[size_t(a)].parent, ++guard) {
       const std::string& name = sk.joints[size_t(a)].name;
-      if (name.ends_with("LeftArm")) { group[j] = 1; break; }
-      if (name.ends_with("RightArm")) { group[j] = 2; break; }
+      if (name.ends_with("LeftArm")) {
+        group[j] = 1;
+        break;
+      }
+      if (name.ends_with("RightArm")) {
+        group[j] = 2;
+        break;
+      }
     }
   return group;
 }
@@ -78,10 +84,12 @@ void ClothSimSettings::validate() const {
     if (!ok) throw Error("cloth simulation settings: " + what);
   };
   check(std::isfinite(thickness) && thickness >= 0.f && thickness < 0.1f, "thickness must be in [0, 0.1) m");
-  check(std::isfinite(contactMargin) && contactMargin > 0.f && contactMargin < 0.5f, "contactMargin must be in (0, 0.5) m");
+  check(std::isfinite(contactMargin) && contactMargin > 0.f && contactMargin < 0.5f,
+        "contactMargin must be in (0, 0.5) m");
   check(std::isfinite(transitionSeconds) && transitionSeconds > 0.f && transitionSeconds <= 60.f,
         "transitionSeconds must be in (0, 60]");
-  check(std::isfinite(settleSeconds) && settleSeconds >= 0.f && settleSeconds <= 60.f, "settleSeconds must be in [0, 60]");
+  check(std::isfinite(settleSeconds) && settleSeconds >= 0.f && settleSeconds <= 60.f,
+        "settleSeconds must be in [0, 60]");
   check(std::isfinite(frameRate) && frameRate >= 1.f && frameRate <= 1000.f, "frameRate must be in [1, 1000]");
   check(substeps >= 1 && substeps <= 1000, "substeps must be in [1, 1000]");
   check(iterations >= 1 && iterations <= 100, "iterations must be in [1, 100]");
@@ -110,7 +118,8 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   if (mesh_.vertexCount() == 0 || mesh_.triangles.rows() == 0) throw Error(what + ": empty");
   if (mesh_.skin.vertexCount() != mesh_.vertexCount()) throw Error(what + ": skin weights do not match the vertices");
   for (uint16_t j : mesh_.skin.joints)
-    if (j >= skeleton_.size()) throw Error(what + ": skin weight names joint " + std::to_string(j) + ", beyond the skeleton");
+    if (j >= skeleton_.size())
+      throw Error(what + ": skin weight names joint " + std::to_string(j) + ", beyond the skeleton");
   if (!mesh_.restPositions.allFinite()) throw Error(what + ": non-finite rest positions");
 
   restLocal_ = mesh_.restPositions.rowwise() - origin_.transpose();
@@ -179,7 +188,8 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   double bandArea = 0.0, totalArea = 0.0;
   for (uint32_t v = 0; v < mesh_.vertexCount(); ++v) totalArea += constraints_.vertexArea[v];
   // (softened vertices count by their stiffness, so that the band as a whole holds the same weight)
-  for (size_t a = 0; a < attached_.size(); ++a) bandArea += bandStiffnessScale[a] * constraints_.vertexArea[attached_[a]];
+  for (size_t a = 0; a < attached_.size(); ++a)
+    bandArea += bandStiffnessScale[a] * constraints_.vertexArea[attached_[a]];
   const double g = settings_.gravity.norm() > 0.f ? double(settings_.gravity.norm()) : 9.81;
   const double bandStiffness = double(settings_.material.density) * totalArea * g / double(settings_.attachSag);
   for (size_t a = 0; a < attached_.size(); ++a)
@@ -232,10 +242,10 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   for (const Mat4f& m : skeleton_.inverseBind) f.matrix(m);
   const ClothSimSettings& s = settings_;
   const ClothMaterial& m = s.material;
-  for (float x : {m.density, m.stretchModulus, m.compressionModulus, m.shearModulus, m.bendingStiffness, m.friction,
-                  m.damping, s.thickness, s.contactMargin, s.transitionSeconds, s.settleSeconds, s.frameRate,
-                  s.attachTopFraction, s.attachSag, s.tetherSlack, s.convergedSpeed, s.convergedStrain, s.failPenetration,
-                  s.failStrain, s.failShare})
+  for (float x : {m.density,        m.stretchModulus,  m.compressionModulus, m.shearModulus,  m.bendingStiffness,
+                  m.friction,       m.damping,         s.thickness,          s.contactMargin, s.transitionSeconds,
+                  s.settleSeconds,  s.frameRate,       s.attachTopFraction,  s.attachSag,     s.tetherSlack,
+                  s.convergedSpeed, s.convergedStrain, s.failPenetration,    s.failStrain,    s.failShare})
     f.value(x);
   f.value(s.substeps);
   f.value(s.iterations);
@@ -272,7 +282,8 @@ float ClothSolver::penetrationOf(const BodyCollider& body, const Vec3f& p) const
 
 SimResiduals ClothSolver::measure(const Pose& target, const Points3f& positions) const {
   SimResiduals r;
-  if (size_t(positions.rows()) != mesh_.vertexCount() || target.local.size() != skeleton_.size() || !positions.allFinite())
+  if (size_t(positions.rows()) != mesh_.vertexCount() || target.local.size() != skeleton_.size() ||
+      !positions.allFinite())
     throw Error("cloth residuals: the shape or the pose does not fit the simulation mesh and skeleton");
   const Points3f x = positions.rowwise() - origin_.transpose();
   for (const DistanceConstraint& c : constraints_.stretch)
@@ -282,7 +293,8 @@ SimResiduals ClothSolver::measure(const Pose& target, const Points3f& positions)
   for (size_t j = 0; j < skeleton_.size(); ++j) goal.local[j] = target.local[j].normalized();
   BodyCollider body = colliderPrototype_;
   body.pose(localSkinMatrices(goal));
-  for (Eigen::Index v = 0; v < x.rows(); ++v) r.maxPenetration = std::max(r.maxPenetration, penetrationOf(body, x.row(v)));
+  for (Eigen::Index v = 0; v < x.rows(); ++v)
+    r.maxPenetration = std::max(r.maxPenetration, penetrationOf(body, x.row(v)));
   return r;
 }
 
@@ -383,7 +395,8 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
       // band hangs on) is lifted out of it: otherwise the band and the contacts fight over the vertex
       // and tear the cloth around it.
       const BodyCollider::Hit hit = body.closest(attachTarget[a], reach);
-      if (hit.found && hit.signedDistance < s.thickness) attachTarget[a] += (s.thickness - hit.signedDistance) * hit.normal;
+      if (hit.found && hit.signedDistance < s.thickness)
+        attachTarget[a] += (s.thickness - hit.signedDistance) * hit.normal;
     }
 
     float frameSpeed = 0.f;
@@ -448,8 +461,8 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     if (overStretched > size_t(s.failShare * float(cc.stretch.size())) || stretch > kRunawayFactor * s.failStrain)
       return fail("the solve exploded at frame " + std::to_string(frame) + ": " + std::to_string(overStretched) +
                   " of " + std::to_string(cc.stretch.size()) + " edges stretched beyond " +
-                  std::to_string(int(100.f * s.failStrain)) + "%, the worst by " + std::to_string(int(100.f * stretch)) +
-                  "% " + whereIs(worstVertex));
+                  std::to_string(int(100.f * s.failStrain)) + "%, the worst by " +
+                  std::to_string(int(100.f * stretch)) + "% " + whereIs(worstVertex));
     std::swap(blendOld, blendNew);
     lastFrameSpeed = std::sqrt(frameSpeed);
   }

@@ -16,18 +16,18 @@
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/cloth/cloth_constraints.hpp"
 #include "swish/bake/cloth/cloth_material.hpp"
-#include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
+#include "swish/bake/dataset/dataset.hpp"
 
 namespace swish::bake {
 
 struct ClothSimSettings {
   ClothMaterial material = clothMaterialPreset("jersey");
-  float thickness = 0.004f;          // m: how far the cloth keeps off the body surface
-  float contactMargin = 0.02f;       // m: vertices this close beyond the thickness get a contact plane
-  float transitionSeconds = 1.f;     // A-pose -> target, eased
-  float settleSeconds = 0.5f;        // at the target pose before the frame is kept
-  float frameRate = 30.f;            // body poses (and contact planes) per second
+  float thickness = 0.004f;       // m: how far the cloth keeps off the body surface
+  float contactMargin = 0.02f;    // m: vertices this close beyond the thickness get a contact plane
+  float transitionSeconds = 1.f;  // A-pose -> target, eased
+  float settleSeconds = 0.5f;     // at the target pose before the frame is kept
+  float frameRate = 30.f;         // body poses (and contact planes) per second
   // Per frame, and constraint sweeps per substep. On the shared T-shirt at ~12k vertices 8 x 1 left
   // the rest pose 46% stretched under gravity (one Gauss-Seidel sweep per substep cannot carry the
   // weight up ~100 rows of edges); 12 x 2 leaves 20% (99th percentile 8.5%) for ~2x the time.
@@ -36,13 +36,13 @@ struct ClothSimSettings {
   int substeps = 12;
   int iterations = 2;
   Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);
-  float attachTopFraction = 0.08f;   // top band of the garment (fraction of its rest height) attached
-  float attachSag = 0.005f;          // m: how far the attached band would sag holding the whole garment
-  float tetherSlack = 0.01f;         // tethers let a vertex stretch this much beyond its rest geodesic
+  float attachTopFraction = 0.08f;  // top band of the garment (fraction of its rest height) attached
+  float attachSag = 0.005f;         // m: how far the attached band would sag holding the whole garment
+  float tetherSlack = 0.01f;        // tethers let a vertex stretch this much beyond its rest geodesic
   // Outcome bounds.
-  float convergedSpeed = 0.05f;      // m/s: the fastest vertex in the last frame, to count as settled
-  float convergedStrain = 0.25f;     // worst edge strain to count as converged
-  float failPenetration = 0.01f;     // m inside the thick surface: the pose fails beyond this
+  float convergedSpeed = 0.05f;   // m/s: the fastest vertex in the last frame, to count as settled
+  float convergedStrain = 0.25f;  // worst edge strain to count as converged
+  float failPenetration = 0.01f;  // m inside the thick surface: the pose fails beyond this
   // The solve has exploded when more than failShare of the edges are stretched beyond failStrain
   // (relative to the edge's rest length, or half the median one if longer), or any edge beyond five
   // times that. A blow-up stretches edges everywhere; a few tens of edges over 100% on the shoulder
@@ -103,8 +103,8 @@ class ClothSolver {
   Skeleton skeleton_;
   SimulationMesh mesh_;
   ClothSimSettings settings_;
-  Vec3f origin_;            // the solve's origin in character space
-  Points3f restLocal_;      // simulation mesh rest positions relative to origin_
+  Vec3f origin_;        // the solve's origin in character space
+  Points3f restLocal_;  // simulation mesh rest positions relative to origin_
   ClothConstraints constraints_;
   std::vector<uint32_t> attached_;
   std::vector<float> attachCompliance_;  // per attached vertex: 1 / its share of the band's stiffness

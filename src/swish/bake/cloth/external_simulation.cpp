@@ -9,8 +9,8 @@
 
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
-#include "swish/io/mesh_import.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/io/mesh_import.hpp"
 
 namespace swish::bake {
 namespace {
@@ -62,8 +62,9 @@ std::string bvhText(const Skeleton& sk, const std::vector<Pose>& frames, float f
   for (size_t j = 0; j < sk.size(); ++j) {
     const int p = sk.joints[j].parent;
     if (p < 0) {
-      if (root >= 0) throw Error("BVH export: the skeleton has more than one root ('" + sk.joints[size_t(root)].name +
-                                 "', '" + sk.joints[j].name + "'); BVH holds one hierarchy");
+      if (root >= 0)
+        throw Error("BVH export: the skeleton has more than one root ('" + sk.joints[size_t(root)].name + "', '" +
+                    sk.joints[j].name + "'); BVH holds one hierarchy");
       root = int(j);
     } else {
       children[size_t(p)].push_back(int(j));
@@ -129,12 +130,13 @@ void writeTransitionBvh(const std::filesystem::path& bvhPath, const Skeleton& sk
                         const TransitionClipSettings& s) {
   std::vector<TransitionMarker> markers;
   const std::vector<Pose> frames = buildTransitionFrames(sk, poses, s, markers);
-  nlohmann::json j = {{"clip", bvhPath.filename().string()},
-                      {"framesPerSecond", s.framesPerSecond},
-                      {"transitionSeconds", s.transitionSeconds},
-                      {"holdSeconds", s.holdSeconds},
-                      {"note", "export the cloth at targetFrame of each pose, keeping the simulation mesh's vertex order"},
-                      {"poses", nlohmann::json::array()}};
+  nlohmann::json j = {
+      {"clip", bvhPath.filename().string()},
+      {"framesPerSecond", s.framesPerSecond},
+      {"transitionSeconds", s.transitionSeconds},
+      {"holdSeconds", s.holdSeconds},
+      {"note", "export the cloth at targetFrame of each pose, keeping the simulation mesh's vertex order"},
+      {"poses", nlohmann::json::array()}};
   for (const auto& m : markers)
     j["poses"].push_back({{"id", m.poseId}, {"firstFrame", m.firstFrame}, {"targetFrame", m.targetFrame}});
   writeTextFileAtomic(bvhPath, bvhText(sk, frames, s.framesPerSecond));
@@ -272,8 +274,9 @@ const io::ImportedMesh& pickGarment(const std::vector<io::ImportedMesh>& meshes,
       hit = &m;
     }
   }
-  if (!hit) throw Error(file.string() + ": " + std::to_string(meshes.size()) + " meshes (" + names +
-                        "), none named garment/cloth/shirt/jersey: keep only the garment in the file");
+  if (!hit)
+    throw Error(file.string() + ": " + std::to_string(meshes.size()) + " meshes (" + names +
+                "), none named garment/cloth/shirt/jersey: keep only the garment in the file");
   return *hit;
 }
 
@@ -341,13 +344,14 @@ ExternalShapeSource::ExternalShapeSource(const ExternalSimulationSettings& setti
       char d[64];
       std::snprintf(d, sizeof d, "%.1f mm", 1000.0 * restBinding_->maxBindingDistance());
       throw Error(what + ": the re-meshed garment's rest shape is " + d +
-                  " from the simulation mesh (garment.obj) at its farthest vertex (bound 50 mm): is it in the " + space +
-                  " the config states, and the same garment in the rest pose?");
+                  " from the simulation mesh (garment.obj) at its farthest vertex (bound 50 mm): is it in the " +
+                  space + " the config states, and the same garment in the rest pose?");
     }
   };
   auto toCharacter = [&](const Points3f& p) {
     Points3f out(p.rows(), 3);
-    for (Eigen::Index v = 0; v < p.rows(); ++v) out.row(v) = settings_.toCharacter(p.row(v).transpose().cast<double>()).transpose();
+    for (Eigen::Index v = 0; v < p.rows(); ++v)
+      out.row(v) = settings_.toCharacter(p.row(v).transpose().cast<double>()).transpose();
     return out;
   };
 
@@ -363,7 +367,8 @@ ExternalShapeSource::ExternalShapeSource(const ExternalSimulationSettings& setti
         throw Error(sidecar.string() + ": not valid JSON (" + e.what() + ")");
       }
       if (j.contains("pose_list_digest") && j["pose_list_digest"] != std::to_string(poseListDigest))
-        throw Error(sidecar.string() + ": these results were exported for another pose list than the recipe makes now "
+        throw Error(sidecar.string() +
+                    ": these results were exported for another pose list than the recipe makes now "
                     "(its clips, sampling, thinning or limb clearance changed since 'swish bake --export-poses'): "
                     "export again and simulate the new poses");
       break;
@@ -384,8 +389,8 @@ ExternalShapeSource::ExternalShapeSource(const ExternalSimulationSettings& setti
       bindRest(toCharacter(m.positions), m.triangles, rest.string());
       break;
     }
-    description_ = "external simulation: folder " + path.string() + " (" + std::to_string(files.size()) +
-                   " files, " + space + (restBinding_ ? "; re-meshed shapes bound through " + restFile_ : "") + ")";
+    description_ = "external simulation: folder " + path.string() + " (" + std::to_string(files.size()) + " files, " +
+                   space + (restBinding_ ? "; re-meshed shapes bound through " + restFile_ : "") + ")";
   } else {
     multiFrame_ = true;
     hashFile(h, path);
@@ -394,7 +399,8 @@ ExternalShapeSource::ExternalShapeSource(const ExternalSimulationSettings& setti
     for (const auto& m : meshes)
       if (!m.frames.empty()) withFrames.push_back(m);
     if (withFrames.empty())
-      throw Error(path.string() + ": no mesh with frames (morph targets / blend shapes) in the file; give a folder of "
+      throw Error(path.string() +
+                  ": no mesh with frames (morph targets / blend shapes) in the file; give a folder of "
                   "pose_<id>.obj files instead, or store one shape per pose as morph targets");
     const io::ImportedMesh& g = pickGarment(withFrames, path);
     const size_t n = g.frames.size(), poses = targetFrames.size();
@@ -420,8 +426,9 @@ ExternalShapeSource::ExternalShapeSource(const ExternalSimulationSettings& setti
       for (size_t id = 0; id < poses; ++id) frames_[id] = toCharacter(g.frames[targetFrames[id]].second);
       how = "one morph target per clip frame, each pose at its target frame";
     } else {
-      throw Error(path.string() + ": mesh '" + g.name + "' has " + std::to_string(n) + " frames; expected one per pose (" +
-                  std::to_string(poses) + "), one per frame of the exported clip (" + std::to_string(clipFrames) +
+      throw Error(path.string() + ": mesh '" + g.name + "' has " + std::to_string(n) +
+                  " frames; expected one per pose (" + std::to_string(poses) +
+                  "), one per frame of the exported clip (" + std::to_string(clipFrames) +
                   "), or frames named pose_<id>");
     }
     frameTriangles_ = g.triangles;
@@ -430,15 +437,19 @@ ExternalShapeSource::ExternalShapeSource(const ExternalSimulationSettings& setti
     bool sameEdges = sameMesh;
     for (Eigen::Index t = 0; t < g.triangles.rows() && sameEdges; ++t)
       for (int k = 0; k < 3 && sameEdges; ++k)
-        sameEdges = std::binary_search(simEdges_.begin(), simEdges_.end(), edgeKey(g.triangles(t, k), g.triangles(t, (k + 1) % 3)));
+        sameEdges = std::binary_search(simEdges_.begin(), simEdges_.end(),
+                                       edgeKey(g.triangles(t, k), g.triangles(t, (k + 1) % 3)));
     if (!sameEdges) bindRest(base, g.triangles, path.string() + " (mesh '" + g.name + "', its base shape)");
     description_ = "external simulation: " + path.string() + ", mesh '" + g.name + "', " + std::to_string(n) +
-                   " frames (" + how + ", " + space + (restBinding_ ? "; re-meshed, bound through its base shape" : "") + ")";
+                   " frames (" + how + ", " + space +
+                   (restBinding_ ? "; re-meshed, bound through its base shape" : "") + ")";
   }
   digest_ = h.h;
 }
 
-float ExternalShapeSource::maxBindingDistance() const { return restBinding_ ? restBinding_->maxBindingDistance() : 0.f; }
+float ExternalShapeSource::maxBindingDistance() const {
+  return restBinding_ ? restBinding_->maxBindingDistance() : 0.f;
+}
 
 std::string ExternalShapeSource::description() const { return description_; }
 
@@ -453,12 +464,15 @@ Points3f ExternalShapeSource::fromMesh(const Points3f& p, const Triangles& tris,
   if (sameEdges && restBinding_ && n != restVertexCount_) return p;
   if (restBinding_ && n == restVertexCount_) return restBinding_->follow(p);
   std::string why = what + ": " + std::to_string(n) + " vertices";
-  if (n == simN) why += " in another order than the simulation mesh (its faces are not garment.obj's)";
-  else why += ", the simulation mesh (garment.obj) has " + std::to_string(simN);
+  if (n == simN)
+    why += " in another order than the simulation mesh (its faces are not garment.obj's)";
+  else
+    why += ", the simulation mesh (garment.obj) has " + std::to_string(simN);
   if (restBinding_)
     why += ", the re-meshed rest mesh " + restFile_ + " " + std::to_string(restVertexCount_);
   else
-    why += "; a re-meshed garment needs its rest shape beside the poses (rest.obj, same vertex order as the pose files)";
+    why +=
+        "; a re-meshed garment needs its rest shape beside the poses (rest.obj, same vertex order as the pose files)";
   throw Error(why);
 }
 
@@ -476,14 +490,14 @@ Points3f ExternalShapeSource::shape(uint32_t id) const {
   const std::vector<fs::path> candidates = externalPoseCandidates(settings_.path, id);
   for (const fs::path& c : candidates)
     if (fs::exists(c, ec)) found.push_back(c);
-  if (found.empty())
-    throw Error(candidates[0].string() + ": missing (also looked for .glb, .gltf and .fbx)");
+  if (found.empty()) throw Error(candidates[0].string() + ": missing (also looked for .glb, .gltf and .fbx)");
   if (found.size() > 1)
     throw Error(found[0].string() + " and " + found[1].string() + ": two results for one pose; keep one");
   FileMesh m = readMeshFile(found[0]);
   Points3f c(m.positions.rows(), 3);
   if (!m.positions.allFinite()) throw Error(found[0].string() + ": non-finite vertex positions");
-  for (Eigen::Index v = 0; v < c.rows(); ++v) c.row(v) = settings_.toCharacter(m.positions.row(v).transpose().cast<double>()).transpose();
+  for (Eigen::Index v = 0; v < c.rows(); ++v)
+    c.row(v) = settings_.toCharacter(m.positions.row(v).transpose().cast<double>()).transpose();
   return fromMesh(c, m.triangles, found[0].string());
 }
 

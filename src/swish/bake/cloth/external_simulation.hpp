@@ -108,8 +108,9 @@ class ExternalShapeSource {
   // its frame in the exported clip. poseListDigest: checked against poses.json when the folder (or its
   // parent) holds the export's one. Throws Error naming the file: a missing path, a multi-frame file
   // whose frames do not map to the poses, a rest mesh that is broken or lies off the garment.
-  ExternalShapeSource(const ExternalSimulationSettings& settings, const Points3f& simRest, const Triangles& simTriangles,
-                      const std::vector<uint32_t>& targetFrames, uint64_t poseListDigest);
+  ExternalShapeSource(const ExternalSimulationSettings& settings, const Points3f& simRest,
+                      const Triangles& simTriangles, const std::vector<uint32_t>& targetFrames,
+                      uint64_t poseListDigest);
   ~ExternalShapeSource();
 
   // Pose `id`'s shape. Throws Error naming the file and the problem (missing, unreadable, wrong

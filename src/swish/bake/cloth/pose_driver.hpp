@@ -22,10 +22,10 @@ namespace swish::bake {
 using PoseSimulationProgress = std::function<bool(size_t done, size_t total, double secondsLeft)>;
 
 struct PoseSimulationRun {
-  size_t simulated = 0;   // solved in this run
-  size_t reused = 0;      // found finished in the folder
-  size_t failed = 0;      // failures, solved now or found recorded
-  bool stopped = false;   // the progress callback asked to stop before all poses were done
+  size_t simulated = 0;  // solved in this run
+  size_t reused = 0;     // found finished in the folder
+  size_t failed = 0;     // failures, solved now or found recorded
+  bool stopped = false;  // the progress callback asked to stop before all poses were done
   std::vector<std::pair<uint32_t, std::string>> failures;  // pose id, reason; ascending ids
 };
 

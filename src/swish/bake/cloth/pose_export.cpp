@@ -4,8 +4,8 @@
 
 #include "swish/bake/cloth/external_simulation.hpp"
 #include "swish/core/error.hpp"
-#include "swish/io/gltf_export.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/io/gltf_export.hpp"
 
 namespace swish::bake {
 
@@ -23,7 +23,7 @@ std::string readme(const DatasetPoseList& list, const TransitionClipSettings& cl
                    const std::vector<TransitionMarker>& markers, size_t simVertices, size_t simTriangles) {
   char head[8192];
   std::snprintf(head, sizeof head,
-R"(# Poses to simulate for swish
+                R"(# Poses to simulate for swish
 
 This folder holds %zu poses of the character '%s' for your cloth tool. swish learns the garment's
 shape in each pose from what you send back.
@@ -143,33 +143,39 @@ PoseExportResult exportPoses(const DatasetBuildSettings& s, const fs::path& dir,
       {"character", ch.name},
       {"space", "metres, Y up, the character at the origin"},
       {"clip",
-       {{"bvh", "poses.bvh"}, {"gltf", "poses.glb"}, {"frames", frames.size()},
-        {"frames_per_second", clip.framesPerSecond}, {"transition_seconds", clip.transitionSeconds},
+       {{"bvh", "poses.bvh"},
+        {"gltf", "poses.glb"},
+        {"frames", frames.size()},
+        {"frames_per_second", clip.framesPerSecond},
+        {"transition_seconds", clip.transitionSeconds},
         {"hold_seconds", clip.holdSeconds}}},
       {"body", {{"file", "body.obj"}, {"vertices", ch.body.vertexCount()}}},
       {"garment", {{"file", "garment.obj"}, {"vertices", sim.vertexCount()}, {"triangles", sim.triangles.rows()}}},
       {"results", {{"folder", "results"}, {"rest", "results/rest.obj"}}},
       {"pose_list_digest", std::to_string(list.digest)},
       {"joints", joints},
-      {"rotations", "per pose, each joint's local rotation as a quaternion [x, y, z, w] (glTF order); the clip holds the same"},
+      {"rotations",
+       "per pose, each joint's local rotation as a quaternion [x, y, z, w] (glTF order); the clip holds the same"},
       {"poses", poses}};
   writeTextFileAtomic(dir / "poses.json", sidecar.dump(1) + "\n");
   wrote(dir / "poses.json");
 
-  writeTextFileAtomic(dir / "body.obj", objText(ch.body.positions, ch.body.triangles, "swish: body '" + ch.name +
-                                                                                        "', rest pose, metres, Y up"));
+  writeTextFileAtomic(dir / "body.obj", objText(ch.body.positions, ch.body.triangles,
+                                                "swish: body '" + ch.name + "', rest pose, metres, Y up"));
   wrote(dir / "body.obj");
-  writeTextFileAtomic(dir / "garment.obj",
-                      objText(sim.restPositions, sim.triangles,
-                              "swish: garment to simulate (simulation mesh), rest pose, metres, Y up; keep this vertex order"));
+  writeTextFileAtomic(
+      dir / "garment.obj",
+      objText(sim.restPositions, sim.triangles,
+              "swish: garment to simulate (simulation mesh), rest pose, metres, Y up; keep this vertex order"));
   wrote(dir / "garment.obj");
   writeTextFileAtomic(dir / "README.md",
                       readme(list, clip, frames.size(), markers, sim.vertexCount(), size_t(sim.triangles.rows())));
   wrote(dir / "README.md");
   char line[200];
-  std::snprintf(line, sizeof line, "export: %zu poses, a %zu-frame clip (%.1f s at %g fps), garment of %zu vertices in %s",
-                out.poses, out.clipFrames, double(out.clipFrames) / double(clip.framesPerSecond),
-                double(clip.framesPerSecond), out.simulationVertices, dir.string().c_str());
+  std::snprintf(line, sizeof line,
+                "export: %zu poses, a %zu-frame clip (%.1f s at %g fps), garment of %zu vertices in %s", out.poses,
+                out.clipFrames, double(out.clipFrames) / double(clip.framesPerSecond), double(clip.framesPerSecond),
+                out.simulationVertices, dir.string().c_str());
   log(line);
   return out;
 }

@@ -43,12 +43,13 @@ void blendWeights(const SkinWeights& in, uint32_t a, uint32_t b, SkinWeights& ou
       const float w = 0.5f * in.weights[size_t(v) * n + k];
       if (w == 0.f) continue;
       auto it = std::find_if(merged.begin(), merged.end(), [&](auto& p) { return p.first == j; });
-      if (it == merged.end()) merged.push_back({j, w});
-      else it->second += w;
+      if (it == merged.end())
+        merged.push_back({j, w});
+      else
+        it->second += w;
     }
-  std::sort(merged.begin(), merged.end(), [](auto& x, auto& y) {
-    return x.second != y.second ? x.second > y.second : x.first < y.first;
-  });
+  std::sort(merged.begin(), merged.end(),
+            [](auto& x, auto& y) { return x.second != y.second ? x.second > y.second : x.first < y.first; });
   if (merged.size() > size_t(n)) merged.resize(size_t(n));
   float sum = 0.f;
   for (auto& p : merged) sum += p.second;
@@ -242,7 +243,8 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
       for (uint32_t end : {gone, keep})
         for (uint32_t t : around[end]) {
           const auto& tri = tris[t];
-          if (std::find(tri.begin(), tri.end(), end == gone ? keep : gone) != tri.end()) continue;  // removed with the edge
+          if (std::find(tri.begin(), tri.end(), end == gone ? keep : gone) != tri.end())
+            continue;  // removed with the edge
           Vec3f p[3], q[3];
           for (int k = 0; k < 3; ++k) p[k] = q[k] = pos(tri[size_t(k)]);
           for (int k = 0; k < 3; ++k)
@@ -256,12 +258,14 @@ SimulationMesh collapseShortEdges(const SimulationMesh& in, float minEdge) {
         blended.influences = n;
         blendWeights(skin, keep, gone, blended);
         std::copy(blended.joints.begin(), blended.joints.end(), skin.joints.begin() + std::ptrdiff_t(size_t(keep) * n));
-        std::copy(blended.weights.begin(), blended.weights.end(), skin.weights.begin() + std::ptrdiff_t(size_t(keep) * n));
+        std::copy(blended.weights.begin(), blended.weights.end(),
+                  skin.weights.begin() + std::ptrdiff_t(size_t(keep) * n));
         position[keep] = target;
       }
       for (uint32_t t : around[gone]) {
         auto& tri = tris[t];
-        if (std::find(tri.begin(), tri.end(), keep) != tri.end()) deadTri[t] = 1;
+        if (std::find(tri.begin(), tri.end(), keep) != tri.end())
+          deadTri[t] = 1;
         else
           for (uint32_t& u : tri)
             if (u == gone) u = keep;
@@ -350,7 +354,8 @@ SimulationMesh buildSimulationMesh(const Character& character, size_t targetVert
     std::vector<float> lengths;
     for (Eigen::Index t = 0; t < s.triangles.rows(); ++t)
       for (int k = 0; k < 3; ++k)
-        lengths.push_back((s.restPositions.row(s.triangles(t, k)) - s.restPositions.row(s.triangles(t, (k + 1) % 3))).norm());
+        lengths.push_back(
+            (s.restPositions.row(s.triangles(t, k)) - s.restPositions.row(s.triangles(t, (k + 1) % 3))).norm());
     std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
     return collapseShortEdges(s, 0.25f * lengths[lengths.size() / 2]);
   }
@@ -371,7 +376,8 @@ SimulationMesh buildSimulationMesh(const Character& character, size_t targetVert
     // from the game mesh (seams, hems) and only make the solve stiff where nothing is to be seen.
     SimulationMesh r = collapseShortEdges(refineToEdgeLength(s, float(edge)), 0.25f * float(edge));
     const double ratio = double(r.vertexCount()) / double(targetVertices);
-    if (attempt == 0 || std::abs(std::log(ratio)) < std::abs(std::log(double(best.vertexCount()) / double(targetVertices))))
+    if (attempt == 0 ||
+        std::abs(std::log(ratio)) < std::abs(std::log(double(best.vertexCount()) / double(targetVertices))))
       best = std::move(r);
     if (std::abs(ratio - 1.0) < 0.1) break;
     edge *= std::sqrt(ratio);

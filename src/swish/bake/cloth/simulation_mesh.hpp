@@ -15,13 +15,13 @@
 namespace swish::bake {
 
 struct SimulationMesh {
-  Points3f restPositions;              // character space, rest (A-)pose
-  Triangles triangles;                 // welded: neighbours share vertex indices
-  SkinWeights skin;                    // per simulation vertex
+  Points3f restPositions;  // character space, rest (A-)pose
+  Triangles triangles;     // welded: neighbours share vertex indices
+  SkinWeights skin;        // per simulation vertex
   // Game-mesh vertex -> simulation vertex at its rest position (within a quarter of the refined edge
   // length of it where collapseShortEdges merged it into a neighbour).
   std::vector<uint32_t> gameToSim;
-  float refinedEdgeLength = 0.f;       // m: longest edge allowed by refineToEdgeLength (0: not refined)
+  float refinedEdgeLength = 0.f;  // m: longest edge allowed by refineToEdgeLength (0: not refined)
 
   size_t vertexCount() const { return size_t(restPositions.rows()); }
 };
@@ -35,8 +35,7 @@ constexpr size_t kDefaultSimulationVertices = 12000;
 // length) with a vertex count within about 10% of `targetVertices`; a game mesh that already has
 // that many keeps its vertices except edges under a quarter of its median edge, which collapse
 // (0: the welded mesh as is). Throws Error naming the mesh and the problem.
-SimulationMesh buildSimulationMesh(const Character& character,
-                                   size_t targetVertices = kDefaultSimulationVertices);
+SimulationMesh buildSimulationMesh(const Character& character, size_t targetVertices = kDefaultSimulationVertices);
 
 // Longest-edge bisection (Rivara): splits, longest first, every edge longer than `maxEdge` at its
 // midpoint, together with the one or two triangles on it, until none is left. New vertices sit at

@@ -33,15 +33,13 @@ void decodeBc4Block(const squish::u8* block, squish::u8 out[16]) {
 size_t checkedTexels(const NormalMapImage& map) {
   const size_t texels = size_t(map.width) * map.height;
   if (texels == 0 || map.xy.size() != texels * 2)
-    throw Error("bc5 baseline: map of " + std::to_string(map.width) + "x" + std::to_string(map.height) +
-                " holds " + std::to_string(map.xy.size()) + " values");
+    throw Error("bc5 baseline: map of " + std::to_string(map.width) + "x" + std::to_string(map.height) + " holds " +
+                std::to_string(map.xy.size()) + " values");
   return texels;
 }
 }  // namespace
 
-size_t bc5Bytes(uint32_t width, uint32_t height) {
-  return size_t((width + 3) / 4) * size_t((height + 3) / 4) * 16;
-}
+size_t bc5Bytes(uint32_t width, uint32_t height) { return size_t((width + 3) / 4) * size_t((height + 3) / 4) * 16; }
 
 NormalMapImage bc5RoundTrip(const NormalMapImage& map) {
   const size_t texels = checkedTexels(map);
@@ -66,7 +64,8 @@ NormalMapImage bc5RoundTrip(const NormalMapImage& map) {
       for (uint32_t t = 0; t < 16; ++t) {
         const uint32_t x = bx * 4 + t % 4, y = by * 4 + t / 4;
         if (x >= map.width || y >= map.height) continue;
-        for (int c = 0; c < 2; ++c) out.xy[2 * (size_t(y) * map.width + x) + c] = float(values[c][t]) / 255.f * 2.f - 1.f;
+        for (int c = 0; c < 2; ++c)
+          out.xy[2 * (size_t(y) * map.width + x) + c] = float(values[c][t]) / 255.f * 2.f - 1.f;
       }
     }
   return out;
@@ -111,12 +110,14 @@ NormalMapImage bc5RoundTripResized(const NormalMapImage& map, uint32_t width, ui
   // Rows first (map.height lines of map.width texels down to width), then the columns.
   std::vector<float> rows(size_t(width) * map.height * 2);
   for (uint32_t y = 0; y < map.height; ++y)
-    boxDown(map.width, width, [&](uint32_t i, int c) { return map.xy[(size_t(y) * map.width + i) * 2 + c]; },
-            [&](uint32_t o, int c, float v) { rows[(size_t(y) * width + o) * 2 + c] = v; });
+    boxDown(
+        map.width, width, [&](uint32_t i, int c) { return map.xy[(size_t(y) * map.width + i) * 2 + c]; },
+        [&](uint32_t o, int c, float v) { rows[(size_t(y) * width + o) * 2 + c] = v; });
   NormalMapImage small{width, height, std::vector<float>(size_t(width) * height * 2)};
   for (uint32_t x = 0; x < width; ++x)
-    boxDown(map.height, height, [&](uint32_t i, int c) { return rows[(size_t(i) * width + x) * 2 + c]; },
-            [&](uint32_t o, int c, float v) { small.xy[(size_t(o) * width + x) * 2 + c] = v; });
+    boxDown(
+        map.height, height, [&](uint32_t i, int c) { return rows[(size_t(i) * width + x) * 2 + c]; },
+        [&](uint32_t o, int c, float v) { small.xy[(size_t(o) * width + x) * 2 + c] = v; });
   const NormalMapImage decoded = bc5RoundTrip(small);
   // Bilinear back up, texel centres aligned, edges clamped (a sampler's linear filter, clamp to edge).
   NormalMapImage out{map.width, map.height, std::vector<float>(texels * 2)};

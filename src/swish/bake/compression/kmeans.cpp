@@ -108,8 +108,8 @@ KMeansResult kMeans(const RowMatXf& points, const KMeansOptions& o) {
     r.inertia = 0.0;
     for (float v : d2) r.inertia += v;
     r.iterations = it;
-    const bool converged = r.inertia == 0.0 ||
-                           (std::isfinite(previous) && previous - r.inertia <= o.relativeTolerance * previous);
+    const bool converged =
+        r.inertia == 0.0 || (std::isfinite(previous) && previous - r.inertia <= o.relativeTolerance * previous);
     if (it >= o.maxIterations || converged) break;
     previous = r.inertia;
 

@@ -30,10 +30,10 @@ struct KMeansOptions {
 using RowMatXf = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 struct KMeansResult {
-  RowMatXf centres;                 // clusters x D
-  std::vector<uint32_t> assignment; // per point, its centre
+  RowMatXf centres;                  // clusters x D
+  std::vector<uint32_t> assignment;  // per point, its centre
   std::vector<uint32_t> clusterSizes;
-  double inertia = 0.0;             // sum of squared distances to the assigned centre
+  double inertia = 0.0;  // sum of squared distances to the assigned centre
   int iterations = 0;
 };
 

@@ -4,8 +4,8 @@
 // A dataset holds hundreds of 360x360 maps (259,200 values each), so the PCA is randomised by default.
 #include <vector>
 
-#include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/compression/pca.hpp"
+#include "swish/bake/dataset/dataset.hpp"
 
 namespace swish::bake {
 

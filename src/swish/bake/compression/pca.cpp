@@ -11,13 +11,9 @@
 
 namespace swish::bake {
 
-MatXf PcaResult::project(const MatXf& samples) const {
-  return basis.transpose() * (samples.colwise() - mean);
-}
+MatXf PcaResult::project(const MatXf& samples) const { return basis.transpose() * (samples.colwise() - mean); }
 
-MatXf PcaResult::reconstruct(const MatXf& codes) const {
-  return (basis * codes).colwise() + mean;
-}
+MatXf PcaResult::reconstruct(const MatXf& codes) const { return (basis * codes).colwise() + mean; }
 
 namespace {
 
@@ -83,8 +79,9 @@ PcaResult fitPca(const MatXf& samples, const PcaOptions& o, const char* what) {
     r.totalSquaredNorm += (samples.col(j) - r.mean).cast<double>().squaredNorm();
 
   const Eigen::Index maxRank = std::min(samples.rows(), samples.cols());
-  const bool exact = o.method == PcaOptions::Method::Exact ||
-                     (o.method == PcaOptions::Method::Auto && double(samples.rows()) * double(samples.cols()) <= o.exactLimit);
+  const bool exact =
+      o.method == PcaOptions::Method::Exact ||
+      (o.method == PcaOptions::Method::Auto && double(samples.rows()) * double(samples.cols()) <= o.exactLimit);
   Decomposition d;
   if (exact) {
     d = exactSvd(samples, r.mean);

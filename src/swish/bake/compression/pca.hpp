@@ -16,12 +16,12 @@ namespace swish::bake {
 
 struct PcaOptions {
   enum class Method { Auto, Exact, Randomized };
-  int maxComponents = 0;          // K upper bound (0: as many as the data allows)
-  double varianceToKeep = 0.0;    // in (0, 1]: smallest K whose explained variance reaches it; 0: unused
-  Method method = Method::Auto;   // Auto: Exact when D * N <= exactLimit, else Randomized
+  int maxComponents = 0;         // K upper bound (0: as many as the data allows)
+  double varianceToKeep = 0.0;   // in (0, 1]: smallest K whose explained variance reaches it; 0: unused
+  Method method = Method::Auto;  // Auto: Exact when D * N <= exactLimit, else Randomized
   double exactLimit = 2.5e7;
-  int oversampling = 10;          // randomised: extra sketch columns
-  int powerIterations = 3;        // randomised: sharpen the spectrum of the sketch
+  int oversampling = 10;    // randomised: extra sketch columns
+  int powerIterations = 3;  // randomised: sharpen the spectrum of the sketch
   uint64_t seed = 1;
 };
 

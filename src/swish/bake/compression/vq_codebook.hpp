@@ -8,22 +8,22 @@
 #include <cstdint>
 #include <vector>
 
-#include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/compression/kmeans.hpp"
+#include "swish/bake/dataset/dataset.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::bake {
 
 struct VqOptions {
-  uint32_t codebookSize = 4096;    // entries, 1..65536 (16-bit indices)
-  uint32_t trainingBlocks = 65536; // subsample for the Lloyd iterations (0: all blocks)
+  uint32_t codebookSize = 4096;     // entries, 1..65536 (16-bit indices)
+  uint32_t trainingBlocks = 65536;  // subsample for the Lloyd iterations (0: all blocks)
   int iterations = 25;
-  int refinements = 1;             // passes over ALL blocks after training (assign + refit)
+  int refinements = 1;  // passes over ALL blocks after training (assign + refit)
   uint64_t seed = 1;
 };
 
 struct VqReport {
-  uint32_t codebookEntries = 0;      // may be below codebookSize when there are fewer distinct blocks
+  uint32_t codebookEntries = 0;  // may be below codebookSize when there are fewer distinct blocks
   uint64_t blocks = 0;
   uint64_t codebookBytes = 0;
   uint64_t indexBytes = 0;

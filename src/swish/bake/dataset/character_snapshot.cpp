@@ -27,8 +27,9 @@ void putMesh(ByteWriter& w, const Mesh& m) {
   const size_t n = m.vertexCount();
   w.u32(uint32_t(n));
   w.u32(uint32_t(m.triangleCount()));
-  const uint8_t flags = uint8_t((size_t(m.normals.rows()) == n && n ? 1 : 0) |
-                                (size_t(m.tangents.rows()) == n && n ? 2 : 0) | (size_t(m.uvs.rows()) == n && n ? 4 : 0));
+  const uint8_t flags =
+      uint8_t((size_t(m.normals.rows()) == n && n ? 1 : 0) | (size_t(m.tangents.rows()) == n && n ? 2 : 0) |
+              (size_t(m.uvs.rows()) == n && n ? 4 : 0));
   w.u8(flags);
   w.f32s({m.positions.data(), size_t(m.positions.size())});
   if (flags & 1) w.f32s({m.normals.data(), size_t(m.normals.size())});
@@ -72,7 +73,8 @@ Mesh getMesh(ByteReader& r) {
   const uint32_t skinned = r.u32("skinned vertex");
   if (m.skin.influences < 0 || m.skin.influences > kMaxInfluences)
     r.fail("skin influences " + std::to_string(m.skin.influences) + " outside 0.." + std::to_string(kMaxInfluences));
-  if (skinned != 0 && skinned != n) r.fail("skin covers " + std::to_string(skinned) + " of " + std::to_string(n) + " vertices");
+  if (skinned != 0 && skinned != n)
+    r.fail("skin covers " + std::to_string(skinned) + " of " + std::to_string(n) + " vertices");
   const uint64_t entries = r.multiply(skinned, uint64_t(m.skin.influences), "skin");
   r.checkCount(entries, 6, "skin entry");
   m.skin.joints.resize(size_t(entries));
@@ -116,7 +118,8 @@ Character decodeCharacterSnapshot(std::span<const uint8_t> bytes, const std::str
   ByteReader r(bytes.first(bytes.size() - 4), what, "file");
   r.skip(8, "magic");
   const uint32_t version = r.u32("version");
-  if (version != kVersion) r.fail("version " + std::to_string(version) + " (this build reads " + std::to_string(kVersion) + ")");
+  if (version != kVersion)
+    r.fail("version " + std::to_string(version) + " (this build reads " + std::to_string(kVersion) + ")");
   Character c;
   c.name = getString(r, "name");
   const size_t joints = r.checkCount(r.u32("joint"), 40, "joint");

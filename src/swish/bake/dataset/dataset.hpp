@@ -29,19 +29,19 @@ struct NormalMapImage {
 };
 
 struct DatasetPose {
-  uint32_t id = 0;                 // index in the thinned pose list (stable across re-runs)
-  Pose pose;                       // local rotations on the character's skeleton
-  Points3f gameMeshWorld;          // transferred + smoothed game mesh, character space, posed
-  Points3f gameMeshPreSkin;        // the same shape un-skinned to pre-skinning space
-  NormalMapImage normalMap;        // detail of the simulation mesh the game mesh lacks
+  uint32_t id = 0;           // index in the thinned pose list (stable across re-runs)
+  Pose pose;                 // local rotations on the character's skeleton
+  Points3f gameMeshWorld;    // transferred + smoothed game mesh, character space, posed
+  Points3f gameMeshPreSkin;  // the same shape un-skinned to pre-skinning space
+  NormalMapImage normalMap;  // detail of the simulation mesh the game mesh lacks
   SimResiduals residuals;
 };
 
 struct Dataset {
-  Character character;               // skeleton, body, game mesh (rest pose)
-  std::vector<uint32_t> inputJoints; // Theta joints, skeleton indices
-  std::vector<DatasetPose> poses;    // only poses whose simulation succeeded
-  nlohmann::json settings;           // the bake settings that made it
+  Character character;                // skeleton, body, game mesh (rest pose)
+  std::vector<uint32_t> inputJoints;  // Theta joints, skeleton indices
+  std::vector<DatasetPose> poses;     // only poses whose simulation succeeded
+  nlohmann::json settings;            // the bake settings that made it
 };
 
 }  // namespace swish::bake

@@ -8,11 +8,11 @@
 
 #include "swish/bake/dataset/character_snapshot.hpp"
 #include "swish/core/error.hpp"
-#include "swish/io/png.hpp"
 #include "swish/files/atomic_write.hpp"
 #include "swish/files/byte_reader.hpp"
 #include "swish/files/byte_writer.hpp"
 #include "swish/files/crc32.hpp"
+#include "swish/io/png.hpp"
 
 namespace swish::bake {
 namespace fs = std::filesystem;
@@ -105,7 +105,8 @@ PoseFile decodePoseFile(std::span<const uint8_t> bytes, const std::string& what)
   f.mapHeight = r.u32("normal map height");
   r.expectEnd();
   for (const Quatf& q : f.pose.pose.local)
-    if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.f) > 1e-3f) r.fail("a joint rotation is not a unit quaternion");
+    if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.f) > 1e-3f)
+      r.fail("a joint rotation is not a unit quaternion");
   if (!f.pose.gameMeshWorld.allFinite() || !f.pose.gameMeshPreSkin.allFinite() ||
       !f.pose.pose.rootTranslation.allFinite())
     r.fail("non-finite positions");
@@ -134,7 +135,8 @@ DatasetWriter::DatasetWriter(fs::path folder, const Character& character, std::v
       inputJoints_(std::move(inputJoints)),
       settings_(std::move(settings)),
       bitDepth_(bitDepth) {
-  if (bitDepth != 8 && bitDepth != 16) throw Error("dataset " + folder_.string() + ": normal-map bit depth must be 8 or 16");
+  if (bitDepth != 8 && bitDepth != 16)
+    throw Error("dataset " + folder_.string() + ": normal-map bit depth must be 8 or 16");
   for (uint32_t j : inputJoints_)
     if (j >= character.skeleton.size())
       throw Error("dataset " + folder_.string() + ": input joint " + std::to_string(j) + " is not in the skeleton");
@@ -146,7 +148,8 @@ DatasetWriter::DatasetWriter(fs::path folder, const Character& character, std::v
   const fs::path charFile = folder_ / "character.bin";
   if (fs::exists(charFile)) {
     if (readBytes(charFile) != snapshot)
-      throw Error(charFile.string() + ": this dataset folder was made for a different character (or different "
+      throw Error(charFile.string() +
+                  ": this dataset folder was made for a different character (or different "
                   "meshes); use a new folder or delete it");
   } else {
     writeFileAtomic(charFile, snapshot);
@@ -249,19 +252,22 @@ Dataset readDataset(const fs::path& folder) {
   const fs::path charFile = folder / "character.bin";
   d.character = decodeCharacterSnapshot(readBytes(charFile), charFile.string());
   for (uint32_t j : d.inputJoints)
-    if (j >= d.character.skeleton.size()) throw Error(mwhat + ": input joint " + std::to_string(j) + " is not in the skeleton");
+    if (j >= d.character.skeleton.size())
+      throw Error(mwhat + ": input joint " + std::to_string(j) + " is not in the skeleton");
   const size_t n = d.character.garment.vertexCount();
   for (size_t k = 0; k < ids.size(); ++k) {
     if (k && ids[k] <= ids[k - 1]) throw Error(mwhat + ": pose ids are not strictly ascending");
     const fs::path file = datasetPosePath(folder, ids[k]);
     const std::string what = file.string();
     PoseFile f = decodePoseFile(readBytes(file), what);
-    if (f.pose.id != ids[k]) throw Error(what + ": holds pose " + std::to_string(f.pose.id) + ", not " + std::to_string(ids[k]));
+    if (f.pose.id != ids[k])
+      throw Error(what + ": holds pose " + std::to_string(f.pose.id) + ", not " + std::to_string(ids[k]));
     if (f.pose.pose.local.size() != d.character.skeleton.size())
       throw Error(what + ": " + std::to_string(f.pose.pose.local.size()) + " joints, the character has " +
                   std::to_string(d.character.skeleton.size()));
     if (size_t(f.pose.gameMeshWorld.rows()) != n)
-      throw Error(what + ": " + std::to_string(f.pose.gameMeshWorld.rows()) + " vertices, the garment has " + std::to_string(n));
+      throw Error(what + ": " + std::to_string(f.pose.gameMeshWorld.rows()) + " vertices, the garment has " +
+                  std::to_string(n));
     if (f.mapWidth != width || f.mapHeight != height)
       throw Error(what + ": normal map " + std::to_string(f.mapWidth) + "x" + std::to_string(f.mapHeight) +
                   ", the manifest says " + std::to_string(width) + "x" + std::to_string(height));

@@ -6,8 +6,8 @@
 
 #include "swish/core/error.hpp"
 #include "swish/core/mesh_frames.hpp"
-#include "swish/io/png.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/io/png.hpp"
 
 namespace swish::bake {
 

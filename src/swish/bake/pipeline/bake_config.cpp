@@ -99,14 +99,16 @@ void parseCharacter(const Checker& c, const nlohmann::json& v, const std::filesy
 // carry it as it was resolved then).
 void parseSimulationSource(const Checker& c, const nlohmann::json& sim, const std::string& p, DatasetBuildSettings& s) {
   const std::string source = c.string(sim, "source", "solver", p);
-  if (source != "solver" && source != "external") c.fail(p + ".source", "'" + source + "' is not one of solver, external");
+  if (source != "solver" && source != "external")
+    c.fail(p + ".source", "'" + source + "' is not one of solver, external");
   const bool external = source == "external";
   for (const char* k : {"path", "space", "units_per_metre", "up_axis", "origin"})
     if (!external && sim.contains(k)) c.fail(p + "." + k, "applies to \"source\": \"external\" only");
   if (!external) return;
   if (!sim.contains("path"))
-    c.fail(p + ".path", "is required with \"source\": \"external\" (the folder of pose_<id>.obj files, or one "
-                        "multi-frame .glb/.gltf/.fbx)");
+    c.fail(p + ".path",
+           "is required with \"source\": \"external\" (the folder of pose_<id>.obj files, or one "
+           "multi-frame .glb/.gltf/.fbx)");
   ExternalSimulationSettings& e = s.external;
   e.path = c.string(sim, "path", "", p);
   const std::string space = c.string(sim, "space", "character", p);
@@ -171,9 +173,12 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   ls.strength = float(c.number(tr, p, "smoothing_strength", 0, 1, ls.strength));
   ls.iterations = int(c.number(tr, p, "smoothing_iterations", 0, 1000, ls.iterations, true));
   const std::string weights = c.string(tr, "smoothing_weights", "cotangent", p);
-  if (weights == "cotangent") ls.weights = LaplacianWeights::Cotangent;
-  else if (weights == "uniform") ls.weights = LaplacianWeights::Uniform;
-  else c.fail(p + ".smoothing_weights", "'" + weights + "' is not one of cotangent, uniform");
+  if (weights == "cotangent")
+    ls.weights = LaplacianWeights::Cotangent;
+  else if (weights == "uniform")
+    ls.weights = LaplacianWeights::Uniform;
+  else
+    c.fail(p + ".smoothing_weights", "'" + weights + "' is not one of cotangent, uniform");
 
   const nlohmann::json nm = j.value("normal_maps", nlohmann::json::object());
   p = prefix + ".normal_maps";
@@ -214,7 +219,8 @@ DatasetBuildSettings parsePart1(const Checker& c, const nlohmann::json& j, const
       training += !held.count(normaliseSubject(clip.subject));
     }
     for (const auto& subject : s.holdoutSubjects)
-      if (!seen.count(normaliseSubject(subject))) c.fail(p + ".subjects", "no clip of subject '" + subject + "' in part1.clips");
+      if (!seen.count(normaliseSubject(subject)))
+        c.fail(p + ".subjects", "no clip of subject '" + subject + "' in part1.clips");
     if (training == 0) c.fail(p + ".subjects", "holds out every clip: nothing is left to train on");
   }
 
@@ -265,7 +271,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   return s.poseShape();
 }
 
-BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source, const std::filesystem::path& baseDir) {
+BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source,
+                           const std::filesystem::path& baseDir) {
   const Checker c{source};
   c.onlyKeys(json, "", {"name", "output", "work", "dataset", "part1", "train"});
   BakeConfig cfg;
@@ -283,10 +290,29 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   }
   const nlohmann::json train = json.value("train", nlohmann::json::object());
   c.onlyKeys(train, "train",
-             {"mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
-              "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation", "learning_rate",
-              "batch_size", "max_epochs", "patience", "validation_fraction", "normal_code_weight", "mesh_weight_floor", "max_training_seconds", "test_fraction",
-              "temporal_time_constant", "seed", "bc5_baseline", "input_joints"});
+             {"mesh_components",
+              "mesh_variance",
+              "normal_code_dims",
+              "database_size",
+              "codebook_size",
+              "vq_training_blocks",
+              "vq_iterations",
+              "hidden_layers",
+              "hidden_width",
+              "activation",
+              "learning_rate",
+              "batch_size",
+              "max_epochs",
+              "patience",
+              "validation_fraction",
+              "normal_code_weight",
+              "mesh_weight_floor",
+              "max_training_seconds",
+              "test_fraction",
+              "temporal_time_constant",
+              "seed",
+              "bc5_baseline",
+              "input_joints"});
   BakeTrainSettings& t = cfg.train;
   const std::string p = "train";
   t.meshComponents = int(c.number(train, p, "mesh_components", 1, 4096, t.meshComponents, true));
@@ -306,8 +332,9 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
       c.fail("train.activation", e.what());
     }
     if (t.mlp.activation != Activation::Selu)
-      c.fail("train.activation", "the .swish runtime evaluates SELU only; other activations are for experiments "
-                                 "with the trainer, not for baked models");
+      c.fail("train.activation",
+             "the .swish runtime evaluates SELU only; other activations are for experiments "
+             "with the trainer, not for baked models");
   }
   t.mlp.learningRate = c.number(train, p, "learning_rate", 1e-7, 1.0, t.mlp.learningRate);
   t.mlp.batchSize = int(c.number(train, p, "batch_size", 1, 1 << 20, t.mlp.batchSize, true));

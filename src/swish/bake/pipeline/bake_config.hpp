@@ -44,8 +44,9 @@
 //       "learning_rate", "batch_size", "max_epochs", "patience", "validation_fraction",
 //       "normal_code_weight" (the normal code's share of the MLP loss, 1: the mesh's),
 //       "mesh_weight_floor" (0..1, default 0: the mesh weights' loss follows the vertex error; a floor
-//       shares that much of it evenly over the components), "max_training_seconds", "test_fraction", "temporal_time_constant", "seed", "bc5_baseline",
-//       "input_joints" (the network's Theta joints; absent: part1.input_joints, the thinning joints;
+//       shares that much of it evenly over the components), "max_training_seconds", "test_fraction",
+//       "temporal_time_constant", "seed", "bc5_baseline", "input_joints" (the network's Theta joints; absent:
+//       part1.input_joints, the thinning joints;
 //                       checked against the character before part 1 simulates anything)
 //     }
 //   }
@@ -56,8 +57,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/pipeline/part2_training.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
+#include "swish/bake/pipeline/part2_training.hpp"
 
 namespace swish::bake {
 

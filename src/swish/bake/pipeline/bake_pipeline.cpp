@@ -7,13 +7,13 @@
 #include <optional>
 #include <set>
 
-#include "swish/bake/report/bake_report.hpp"
-#include "swish/bake/poses/clip_list.hpp"
-#include "swish/bake/report/subject_evaluation.hpp"
-#include "swish/files/json_file.hpp"
 #include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/poses/clip_list.hpp"
+#include "swish/bake/report/bake_report.hpp"
+#include "swish/bake/report/subject_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/files/json_file.hpp"
 #include "swish/model/model_file.hpp"
 
 namespace swish::bake {
@@ -47,7 +47,8 @@ std::string fingerprint(const BakeConfig& cfg) {
 
 // The model file already holds the result of this dataset + settings?
 bool part2Current(const BakeConfig& cfg) {
-  if (!std::filesystem::exists(cfg.modelPath()) || !std::filesystem::exists(cfg.reportDir() / "report.json")) return false;
+  if (!std::filesystem::exists(cfg.modelPath()) || !std::filesystem::exists(cfg.reportDir() / "report.json"))
+    return false;
   try {
     const Model m = loadModel(cfg.modelPath());
     const auto meta = nlohmann::json::parse(m.metadata);
@@ -66,7 +67,8 @@ std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const
   for (const auto& subject : s.holdoutSubjects) held.insert(normaliseSubject(subject));
   for (const ClipSource& c : s.clips) (held.count(normaliseSubject(c.subject)) ? heldOut : training).clips.push_back(c);
   if (held.empty()) return {training, heldOut};
-  if (training.clips.empty()) throw Error("bake part 1: part1.holdout holds out every clip: nothing is left to train on");
+  if (training.clips.empty())
+    throw Error("bake part 1: part1.holdout holds out every clip: nothing is left to train on");
   // Frames as a game plays them, one character, unmirrored; nothing added, nothing previewed.
   heldOut.evenPoses = s.holdoutPoses;
   heldOut.includeRestPose = false;
@@ -93,7 +95,8 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
     part1Settings.simulatedPoseList = opt.simulatedPoseList;
     const auto [training, heldOut] = splitHeldOutSubjects(part1Settings);
-    const DatasetBuildResult part1 = buildDataset(training, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
+    const DatasetBuildResult part1 =
+        buildDataset(training, cfg.dataset, cfg.simulationDir(), cfg.previewDir(), opt.log);
     if (!heldOut.clips.empty()) {
       log("part 1: the held-out subjects' frames: " + std::to_string(heldOut.clips.size()) + " clips -> " +
           cfg.holdoutDatasetDir().string());
@@ -115,7 +118,8 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     log(line);
   } else if (!std::filesystem::exists(cfg.dataset / "manifest.json")) {
     if (cfg.part1)
-      throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() + " (no manifest.json): part 1 has not run");
+      throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
+                  " (no manifest.json): part 1 has not run");
     throw Error("bake '" + cfg.name + "': no dataset at " + cfg.dataset.string() +
                 " (no manifest.json) and no \"part1\" section to make one");
   } else if (cfg.part1) {
@@ -160,8 +164,8 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
                   "part 2: held-out subjects: %zu poses, vertex error mean %.2f mm, p95 %.2f mm (rest shape skinned "
                   "%.2f / %.2f mm); random held-out frames of training clips %.2f / %.2f mm",
                   subjects->overall.poses, subjects->overall.totalMm.mean, subjects->overall.totalMm.p95,
-                  subjects->overall.restSkinnedMm.mean, subjects->overall.restSkinnedMm.p95, out.evaluation.totalMm.mean,
-                  out.evaluation.totalMm.p95);
+                  subjects->overall.restSkinnedMm.mean, subjects->overall.restSkinnedMm.p95,
+                  out.evaluation.totalMm.mean, out.evaluation.totalMm.p95);
     log(line);
   }
   Model model = out.model;
@@ -176,8 +180,9 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   res.part2Seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   char line[256];
-  std::snprintf(line, sizeof line, "done in %.1f s: model %s, report %s; held-out vertex error mean %.2f mm, p95 %.2f mm",
-                res.seconds, res.model.string().c_str(), res.report.string().c_str(), out.evaluation.totalMm.mean,
+  std::snprintf(line, sizeof line,
+                "done in %.1f s: model %s, report %s; held-out vertex error mean %.2f mm, p95 %.2f mm", res.seconds,
+                res.model.string().c_str(), res.report.string().c_str(), out.evaluation.totalMm.mean,
                 out.evaluation.totalMm.p95);
   log(line);
   return res;

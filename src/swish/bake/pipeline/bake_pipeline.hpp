@@ -13,14 +13,14 @@
 namespace swish::bake {
 
 struct BakeRunOptions {
-  bool force = false;                                  // redo part 2 even if its output is current
+  bool force = false;  // redo part 2 even if its output is current
   // Run one part only (a cluster bake runs them as separate jobs, swish/cluster/): without part 1 the
   // dataset must exist; without part 2 the run ends when the dataset is written.
   bool part1 = true, part2 = true;
   // Nonzero: part 1's simulations were made by a cluster's array tasks for this pose list
   // (DatasetBuildSettings::simulatedPoseList); part 1 then only checks, transfers and writes the dataset.
   uint64_t simulatedPoseList = 0;
-  std::function<void(const std::string& line)> log;    // progress lines (stage, %, time left)
+  std::function<void(const std::string& line)> log;  // progress lines (stage, %, time left)
 };
 
 struct BakeRunResult {

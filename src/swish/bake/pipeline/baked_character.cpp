@@ -38,9 +38,11 @@ fs::path findBakeFile(const std::string& name, const fs::path& modelFile) {
 BakedCharacter findBakedCharacter(const std::string& modelMetadataJson, const fs::path& modelFile) {
   BakedCharacter out;
   const json meta = json::parse(modelMetadataJson, nullptr, false);
-  if (meta.is_discarded() || !meta.is_object() || !meta.contains("dataset_settings") || !meta["dataset_settings"].is_object()) {
-    out.problem = "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character "
-                  "it was baked on is unknown";
+  if (meta.is_discarded() || !meta.is_object() || !meta.contains("dataset_settings") ||
+      !meta["dataset_settings"].is_object()) {
+    out.problem =
+        "the model's metadata has no bake settings (\"dataset_settings\", written by swish bake): the character "
+        "it was baked on is unknown";
     return out;
   }
   out.datasetSettings = meta["dataset_settings"];
@@ -61,9 +63,11 @@ BakedCharacter findBakedCharacter(const std::string& modelMetadataJson, const fs
     out.kind = BakedCharacter::Kind::Recipe;
     out.named = recipe;
     s.characterRecipe = findBakeFile(recipe, modelFile);
-    out.description = "the default character from recipe " + (s.characterRecipe.empty() ? recipe : s.characterRecipe.string());
+    out.description =
+        "the default character from recipe " + (s.characterRecipe.empty() ? recipe : s.characterRecipe.string());
     if (s.characterRecipe.empty())
-      out.problem = "the bake's character recipe " + recipe + " is not at hand (looked as written and beside the model)";
+      out.problem =
+          "the bake's character recipe " + recipe + " is not at hand (looked as written and beside the model)";
   } else {
     out.kind = BakedCharacter::Kind::EmbeddedDefault;
     out.description = "the embedded default character, rebuilt by code";
@@ -87,8 +91,9 @@ Character characterToDraw(const std::string& choice, const std::string& modelMet
     return makeDefaultCharacter();
   }
   if (!baked.problem.empty())
-    throw Error(modelFile.string() + ": " + baked.problem + "; pass --character FILE with the character the model was baked on (" +
-                baked.named + "), or --character default (the embedded mannequin) or none");
+    throw Error(modelFile.string() + ": " + baked.problem +
+                "; pass --character FILE with the character the model was baked on (" + baked.named +
+                "), or --character default (the embedded mannequin) or none");
   label = "the body it was baked on, " + baked.description;
   return loadDatasetCharacter(baked.settings);
 }

@@ -13,12 +13,12 @@ namespace swish::bake {
 
 struct BakedCharacter {
   enum class Kind { Unknown, EmbeddedDefault, Recipe, File };
-  Kind kind = Kind::Unknown;        // Unknown: the metadata names no bake (a procedural or hand-made model)
-  DatasetBuildSettings settings;    // the character fields, and the bake's input joints when it named them
-  std::string description;          // "the embedded default character", "recipe <path>", "<path>"
-  std::string named;                // the file the bake named (Recipe, File), as written
-  std::string problem;              // non-empty: why the character cannot be had here (e.g. the file is missing)
-  nlohmann::json datasetSettings;   // the metadata's "dataset_settings" object (null when Unknown)
+  Kind kind = Kind::Unknown;       // Unknown: the metadata names no bake (a procedural or hand-made model)
+  DatasetBuildSettings settings;   // the character fields, and the bake's input joints when it named them
+  std::string description;         // "the embedded default character", "recipe <path>", "<path>"
+  std::string named;               // the file the bake named (Recipe, File), as written
+  std::string problem;             // non-empty: why the character cannot be had here (e.g. the file is missing)
+  nlohmann::json datasetSettings;  // the metadata's "dataset_settings" object (null when Unknown)
 
   bool available() const { return kind != Kind::Unknown && problem.empty(); }
 };

@@ -12,15 +12,15 @@
 #include <tbb/task_arena.h>
 
 #include "swish/bake/character/default_character.hpp"
-#include "swish/bake/dataset/dataset_preview.hpp"
 #include "swish/bake/cloth/pose_driver.hpp"
+#include "swish/bake/dataset/dataset_preview.hpp"
 #include "swish/bake/poses/pose_thinning.hpp"
-#include "swish/runtime/theta.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
+#include "swish/files/atomic_write.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/io/character_import.hpp"
-#include "swish/files/atomic_write.hpp"
+#include "swish/runtime/theta.hpp"
 
 namespace swish::bake {
 
@@ -34,8 +34,8 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 // "simulation  40% (80/200)  12.0 s elapsed, about 18.0 s left" - the same shape for every long step.
 std::string progressLine(const std::string& step, size_t done, size_t total, double elapsed, double left) {
   char line[256];
-  std::snprintf(line, sizeof line, "part 1: %-10s %3.0f%% (%zu/%zu) %7.1f s elapsed, about %7.1f s left",
-                step.c_str(), total ? 100.0 * double(done) / double(total) : 100.0, done, total, elapsed, left);
+  std::snprintf(line, sizeof line, "part 1: %-10s %3.0f%% (%zu/%zu) %7.1f s elapsed, about %7.1f s left", step.c_str(),
+                total ? 100.0 * double(done) / double(total) : 100.0, done, total, elapsed, left);
   return line;
 }
 
@@ -127,8 +127,8 @@ std::vector<AnimationClip> importClips(const std::vector<ClipSource>& sources, c
       o.framesPerSecond = c.framesPerSecond;
       clips[i] = io::importAnimation(c.file, skeleton, o);
       if (c.expectedFrames > 0 && clips[i].frames.size() != c.expectedFrames)
-        errors[i] = c.file.string() + ": " + std::to_string(clips[i].frames.size()) + " frames, but its index file says " +
-                    std::to_string(c.expectedFrames);
+        errors[i] = c.file.string() + ": " + std::to_string(clips[i].frames.size()) +
+                    " frames, but its index file says " + std::to_string(c.expectedFrames);
     } catch (const Error& e) {
       const std::string what = e.what();
       errors[i] = what.find(c.file.string()) == std::string::npos ? c.file.string() + ": " + what : what;
@@ -159,10 +159,12 @@ std::vector<AnimationClip> importClips(const std::vector<ClipSource>& sources, c
     }
     std::string subjects;
     for (const auto& [subject, n] : perSubject)
-      subjects += (subjects.empty() ? "" : ", ") + (subject.empty() ? std::string("(none)") : subject) + ": " + std::to_string(n);
+      subjects += (subjects.empty() ? "" : ", ") + (subject.empty() ? std::string("(none)") : subject) + ": " +
+                  std::to_string(n);
     char line[160];
-    std::snprintf(line, sizeof line, "part 1: %zu clips, %zu frames read and retargeted in %.2f s; clips per subject: ",
-                  clips.size(), frames, since(start));
+    std::snprintf(line, sizeof line,
+                  "part 1: %zu clips, %zu frames read and retargeted in %.2f s; clips per subject: ", clips.size(),
+                  frames, since(start));
     log(line + subjects);
   }
   return clips;
@@ -195,8 +197,8 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   for (const ClipSource& c : clips) {
     nlohmann::json m = nlohmann::json::object();
     for (const auto& [a, b] : c.jointMap) m[a] = b;
-    clipList.push_back({{"file", c.file.string()}, {"naming", namingName(c.naming)}, {"joint_map", m},
-                        {"fps", c.framesPerSecond}});
+    clipList.push_back(
+        {{"file", c.file.string()}, {"naming", namingName(c.naming)}, {"joint_map", m}, {"fps", c.framesPerSecond}});
     // Keys that decide the poses only where they are set, so recipes without them keep their datasets.
     if (!c.jointChains.empty()) {
       io::JointMapOptions o;
@@ -209,26 +211,43 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   const ClothSimSettings& m = simulation;
   nlohmann::json out = {
       {"character",
-       {{"file", characterFile.string()}, {"recipe", characterRecipe.string()}, {"body_mesh", bodyMeshNames},
-        {"garment_mesh", garmentMeshNames}, {"simulation_mesh", simulationMeshNames}}},
+       {{"file", characterFile.string()},
+        {"recipe", characterRecipe.string()},
+        {"body_mesh", bodyMeshNames},
+        {"garment_mesh", garmentMeshNames},
+        {"simulation_mesh", simulationMeshNames}}},
       {"clips", clipList},
       {"input_joints", inputJoints},
       {"sampling",
-       {{"characters", sampling.characters}, {"seconds_per_character", sampling.secondsPerCharacter},
-        {"sample_rate", sampling.sampleRate}, {"mirror_odd_characters", sampling.mirrorOddCharacters},
-        {"speed_jitter", sampling.speedJitter}, {"seed", sampling.seed}}},
-      {"thinning", {{"tolerance", thinningTolerance}, {"target_poses", targetPoses}, {"include_rest_pose", includeRestPose}}},
+       {{"characters", sampling.characters},
+        {"seconds_per_character", sampling.secondsPerCharacter},
+        {"sample_rate", sampling.sampleRate},
+        {"mirror_odd_characters", sampling.mirrorOddCharacters},
+        {"speed_jitter", sampling.speedJitter},
+        {"seed", sampling.seed}}},
+      {"thinning",
+       {{"tolerance", thinningTolerance}, {"target_poses", targetPoses}, {"include_rest_pose", includeRestPose}}},
       {"simulation",
-       {{"preset", m.material.name}, {"vertices", simulationVertices}, {"thickness", m.thickness},
-        {"transition_seconds", m.transitionSeconds}, {"settle_seconds", m.settleSeconds},
-        {"frame_rate", m.frameRate}, {"substeps", m.substeps}, {"iterations", m.iterations},
-        {"gravity", -m.gravity.y()}, {"limb_clearance", limbClearance.clearance}, {"attach_band", m.attachTopFraction}}},
+       {{"preset", m.material.name},
+        {"vertices", simulationVertices},
+        {"thickness", m.thickness},
+        {"transition_seconds", m.transitionSeconds},
+        {"settle_seconds", m.settleSeconds},
+        {"frame_rate", m.frameRate},
+        {"substeps", m.substeps},
+        {"iterations", m.iterations},
+        {"gravity", -m.gravity.y()},
+        {"limb_clearance", limbClearance.clearance},
+        {"attach_band", m.attachTopFraction}}},
       {"transfer",
-       {{"smoothing_strength", transfer.smoothing.strength}, {"smoothing_iterations", transfer.smoothing.iterations},
+       {{"smoothing_strength", transfer.smoothing.strength},
+        {"smoothing_iterations", transfer.smoothing.iterations},
         {"smoothing_weights", transfer.smoothing.weights == LaplacianWeights::Cotangent ? "cotangent" : "uniform"}}},
       {"normal_maps",
-       {{"size", transfer.normalMap.width}, {"max_distance", transfer.normalMap.maxDistance},
-        {"dilation_rings", transfer.normalMap.dilationRings}, {"bit_depth", normalMapBitDepth}}},
+       {{"size", transfer.normalMap.width},
+        {"max_distance", transfer.normalMap.maxDistance},
+        {"dilation_rings", transfer.normalMap.dilationRings},
+        {"bit_depth", normalMapBitDepth}}},
   };
   // Set only where used, so that recipes without them keep their datasets.
   if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
@@ -243,15 +262,21 @@ nlohmann::json DatasetBuildResult::toJson() const {
   for (const FailedPose& p : failed) f.push_back({{"pose", p.id}, {"reason", p.reason}});
   nlohmann::json st = nlohmann::json::array();
   for (const DatasetBuildStep& s : steps) st.push_back({{"step", s.name}, {"seconds", s.seconds}});
-  return {{"clip_frames", clipFrames},     {"samples", samples},
-          {"kept_poses", keptPoses},       {"rest_pose_added", restPoseAdded},
+  return {{"clip_frames", clipFrames},
+          {"samples", samples},
+          {"kept_poses", keptPoses},
+          {"rest_pose_added", restPoseAdded},
           {"tolerance", tolerance},
-          {"poses_corrected", posesCorrected}, {"max_correction_degrees", maxCorrectionDegrees},
+          {"poses_corrected", posesCorrected},
+          {"max_correction_degrees", maxCorrectionDegrees},
           {"max_correction_towards_rest", maxTowardsRest},
           {"simulation_vertices", simulationVertices},
-          {"simulated", simulated},        {"simulations_reused", simulationsReused},
-          {"transferred", transferred},    {"transfers_reused", transfersReused},
-          {"failed", f},                   {"rebuilt", rebuilt},
+          {"simulated", simulated},
+          {"simulations_reused", simulationsReused},
+          {"transferred", transferred},
+          {"transfers_reused", transfersReused},
+          {"failed", f},
+          {"rebuilt", rebuilt},
           {"steps", st}};
 }
 
@@ -310,8 +335,8 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   so.joints = s.inputJoints;
   if (std::any_of(s.clips.begin(), s.clips.end(), [](const ClipSource& c) { return c.weight != 1.0; }))
     for (const ClipSource& c : s.clips) so.clipWeights.push_back(c.weight);
-  const PoseSamples samples = s.evenPoses > 0 ? evenlySpacedFrames(clips, s.evenPoses)
-                                             : samplePoses(character.skeleton, clips, so);
+  const PoseSamples samples =
+      s.evenPoses > 0 ? evenlySpacedFrames(clips, s.evenPoses) : samplePoses(character.skeleton, clips, so);
   res.samples = samples.origins.size();
   ThinningResult thin;
   if (s.evenPoses > 0) {
@@ -325,8 +350,10 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   for (uint32_t k : thin.kept) {
     const PoseSamples::Origin& o = samples.origins[k];
     poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, o)));
-    res.origins.push_back({{"clip", s.clips[o.clip].file.stem().string()}, {"subject", s.clips[o.clip].subject},
-                           {"frame", o.frame}, {"mirrored", o.mirrored}});
+    res.origins.push_back({{"clip", s.clips[o.clip].file.stem().string()},
+                           {"subject", s.clips[o.clip].subject},
+                           {"frame", o.frame},
+                           {"mirrored", o.mirrored}});
   }
   {
     char line[200];
@@ -344,7 +371,8 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
     }
     char line[200];
     std::snprintf(line, sizeof line, "part 1: the rest pose is %.4f from the nearest kept pose: ", double(nearest));
-    log(line + (res.restPoseAdded ? "added as pose " + std::to_string(poses.size() - 1) : std::string("already covered")));
+    log(line +
+        (res.restPoseAdded ? "added as pose " + std::to_string(poses.size() - 1) : std::string("already covered")));
   }
   res.keptPoses = poses.size();
   step("sampling + thinning", t);
@@ -376,11 +404,12 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
     }
     if (!clearance.skipped().empty()) log("part 1: limb clearance skipped: " + clearance.skipped());
     char line[240];
-    if (clearance.limbCount() > 0) std::snprintf(line, sizeof line,
-                  "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk (%zu limbs of the body "
-                  "checked); turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
-                  1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
-                  double(res.maxCorrectionDegrees), stillInside, since(t));
+    if (clearance.limbCount() > 0)
+      std::snprintf(line, sizeof line,
+                    "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk (%zu limbs of the body "
+                    "checked); turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
+                    1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
+                    double(res.maxCorrectionDegrees), stillInside, since(t));
     if (clearance.limbCount() > 0) log(line);
     if (clearance.checksHead()) {
       for (const auto& c : corrections)
@@ -431,8 +460,9 @@ DatasetPoseList listDatasetPoses(const DatasetBuildSettings& s, DatasetBuildResu
   return out;
 }
 
-DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir, const fs::path& simulationDir,
-                                const fs::path& previewDir, const std::function<void(const std::string&)>& logFn) {
+DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& datasetDir,
+                                const fs::path& simulationDir, const fs::path& previewDir,
+                                const std::function<void(const std::string&)>& logFn) {
   auto log = [&](const std::string& line) {
     if (logFn) logFn(line);
   };
@@ -463,14 +493,16 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     buildTransitionFrames(character.skeleton, poses, clip, markers);
     std::vector<uint32_t> targetFrames;
     for (const TransitionMarker& m : markers) targetFrames.push_back(m.targetFrame);
-    external = std::make_unique<ExternalShapeSource>(s.external, shapes.solver().mesh().restPositions,
-                                                     shapes.solver().mesh().triangles, targetFrames,
-                                                     poseListDigest(poses));
+    external =
+        std::make_unique<ExternalShapeSource>(s.external, shapes.solver().mesh().restPositions,
+                                              shapes.solver().mesh().triangles, targetFrames, poseListDigest(poses));
     log("part 1: " + external->description());
     if (external->maxBindingDistance() > 0.f) {
       char line[160];
-      std::snprintf(line, sizeof line, "part 1: re-meshed garment bound to the simulation mesh: farthest vertex %.2f mm "
-                    "from the re-meshed rest surface", 1000.0 * external->maxBindingDistance());
+      std::snprintf(line, sizeof line,
+                    "part 1: re-meshed garment bound to the simulation mesh: farthest vertex %.2f mm "
+                    "from the re-meshed rest surface",
+                    1000.0 * external->maxBindingDistance());
       log(line);
     }
     // A changed result file of an external tool changes the shapes: rebuild the dataset's poses.
@@ -491,7 +523,8 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   PoseSimulationRun sim;
   log("part 1: simulation mesh " + std::to_string(res.simulationVertices) + " vertices, " +
       std::to_string(solver.mesh().triangles.rows()) + " triangles" +
-      (external ? std::string(", shapes from the external simulation") : ", preset '" + s.simulation.material.name + "'"));
+      (external ? std::string(", shapes from the external simulation")
+                : ", preset '" + s.simulation.material.name + "'"));
   if (s.simulatedPoseList != 0 && !external) {
     // Made by a cluster's array tasks: every pose must be there; none is simulated here.
     std::vector<uint32_t> missing;
@@ -529,7 +562,8 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   std::mutex mutex;
   std::vector<uint32_t> todo;
   for (uint32_t id = 0; id < poses.size(); ++id) {
-    const bool failed = std::any_of(sim.failures.begin(), sim.failures.end(), [&](const auto& f) { return f.first == id; });
+    const bool failed =
+        std::any_of(sim.failures.begin(), sim.failures.end(), [&](const auto& f) { return f.first == id; });
     if (failed) continue;
     if (writer.hasPose(id))
       ++res.transfersReused;
@@ -563,9 +597,10 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
           dp.residuals = solver.measure(poses[id], positions);
           if (dp.residuals.maxPenetration > s.simulation.failPenetration) {
             char line[200];
-            std::snprintf(line, sizeof line, "part 1: pose %u (external): the garment ends %.1f mm inside the body "
-                          "(the solver's bound is %.1f mm); kept, as the external tool made it", id,
-                          1000.0 * dp.residuals.maxPenetration, 1000.0 * s.simulation.failPenetration);
+            std::snprintf(line, sizeof line,
+                          "part 1: pose %u (external): the garment ends %.1f mm inside the body "
+                          "(the solver's bound is %.1f mm); kept, as the external tool made it",
+                          id, 1000.0 * dp.residuals.maxPenetration, 1000.0 * s.simulation.failPenetration);
             std::lock_guard<std::mutex> lock(mutex);
             log(line);
           }
@@ -610,7 +645,9 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     tbb::parallel_for(size_t(0), total, size_t(1), one);
   }
   std::sort(res.failed.begin(), res.failed.end(), [](const FailedPose& a, const FailedPose& b) { return a.id < b.id; });
-  nlohmann::json source = {{"tool", "swish bake (part 1)"}, {"samples", res.samples}, {"kept_poses", res.keptPoses},
+  nlohmann::json source = {{"tool", "swish bake (part 1)"},
+                           {"samples", res.samples},
+                           {"kept_poses", res.keptPoses},
                            {"simulation_vertices", res.simulationVertices}};
   if (external) source["simulation"] = external->description();
   writer.writeManifest(res.failed, source);

@@ -26,13 +26,13 @@
 #include <nlohmann/json.hpp>
 
 #include "swish/bake/cloth/cloth_solver.hpp"
-#include "swish/bake/dataset/dataset_io.hpp"
 #include "swish/bake/cloth/external_simulation.hpp"
-#include "swish/bake/poses/pose_sampling.hpp"
-#include "swish/bake/pipeline/pose_shape.hpp"
-#include "swish/bake/transfer/pose_transfer.hpp"
-#include "swish/bake/poses/limb_clearance.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
+#include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/pipeline/pose_shape.hpp"
+#include "swish/bake/poses/limb_clearance.hpp"
+#include "swish/bake/poses/pose_sampling.hpp"
+#include "swish/bake/transfer/pose_transfer.hpp"
 #include "swish/io/joint_map.hpp"
 
 namespace swish::bake {
@@ -61,7 +61,7 @@ struct DatasetBuildSettings {
   // Joints a later step reads (part 2's train.input_joints), checked against the character with
   // inputJoints before any simulation; they do not enter the dataset or its fingerprint.
   std::vector<std::string> alsoRequiredJoints;
-  PoseSamplingOptions sampling;   // .joints is replaced by inputJoints
+  PoseSamplingOptions sampling;  // .joints is replaced by inputJoints
 
   // Whole subjects kept out of training (part1.holdout): their clips are not sampled for the dataset;
   // the bake simulates `holdoutPoses` frames of them, evenly spaced over their clips, into a second
@@ -90,7 +90,7 @@ struct DatasetBuildSettings {
   // Limbs that pass into the trunk are turned out of it before simulating (limb_clearance.hpp);
   // clearance 0 turns this off.
   LimbClearanceSettings limbClearance;
-  int threads = 0;                 // 0: all cores (TBB's default)
+  int threads = 0;  // 0: all cores (TBB's default)
 
   PoseTransferSettings transfer;
   uint32_t normalMapBitDepth = 16;
@@ -133,14 +133,14 @@ struct DatasetBuildStep {
 };
 
 struct DatasetBuildResult {
-  size_t clipFrames = 0;           // frames over all clips
-  size_t samples = 0;              // Theta samples before thinning
-  size_t keptPoses = 0;            // after thinning (the rest pose included when it was added)
-  bool restPoseAdded = false;      // the rest pose was appended to the thinned poses (its id: keptPoses - 1)
-  size_t posesCorrected = 0;       // poses whose limbs (or one-surface head) were turned out of the body
+  size_t clipFrames = 0;       // frames over all clips
+  size_t samples = 0;          // Theta samples before thinning
+  size_t keptPoses = 0;        // after thinning (the rest pose included when it was added)
+  bool restPoseAdded = false;  // the rest pose was appended to the thinned poses (its id: keptPoses - 1)
+  size_t posesCorrected = 0;   // poses whose limbs (or one-surface head) were turned out of the body
   float maxCorrectionDegrees = 0.f;
-  float maxTowardsRest = 0.f;      // head clearance: the largest fraction of the neck turned back to rest
-  float tolerance = 0.f;           // the thinning tolerance used
+  float maxTowardsRest = 0.f;  // head clearance: the largest fraction of the neck turned back to rest
+  float tolerance = 0.f;       // the thinning tolerance used
   size_t simulationVertices = 0;
   size_t simulated = 0, simulationsReused = 0;
   size_t transferred = 0, transfersReused = 0;
@@ -158,13 +158,13 @@ struct DatasetBuildResult {
 // What a cluster bake computes once before it submits (the pose list its array tasks share), and
 // what buildDataset starts with.
 struct DatasetPosePlan {
-  std::unique_ptr<const Character> character;    // the shapes below point into it
+  std::unique_ptr<const Character> character;  // the shapes below point into it
   std::vector<uint32_t> inputJoints;
-  std::vector<Pose> recorded;                    // the thinned poses as the clips hold them (the dataset keeps these)
-  std::vector<Pose> toSimulate;                  // the same with limbs turned out of the trunk: what is simulated
+  std::vector<Pose> recorded;    // the thinned poses as the clips hold them (the dataset keeps these)
+  std::vector<Pose> toSimulate;  // the same with limbs turned out of the trunk: what is simulated
   std::unique_ptr<const PoseShapeSimulator> shapes;
-  nlohmann::json settingsJson;                   // <dataset>/part1_settings.json: settings + pose list digest
-  DatasetBuildResult result;                     // filled up to here (counts, corrections, steps)
+  nlohmann::json settingsJson;  // <dataset>/part1_settings.json: settings + pose list digest
+  DatasetBuildResult result;    // filled up to here (counts, corrections, steps)
 
   // The simulation file fingerprint of each pose (cloth/pose_driver.hpp), in pose id order.
   std::vector<uint64_t> poseFingerprints() const;
@@ -181,13 +181,13 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& settings,
 // the rest pose added, limb clearance applied. `swish bake --export-poses` writes these out for an
 // external cloth tool (pose_export.hpp); buildDataset goes on to simulate them.
 struct DatasetPoseList {
-  std::unique_ptr<const Character> character;     // owned here: `shapes` points into it
+  std::unique_ptr<const Character> character;  // owned here: `shapes` points into it
   std::vector<uint32_t> inputJoints;
-  std::vector<Pose> recorded;                     // what the dataset stores (the root canonical)
-  std::vector<Pose> simulated;                    // recorded, limbs turned out of the trunk: what is simulated
+  std::vector<Pose> recorded;                        // what the dataset stores (the root canonical)
+  std::vector<Pose> simulated;                       // recorded, limbs turned out of the trunk: what is simulated
   std::unique_ptr<const PoseShapeSimulator> shapes;  // simulation mesh, solver, transfer
   float thinningTolerance = 0.f;
-  uint64_t digest = 0;                            // of `simulated`: a different list means other pose ids
+  uint64_t digest = 0;  // of `simulated`: a different list means other pose ids
 };
 // planDatasetPoses in the shape the pose export reads. Fills res's pose counts and steps as buildDataset
 // does. Throws Error as buildDataset does.

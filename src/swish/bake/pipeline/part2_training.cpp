@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "swish/bake/compression/bc5_baseline.hpp"
-#include "swish/bake/training/model_builder.hpp"
 #include "swish/bake/training/body_proxy_fit.hpp"
+#include "swish/bake/training/model_builder.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/runtime/theta.hpp"
@@ -15,26 +15,26 @@ namespace swish::bake {
 
 nlohmann::json BakeTrainSettings::toJson() const {
   nlohmann::json j = {{"mesh_components", meshComponents},
-          {"mesh_variance", meshVariance},
-          {"normal_code_dims", normalCodeDims},
-          {"database_size", databaseSize},
-          {"codebook_size", vq.codebookSize},
-          {"vq_training_blocks", vq.trainingBlocks},
-          {"vq_iterations", vq.iterations},
-          {"hidden_layers", mlp.hiddenLayers},
-          {"hidden_width", mlp.hiddenWidth},
-          {"activation", activationName(mlp.activation)},
-          {"learning_rate", mlp.learningRate},
-          {"batch_size", mlp.batchSize},
-          {"max_epochs", mlp.maxEpochs},
-          {"patience", mlp.patience},
-          {"validation_fraction", mlp.validationFraction},
-          {"normal_code_weight", normalCodeWeight},
-          {"mesh_weight_floor", meshWeightFloor},
-          {"max_training_seconds", mlp.maxSeconds},
-          {"test_fraction", testFraction},
-          {"temporal_time_constant", temporalTimeConstant},
-          {"seed", seed}};
+                      {"mesh_variance", meshVariance},
+                      {"normal_code_dims", normalCodeDims},
+                      {"database_size", databaseSize},
+                      {"codebook_size", vq.codebookSize},
+                      {"vq_training_blocks", vq.trainingBlocks},
+                      {"vq_iterations", vq.iterations},
+                      {"hidden_layers", mlp.hiddenLayers},
+                      {"hidden_width", mlp.hiddenWidth},
+                      {"activation", activationName(mlp.activation)},
+                      {"learning_rate", mlp.learningRate},
+                      {"batch_size", mlp.batchSize},
+                      {"max_epochs", mlp.maxEpochs},
+                      {"patience", mlp.patience},
+                      {"validation_fraction", mlp.validationFraction},
+                      {"normal_code_weight", normalCodeWeight},
+                      {"mesh_weight_floor", meshWeightFloor},
+                      {"max_training_seconds", mlp.maxSeconds},
+                      {"test_fraction", testFraction},
+                      {"temporal_time_constant", temporalTimeConstant},
+                      {"seed", seed}};
   if (!inputJoints.empty()) j["input_joints"] = inputJoints;  // absent: the dataset's (older fingerprints stay)
   return j;
 }
@@ -48,7 +48,8 @@ std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSetti
   std::vector<uint32_t> out;
   for (const std::string& name : st.inputJoints) {
     const int j = ds.character.skeleton.find(name);
-    if (j < 0) throw Error("bake: train.input_joints: the character '" + ds.character.name + "' has no joint '" + name + "'");
+    if (j < 0)
+      throw Error("bake: train.input_joints: the character '" + ds.character.name + "' has no joint '" + name + "'");
     if (std::find(out.begin(), out.end(), uint32_t(j)) != out.end())
       throw Error("bake: train.input_joints: joint '" + name + "' is named twice");
     out.push_back(uint32_t(j));
@@ -83,12 +84,14 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   // The rest pose part 1 added (part1_dataset.hpp) is always trained on, never held out: it is
   // there so that the network knows the A-pose, not to be measured.
   std::vector<uint32_t>& pinned = out.pinnedPoses;
-  const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") && ds.settings["rest_pose_id"].is_number_integer();
+  const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") &&
+                       ds.settings["rest_pose_id"].is_number_integer();
   const int64_t restId = hasRest ? ds.settings["rest_pose_id"].get<int64_t>() : int64_t(-1);
   for (size_t i = 0; i < poses; ++i)
     if (restId >= 0 && int64_t(ds.poses[i].id) == restId) pinned.push_back(uint32_t(i));
   Rng rng(st.seed);
-  IndexSplit split = seededSplit(poses, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
+  IndexSplit split =
+      seededSplit(poses, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
   out.testPoses = std::move(split.held);
   out.trainingPoses = std::move(split.kept);
   const size_t nTrain = out.trainingPoses.size();
@@ -136,7 +139,8 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       for (const NormalMapImage* m : out.databaseMaps) bc5Acc.addMaps(*m, bc5RoundTrip(*m));
       out.bc5VsUncompressed = bc5Acc.stats();
       out.bc5Bytes = uint64_t(db.mapCount()) * bc5Bytes(db.width, db.height);
-      const auto [w, h] = bc5SizeWithin(db.width, db.height, size_t(out.vq.totalBytes() / std::max<size_t>(1, db.mapCount())));
+      const auto [w, h] =
+          bc5SizeWithin(db.width, db.height, size_t(out.vq.totalBytes() / std::max<size_t>(1, db.mapCount())));
       if (w > 0) {
         AngularErrorAccumulator equalAcc;
         for (const NormalMapImage* m : out.databaseMaps) equalAcc.addMaps(*m, bc5RoundTripResized(*m, w, h));
@@ -196,8 +200,10 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     report("body proxy", 0.92);
     const BodyProxyFit fit = fitBodyProxy(ds.character.body, out.model.skeleton, &out.model.gameMesh);
     out.model.bodyProxy = fit.proxy;
-    out.metadata["body_proxy"] = {{"capsules", fit.proxy.capsules.size()}, {"joints", fit.capsuleJoints},
-                                  {"dropped", fit.dropped}, {"worst_outside_mm", fit.worstOutsideMm}};
+    out.metadata["body_proxy"] = {{"capsules", fit.proxy.capsules.size()},
+                                  {"joints", fit.capsuleJoints},
+                                  {"dropped", fit.dropped},
+                                  {"worst_outside_mm", fit.worstOutsideMm}};
     stage("body proxy");
   }
 
@@ -219,8 +225,10 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       {"mesh_explained_variance", out.meshPca.explainedVariance[K]},
       // No timings here (the report has them): the model's bytes are a function of the recipe alone.
       {"penetration", penetrationJson(ev)},
-      {"mlp", {{"best_epoch", out.regressor.bestEpoch}, {"epochs", out.regressor.epochsRun},
-               {"validation_loss", out.regressor.bestValidationLoss}}}};
+      {"mlp",
+       {{"best_epoch", out.regressor.bestEpoch},
+        {"epochs", out.regressor.epochsRun},
+        {"validation_loss", out.regressor.bestValidationLoss}}}};
   if (maps) {
     out.metadata["errors"]["normal_database"] = toJson(ev.normalDatabase);
     out.metadata["errors"]["normal_selection"] = toJson(ev.normalSelection);
@@ -229,8 +237,10 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     out.metadata["errors"]["vq_vs_uncompressed"] = toJson(out.vqVsUncompressed);
     out.metadata["errors"]["bc5_vs_uncompressed"] = toJson(out.bc5VsUncompressed);
     out.metadata["errors"]["bc5_at_vq_memory_vs_uncompressed"] = toJson(out.bc5AtVqMemoryVsUncompressed);
-    out.metadata["memory"] = {{"vq_bytes", out.vq.totalBytes()}, {"bc5_bytes", out.bc5Bytes},
-                              {"database_maps", db.mapCount()}, {"codebook_entries", db.codebookSize}};
+    out.metadata["memory"] = {{"vq_bytes", out.vq.totalBytes()},
+                              {"bc5_bytes", out.bc5Bytes},
+                              {"database_maps", db.mapCount()},
+                              {"codebook_entries", db.codebookSize}};
   }
   out.model.metadata = out.metadata.dump();
   report("done", 1.0);

@@ -8,20 +8,20 @@
 
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/report/bake_evaluation.hpp"
-#include "swish/bake/dataset/dataset.hpp"
-#include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/bake/compression/normal_map_database.hpp"
 #include "swish/bake/compression/normal_map_pca.hpp"
 #include "swish/bake/compression/vq_codebook.hpp"
+#include "swish/bake/dataset/dataset.hpp"
+#include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::bake {
 
 struct BakeTrainSettings {
-  int meshComponents = 24;         // K upper bound
-  double meshVariance = 0.0;       // if > 0: smallest K reaching this explained variance (<= meshComponents)
-  int normalCodeDims = 8;          // C (0: no normal maps in the model)
+  int meshComponents = 24;    // K upper bound
+  double meshVariance = 0.0;  // if > 0: smallest K reaching this explained variance (<= meshComponents)
+  int normalCodeDims = 8;     // C (0: no normal maps in the model)
   int databaseSize = 128;
   VqOptions vq;
   bool bc5Baseline = true;
@@ -35,7 +35,7 @@ struct BakeTrainSettings {
   // poses, K = 48, 5x192) a floor of 0.5, the earlier default, gave 3.61 mm held-out against 3.05 mm
   // with 0 (seed 2: 3.39 against 2.94; docs/baking.md).
   double meshWeightFloor = 0.0;
-  double testFraction = 0.1;       // held out for the report
+  double testFraction = 0.1;  // held out for the report
   float temporalTimeConstant = 0.1f;
   uint64_t seed = 1;
   // The network's input joints (Theta), by name; empty: the dataset's, the joints part 1 thinned the
@@ -71,7 +71,7 @@ struct BakeTrainOutput {
   std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
   std::vector<uint32_t> pinnedPoses;  // indices into dataset.poses always trained on (the rest pose part 1 added)
   std::vector<StageTime> stages;
-  nlohmann::json metadata;                          // what went into Model::metadata
+  nlohmann::json metadata;  // what went into Model::metadata
 };
 
 // Progress: (stage, fraction of part 2 done in [0, 1]).

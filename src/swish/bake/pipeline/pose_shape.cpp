@@ -53,8 +53,8 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
   // the recorded pose. The model so learns its real inputs, and the sleeves of a hanging arm pass
   // into the torso with the arm, as the body does.
   if (!samePose(simulated, recorded))
-    tp.gameMeshWorld = skinPositions(tp.gameMeshPreSkin, character_->garment.skin,
-                                     character_->skeleton.skinningMatrices(recorded));
+    tp.gameMeshWorld =
+        skinPositions(tp.gameMeshPreSkin, character_->garment.skin, character_->skeleton.skinningMatrices(recorded));
   return tp;
 }
 

@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "swish/bake/cloth/cloth_solver.hpp"
+#include "swish/bake/cloth/simulation_mesh.hpp"
 #include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/poses/limb_clearance.hpp"
 #include "swish/bake/transfer/pose_transfer.hpp"
-#include "swish/bake/cloth/simulation_mesh.hpp"
 
 namespace swish::bake {
 

@@ -139,8 +139,8 @@ struct ClipListParser {
       if (!fs::is_regular_file(p)) fail(q, "file " + p.string() + " does not exist");
       return withSubjects({p});
     }
-    static const std::set<std::string> known = {"file", "glob", "folder", "index", "naming", "joint_map", "fps",
-                                                "weight", "weights", "subject", "subjects", "exclude_subjects"};
+    static const std::set<std::string> known = {"file", "glob",   "folder",  "index",   "naming",   "joint_map",
+                                                "fps",  "weight", "weights", "subject", "subjects", "exclude_subjects"};
     if (!v.is_object()) fail(q, "must be a clip file, folder or glob (string) or an object");
     for (auto it = v.begin(); it != v.end(); ++it)
       if (!known.count(it.key())) {
@@ -152,8 +152,10 @@ struct ClipListParser {
     const bool indexFolder = v.contains("index") && v.contains("folder");
     const int sources = int(v.contains("file")) + int(v.contains("glob")) + int(v.contains("folder") && !indexFolder) +
                         int(v.contains("index"));
-    if (sources != 1) fail(q, "give exactly one of \"file\", \"glob\", \"folder\" and \"index\" (an index may add "
-                              "\"folder\": where its files are)");
+    if (sources != 1)
+      fail(q,
+           "give exactly one of \"file\", \"glob\", \"folder\" and \"index\" (an index may add "
+           "\"folder\": where its files are)");
 
     std::vector<ClipSource> clips;
     if (v.contains("file")) {
@@ -197,11 +199,16 @@ struct ClipListParser {
     io::JointNaming naming = io::JointNaming::Auto;
     if (v.contains("naming")) {
       const std::string n = text(v.at("naming"), q + ".naming");
-      if (n == "auto") naming = io::JointNaming::Auto;
-      else if (n == "same") naming = io::JointNaming::Same;
-      else if (n == "mixamo") naming = io::JointNaming::Mixamo;
-      else if (n == "unreal") naming = io::JointNaming::Unreal;
-      else fail(q + ".naming", "'" + n + "' is not one of auto, same, mixamo, unreal");
+      if (n == "auto")
+        naming = io::JointNaming::Auto;
+      else if (n == "same")
+        naming = io::JointNaming::Same;
+      else if (n == "mixamo")
+        naming = io::JointNaming::Mixamo;
+      else if (n == "unreal")
+        naming = io::JointNaming::Unreal;
+      else
+        fail(q + ".naming", "'" + n + "' is not one of auto, same, mixamo, unreal");
     }
     io::JointMapOptions map;
     if (v.contains("joint_map")) {
@@ -232,9 +239,12 @@ struct ClipListParser {
       }
       for (auto it = w.begin(); it != w.end(); ++it) {
         const double x = weightValue(it.value(), q + ".weights." + it.key());
-        if (stems.count(it.key())) byClip[it.key()] = x;
-        else if (subjects.count(normaliseSubject(it.key()))) bySubject[normaliseSubject(it.key())] = x;
-        else fail(q + ".weights." + it.key(), "names neither a clip (file stem) nor a subject of this entry");
+        if (stems.count(it.key()))
+          byClip[it.key()] = x;
+        else if (subjects.count(normaliseSubject(it.key())))
+          bySubject[normaliseSubject(it.key())] = x;
+        else
+          fail(q + ".weights." + it.key(), "names neither a clip (file stem) nor a subject of this entry");
       }
     }
     for (ClipSource& c : clips) {
@@ -243,8 +253,10 @@ struct ClipListParser {
       c.jointChains = map.chains;
       c.framesPerSecond = fps;
       c.weight = weight;
-      if (auto it = byClip.find(c.file.stem().string()); it != byClip.end()) c.weight *= it->second;
-      else if (auto s = bySubject.find(normaliseSubject(c.subject)); s != bySubject.end()) c.weight *= s->second;
+      if (auto it = byClip.find(c.file.stem().string()); it != byClip.end())
+        c.weight *= it->second;
+      else if (auto s = bySubject.find(normaliseSubject(c.subject)); s != bySubject.end())
+        c.weight *= s->second;
     }
     return clips;
   }

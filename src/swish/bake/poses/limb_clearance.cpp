@@ -41,8 +41,10 @@ int smallestClearing(int most, float before, DepthAt&& depthAt, float& after) {
   while (after <= kTolerance && hi - lo > 1) {
     const int mid = (lo + hi) / 2;
     const float d = at(mid);
-    if (d <= kTolerance) hi = mid, after = d;
-    else lo = mid;
+    if (d <= kTolerance)
+      hi = mid, after = d;
+    else
+      lo = mid;
   }
   if (tried != hi) after = at(hi);
   return hi;
@@ -68,7 +70,8 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   check(std::isfinite(settings_.maxDegrees) && settings_.maxDegrees > 0.f && settings_.maxDegrees <= 180.f,
         "maxDegrees must be in (0, 180]");
   body_.validate(what, skeleton_.size());
-  if (body_.skin.vertexCount() != body_.vertexCount()) throw Error(what + " has no skin weights: limbs cannot be posed");
+  if (body_.skin.vertexCount() != body_.vertexCount())
+    throw Error(what + " has no skin weights: limbs cannot be posed");
   if (skeleton_.inverseBind.empty()) skeleton_.computeInverseBindFromRest();
 
   // Parts of the surface, seam copies welded (a glTF body is split at its UV seams, which are not
@@ -141,7 +144,8 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
 
 std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   std::vector<LimbCorrection> out;
-  if ((limbs_.empty() && !head_) || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return out;
+  if ((limbs_.empty() && !head_) || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite())
+    return out;
   for (const Quatf& q : pose.local)
     if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
   // Measured with the root at rest, as the solver simulates it (the shape ignores the root).
@@ -327,9 +331,9 @@ std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const
   // The smallest whole percentage of the way back to rest that clears the head.
   auto depthAt = [&](int percent) {
     for (int j : h.chain)
-      p.local[size_t(j)] = slerpShortest(recorded.local[size_t(j)], skeleton_.joints[size_t(j)].rest.rotation,
-                                         float(percent) / 100.f)
-                               .normalized();
+      p.local[size_t(j)] =
+          slerpShortest(recorded.local[size_t(j)], skeleton_.joints[size_t(j)].rest.rotation, float(percent) / 100.f)
+              .normalized();
     return measure();
   };
   float after = before;

@@ -40,15 +40,16 @@
 namespace swish::bake {
 
 struct LimbClearanceSettings {
-  float clearance = 0.015f;   // m between a limb and the trunk: room for two layers of cloth
-  float rootRadius = 0.10f;   // m: limb vertices this close to their root joint are not checked
-  float maxDegrees = 60.f;    // the largest correction; a limb still inside after it is reported
-  float headBorder = 0.03f;   // m: one-surface bodies' head vertices this close to the rest of the body at rest are not checked
+  float clearance = 0.015f;  // m between a limb and the trunk: room for two layers of cloth
+  float rootRadius = 0.10f;  // m: limb vertices this close to their root joint are not checked
+  float maxDegrees = 60.f;   // the largest correction; a limb still inside after it is reported
+  float headBorder =
+      0.03f;  // m: one-surface bodies' head vertices this close to the rest of the body at rest are not checked
 };
 
 struct LimbCorrection {
-  std::string joint;       // the root joint that was rotated
-  float degrees = 0.f;     // by how much
+  std::string joint;        // the root joint that was rotated
+  float degrees = 0.f;      // by how much
   float depthBefore = 0.f;  // m: how far the limb was inside the clearance before
   float depthAfter = 0.f;   // after (0 when cleared)
   // Head clearance only (joint: the head joint): the fraction of the way back to rest the neck chain
@@ -75,7 +76,7 @@ class LimbClearance {
  private:
   struct Limb {
     int rootJoint = -1;
-    std::vector<uint32_t> vertices;  // checked vertices
+    std::vector<uint32_t> vertices;   // checked vertices
     std::vector<float> restDistance;  // their signed distance to the trunk at rest
   };
   Skeleton skeleton_;
@@ -86,9 +87,9 @@ class LimbClearance {
   std::string skipped_;
 
   struct Head {
-    int joint = -1;               // the head joint
-    std::vector<int> chain;       // the joints turned back to rest: the head joint and its neck ancestors
-    std::vector<uint32_t> vertices;  // checked head vertices
+    int joint = -1;                     // the head joint
+    std::vector<int> chain;             // the joints turned back to rest: the head joint and its neck ancestors
+    std::vector<uint32_t> vertices;     // checked head vertices
     std::optional<BodyCollider> rest;   // the body without the head's triangles, unposed
     std::optional<BodyCollider> whole;  // the whole closed body, unposed: its winding number confirms inside
     int wholePart = 0;

@@ -57,8 +57,8 @@ Pose mirrorPose(const Skeleton& skeleton, const Pose& pose) {
 
 Pose poseOfSample(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
                   const PoseSamples::Origin& origin) {
-  if (origin.clip >= clips.size()) throw Error("pose sample refers to clip " + std::to_string(origin.clip) +
-                                               " of " + std::to_string(clips.size()));
+  if (origin.clip >= clips.size())
+    throw Error("pose sample refers to clip " + std::to_string(origin.clip) + " of " + std::to_string(clips.size()));
   const AnimationClip& clip = clips[origin.clip];
   checkClip(skeleton, clip, origin.clip);
   Pose p;
@@ -79,7 +79,8 @@ PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationCli
   for (size_t c = 0; c < clips.size(); ++c) checkClip(skeleton, clips[c], c);
   const std::vector<double>& weights = options.clipWeights;
   if (!weights.empty() && weights.size() != clips.size())
-    throw Error("pose sampling: " + std::to_string(weights.size()) + " clip weights for " + std::to_string(clips.size()) + " clips");
+    throw Error("pose sampling: " + std::to_string(weights.size()) + " clip weights for " +
+                std::to_string(clips.size()) + " clips");
   double weightSum = 0.0;
   for (double w : weights) {
     if (!(w > 0.0) || !std::isfinite(w)) throw Error("pose sampling: clip weights must be > 0");

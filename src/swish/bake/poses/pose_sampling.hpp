@@ -52,8 +52,7 @@ PoseSamples samplePoses(const Skeleton& skeleton, const std::vector<AnimationCli
                         const PoseSamplingOptions& options = {});
 
 // The full-skeleton pose a sample stands for (same interpolation and mirroring as samplePoses).
-Pose poseOfSample(const Skeleton& skeleton, const std::vector<AnimationClip>& clips,
-                  const PoseSamples::Origin& origin);
+Pose poseOfSample(const Skeleton& skeleton, const std::vector<AnimationClip>& clips, const PoseSamples::Origin& origin);
 
 // Mirrors a pose across the character's YZ plane (x -> -x): swaps Left*/Right* (and L*/R* CMU
 // prefixes such as LHipJoint/RHipJoint) joints and reflects each local rotation (w,x,y,z) ->

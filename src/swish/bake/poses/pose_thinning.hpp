@@ -23,9 +23,9 @@ namespace swish::bake {
 struct ThinningResult {
   std::vector<uint32_t> kept;  // sample indices, ascending (the greedy order)
   float tolerance = 0.f;
-  bool truncated = false;      // stopped early because more than maxKept poses were kept
-  size_t distanceChecks = 0;   // full (early-exit) distance evaluations, for benchmarks
-  int passes = 1;              // greedy passes run (thinPosesToCount: the search's iterations)
+  bool truncated = false;     // stopped early because more than maxKept poses were kept
+  size_t distanceChecks = 0;  // full (early-exit) distance evaluations, for benchmarks
+  int passes = 1;             // greedy passes run (thinPosesToCount: the search's iterations)
 };
 
 // One greedy pass. maxKept stops the pass once that many are kept (used by the bisection to give up

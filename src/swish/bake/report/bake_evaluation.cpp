@@ -23,14 +23,21 @@ nlohmann::json toJson(const AngularErrorStats& s) {
 }
 
 nlohmann::json toJson(const PenetrationPool& p) {
-  return {{"poses", p.frames},           {"poses_with_inside", p.framesInside}, {"poses_visible", p.framesVisible},
-          {"vertices_inside", p.inside}, {"vertices_visible", p.visible},       {"share_inside", p.share()},
-          {"deepest_mm", p.deepestMm},   {"deepest_p95_mm", p.deepestPercentileMm(0.95)}};
+  return {{"poses", p.frames},
+          {"poses_with_inside", p.framesInside},
+          {"poses_visible", p.framesVisible},
+          {"vertices_inside", p.inside},
+          {"vertices_visible", p.visible},
+          {"share_inside", p.share()},
+          {"deepest_mm", p.deepestMm},
+          {"deepest_p95_mm", p.deepestPercentileMm(0.95)}};
 }
 
 nlohmann::json penetrationJson(const BakeEvaluation& ev) {
   if (!ev.penetrationMeasured) return nullptr;
-  nlohmann::json j{{"visible_depth_mm", kVisiblePenetrationMm}, {"truth", toJson(ev.truthPenetration)}, {"model", toJson(ev.modelPenetration)}};
+  nlohmann::json j{{"visible_depth_mm", kVisiblePenetrationMm},
+                   {"truth", toJson(ev.truthPenetration)},
+                   {"model", toJson(ev.modelPenetration)}};
   if (ev.pushOut) {
     j["pushed"] = toJson(ev.pushedPenetration);
     j["vertex_total_pushed"] = toJson(ev.totalPushedMm);
@@ -56,9 +63,10 @@ Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut) {
   std::vector<float> lambda(size_t(mlp.outputSize()));
   mlp.evaluate(runtime::computeTheta(model.inputJoints, pose.local), lambda);
   const auto mats = model.skeleton.skinningMatrices(pose);
-  Points3f p = runtime::referenceSkin(
-      runtime::referencePcaReconstruct(model.meshPca, std::span<const float>(lambda.data(), size_t(model.meshComponents()))),
-      model.gameMesh.skin, mats);
+  Points3f p =
+      runtime::referenceSkin(runtime::referencePcaReconstruct(
+                                 model.meshPca, std::span<const float>(lambda.data(), size_t(model.meshComponents()))),
+                             model.gameMesh.skin, mats);
   if (pushOut && !model.bodyProxy.empty()) {
     std::vector<float> posed;
     runtime::poseBodyProxy(model.bodyProxy, mats, posed);
@@ -90,8 +98,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
       throw Error("bake evaluation: " + std::to_string(uncompressed.size()) + " uncompressed maps for a database of " +
                   std::to_string(model.normalMaps.mapCount()) + " (and the normal-map PCA is required)");
     search = std::make_unique<runtime::NearestCodeSearch>(model.normalMaps.keys);
-    for (uint32_t m = 0; m < model.normalMaps.mapCount(); ++m)
-      decoded.push_back(decodeVqMap(model.normalMaps, m));
+    for (uint32_t m = 0; m < model.normalMaps.mapCount(); ++m) decoded.push_back(decodeVqMap(model.normalMaps, m));
   }
   // The PCA basis as a PcaResult-like projector for the truncation error.
   const MatXf& basis = model.meshPca.basis;
@@ -132,8 +139,10 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
       pe.meanMm += e / double(n);
       pe.truncationMeanMm += t / double(n);
       pe.maxMm = std::max(pe.maxMm, e);
-      const double r = 1000.0 * double((restBaseline.row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm());
-      const double m = 1000.0 * double((meanBaseline.row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm());
+      const double r =
+          1000.0 * double((restBaseline.row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm());
+      const double m =
+          1000.0 * double((meanBaseline.row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm());
       restSkinned.push_back(r);
       meanSkinned.push_back(m);
       pe.restSkinnedMeanMm += r / double(n);
@@ -146,7 +155,8 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
       runtime::poseBodyProxy(model.bodyProxy, mats, posed);
       runtime::referencePushOut(*pushed, posed);
       for (size_t v = 0; v < n; ++v)
-        totalPushed.push_back(1000.0 * double((pushed->row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm()));
+        totalPushed.push_back(1000.0 *
+                              double((pushed->row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm()));
     }
     if (collider) {
       collider->pose(mats);

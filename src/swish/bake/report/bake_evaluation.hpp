@@ -23,9 +23,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/compression/normal_map_metrics.hpp"
 #include "swish/bake/compression/pca.hpp"
+#include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/report/penetration.hpp"
 #include "swish/model/model.hpp"
 
@@ -47,7 +47,7 @@ struct PoseEvaluation {
   double meanMm = 0.0, maxMm = 0.0;
   double truncationMeanMm = 0.0;
   double restSkinnedMeanMm = 0.0, meanSkinnedMeanMm = 0.0;  // the baselines' mean on this pose
-  double normalTotalDegrees = 0.0;  // mean over texels (NaN-free; 0 without normal maps)
+  double normalTotalDegrees = 0.0;                          // mean over texels (NaN-free; 0 without normal maps)
   uint32_t selectedMap = 0, idealMap = 0;
   PenetrationStats truthPenetration, modelPenetration, pushedPenetration;  // when measured
 };

@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <sstream>
 
-#include "swish/io/svg_plot.hpp"
 #include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/files/atomic_write.hpp"
 #include "swish/io/error_heat_map.hpp"
 #include "swish/io/png.hpp"
-#include "swish/files/atomic_write.hpp"
+#include "swish/io/svg_plot.hpp"
 #include "swish/runtime/reference_vq_decode.hpp"
 
 namespace swish::bake {
@@ -36,7 +36,8 @@ std::vector<double> truncationRmsMm(const PcaResult& p) {
 std::vector<size_t> worstPoses(const BakeEvaluation& ev, size_t count) {
   std::vector<size_t> idx(ev.perPose.size());
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
-  std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return ev.perPose[a].meanMm > ev.perPose[b].meanMm; });
+  std::stable_sort(idx.begin(), idx.end(),
+                   [&](size_t a, size_t b) { return ev.perPose[a].meanMm > ev.perPose[b].meanMm; });
   idx.resize(std::min(count, idx.size()));
   return idx;
 }
@@ -46,7 +47,8 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   const auto& ev = out.evaluation;
   nlohmann::json r;
   r["character"] = ds.character.name;
-  r["poses"] = {{"dataset", ds.poses.size()}, {"training", out.trainingPoses.size()}, {"held_out", out.testPoses.size()}};
+  r["poses"] = {
+      {"dataset", ds.poses.size()}, {"training", out.trainingPoses.size()}, {"held_out", out.testPoses.size()}};
   nlohmann::json pinned = nlohmann::json::array();  // dataset pose ids always trained on (the rest pose)
   for (uint32_t i : out.pinnedPoses) pinned.push_back(ds.poses[i].id);
   r["poses"]["always_trained"] = pinned;
@@ -54,32 +56,47 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   nlohmann::json perK = nlohmann::json::array();
   const auto rms = truncationRmsMm(out.meshPca);
   for (size_t k = 0; k < rms.size(); ++k)
-    perK.push_back({{"k", k}, {"explained_variance", out.meshPca.explainedVariance[Eigen::Index(k)]}, {"rms_mm", rms[k]}});
-  r["mesh_pca"] = {{"components", out.meshPca.components()}, {"method", out.meshPca.randomized ? "randomized" : "exact"},
+    perK.push_back(
+        {{"k", k}, {"explained_variance", out.meshPca.explainedVariance[Eigen::Index(k)]}, {"rms_mm", rms[k]}});
+  r["mesh_pca"] = {{"components", out.meshPca.components()},
+                   {"method", out.meshPca.randomized ? "randomized" : "exact"},
                    {"per_k", perK}};
-  r["vertex_error_held_out"] = {{"total", toJson(ev.totalMm)}, {"pca_truncation", toJson(ev.truncationMm)},
+  r["vertex_error_held_out"] = {{"total", toJson(ev.totalMm)},
+                                {"pca_truncation", toJson(ev.truncationMm)},
                                 {"regression", toJson(ev.regressionMm)},
                                 {"baseline_rest_skinned", toJson(ev.restSkinnedMm)},
                                 {"baseline_mean_skinned", toJson(ev.meanSkinnedMm)}};
   r["penetration_held_out"] = penetrationJson(ev);
-  r["mlp"] = {{"best_epoch", out.regressor.bestEpoch}, {"epochs_run", out.regressor.epochsRun},
-              {"best_validation_loss", out.regressor.bestValidationLoss}, {"seconds", out.regressor.seconds},
+  r["mlp"] = {{"best_epoch", out.regressor.bestEpoch},
+              {"epochs_run", out.regressor.epochsRun},
+              {"best_validation_loss", out.regressor.bestValidationLoss},
+              {"seconds", out.regressor.seconds},
               {"activation", activationName(out.regressor.activation)}};
   if (ev.hasNormalMaps) {
-    r["normal_maps"] = {
-        {"code_dims", out.normalPca.codeDims()},
-        {"database_maps", out.model.normalMaps.mapCount()},
-        {"held_out", {{"database", toJson(ev.normalDatabase)}, {"selection", toJson(ev.normalSelection)},
-                      {"total_vq", toJson(ev.normalTotal)}, {"vq_added", toJson(ev.normalVqAdded)},
-                      {"selection_agreement", ev.selectionAgreement}}},
-        {"compression", {{"vq_vs_uncompressed", toJson(out.vqVsUncompressed)}, {"bc5_vs_uncompressed", toJson(out.bc5VsUncompressed)},
-                         {"vq_bytes", out.vq.totalBytes()}, {"vq_codebook_bytes", out.vq.codebookBytes},
-                         {"vq_index_bytes", out.vq.indexBytes}, {"bc5_bytes", out.bc5Bytes},
-                         {"bc5_at_vq_memory", {{"vs_uncompressed", toJson(out.bc5AtVqMemoryVsUncompressed)},
-                                               {"width", out.bc5AtVqMemoryWidth}, {"height", out.bc5AtVqMemoryHeight},
-                                               {"bytes", out.bc5AtVqMemoryBytes}}},
-                         {"uncompressed_float_bytes", out.uncompressedBytes}, {"codebook_entries", out.vq.codebookEntries},
-                         {"vq_training_seconds", out.vq.trainingSeconds}, {"vq_assignment_seconds", out.vq.assignmentSeconds}}}};
+    r["normal_maps"] = {{"code_dims", out.normalPca.codeDims()},
+                        {"database_maps", out.model.normalMaps.mapCount()},
+                        {"held_out",
+                         {{"database", toJson(ev.normalDatabase)},
+                          {"selection", toJson(ev.normalSelection)},
+                          {"total_vq", toJson(ev.normalTotal)},
+                          {"vq_added", toJson(ev.normalVqAdded)},
+                          {"selection_agreement", ev.selectionAgreement}}},
+                        {"compression",
+                         {{"vq_vs_uncompressed", toJson(out.vqVsUncompressed)},
+                          {"bc5_vs_uncompressed", toJson(out.bc5VsUncompressed)},
+                          {"vq_bytes", out.vq.totalBytes()},
+                          {"vq_codebook_bytes", out.vq.codebookBytes},
+                          {"vq_index_bytes", out.vq.indexBytes},
+                          {"bc5_bytes", out.bc5Bytes},
+                          {"bc5_at_vq_memory",
+                           {{"vs_uncompressed", toJson(out.bc5AtVqMemoryVsUncompressed)},
+                            {"width", out.bc5AtVqMemoryWidth},
+                            {"height", out.bc5AtVqMemoryHeight},
+                            {"bytes", out.bc5AtVqMemoryBytes}}},
+                          {"uncompressed_float_bytes", out.uncompressedBytes},
+                          {"codebook_entries", out.vq.codebookEntries},
+                          {"vq_training_seconds", out.vq.trainingSeconds},
+                          {"vq_assignment_seconds", out.vq.assignmentSeconds}}}};
   }
   nlohmann::json stages = nlohmann::json::array();
   for (const auto& s : out.stages) stages.push_back({{"stage", s.stage}, {"seconds", s.seconds}});
@@ -87,8 +104,14 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   nlohmann::json worst = nlohmann::json::array();
   for (size_t i : worstPoses(ev, 8)) {
     const auto& p = ev.perPose[i];
-    worst.push_back({{"pose", p.poseId}, {"mean_mm", p.meanMm}, {"max_mm", p.maxMm}, {"truncation_mean_mm", p.truncationMeanMm}, {"rest_skinned_mean_mm", p.restSkinnedMeanMm},
-                     {"normal_deg", p.normalTotalDegrees}, {"selected_map", p.selectedMap}, {"ideal_map", p.idealMap}});
+    worst.push_back({{"pose", p.poseId},
+                     {"mean_mm", p.meanMm},
+                     {"max_mm", p.maxMm},
+                     {"truncation_mean_mm", p.truncationMeanMm},
+                     {"rest_skinned_mean_mm", p.restSkinnedMeanMm},
+                     {"normal_deg", p.normalTotalDegrees},
+                     {"selected_map", p.selectedMap},
+                     {"ideal_map", p.idealMap}});
     if (ev.penetrationMeasured) {
       worst.back()["truth_inside_deepest_mm"] = p.truthPenetration.deepestMm;
       worst.back()["model_inside_deepest_mm"] = p.modelPenetration.deepestMm;
@@ -151,34 +174,40 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
      << (out.meshPca.randomized ? "randomised" : "exact") << " SVD).\n\n![error against K](error_vs_k.svg)\n\n";
   if (subjects) md << subjects->markdown(ev);
   if (ev.penetrationMeasured) {
-    md << "## Garment inside the body\n\nHeld-out poses against the character's posed body, truth and model side by side "
+    md << "## Garment inside the body\n\nHeld-out poses against the character's posed body, truth and model side by "
+          "side "
           "(whether the model or the truth puts the cloth inside): vertices inside the body, those deeper than "
        << f2(kVisiblePenetrationMm) << " mm (visible), the deepest.\n\n"
-       << "| positions | poses with any inside | poses with visible | vertices inside | share | deepest mm | p95 of per-pose deepest mm |\n"
+       << "| positions | poses with any inside | poses with visible | vertices inside | share | deepest mm | p95 of "
+          "per-pose deepest mm |\n"
           "|---|---|---|---|---|---|---|\n";
     auto prow = [&](const char* name, const PenetrationPool& p) {
-      md << "| " << name << " | " << p.framesInside << " / " << p.frames << " | " << p.framesVisible << " | " << p.inside << " | "
-         << f3(100.0 * p.share()) << " % | " << f2(p.deepestMm) << " | " << f2(p.deepestPercentileMm(0.95)) << " |\n";
+      md << "| " << name << " | " << p.framesInside << " / " << p.frames << " | " << p.framesVisible << " | "
+         << p.inside << " | " << f3(100.0 * p.share()) << " % | " << f2(p.deepestMm) << " | "
+         << f2(p.deepestPercentileMm(0.95)) << " |\n";
     };
     prow("truth (simulation, transferred + smoothed)", ev.truthPenetration);
     prow("model (before the push-out)", ev.modelPenetration);
     if (ev.pushOut) {
       prow("model after the run-time push-out", ev.pushedPenetration);
-      md << "\nVertex error with the push-out: mean " << f2(ev.totalPushedMm.mean) << " mm, p95 " << f2(ev.totalPushedMm.p95)
-         << " mm, max " << f2(ev.totalPushedMm.max) << " mm (without: " << f2(ev.totalMm.mean) << " / " << f2(ev.totalMm.p95) << " / "
-         << f2(ev.totalMm.max) << " mm).\n";
+      md << "\nVertex error with the push-out: mean " << f2(ev.totalPushedMm.mean) << " mm, p95 "
+         << f2(ev.totalPushedMm.p95) << " mm, max " << f2(ev.totalPushedMm.max)
+         << " mm (without: " << f2(ev.totalMm.mean) << " / " << f2(ev.totalMm.p95) << " / " << f2(ev.totalMm.max)
+         << " mm).\n";
     } else {
       md << "\nThe model has no body proxy: no push-out at run time.\n";
     }
     md << "\n";
   }
-  md << "## MLP\n\n" << activationName(out.regressor.activation) << ", best validation epoch " << out.regressor.bestEpoch
-     << " of " << out.regressor.epochsRun << ", validation loss " << f3(out.regressor.bestValidationLoss) << ", trained in "
+  md << "## MLP\n\n"
+     << activationName(out.regressor.activation) << ", best validation epoch " << out.regressor.bestEpoch << " of "
+     << out.regressor.epochsRun << ", validation loss " << f3(out.regressor.bestValidationLoss) << ", trained in "
      << f2(out.regressor.seconds) << " s.\n\n![training curve](training_curve.svg)\n\n";
   if (ev.hasNormalMaps) {
     md << "## Normal maps\n\n| angular error (deg) | mean | p95 | max |\n|---|---|---|---|\n";
     auto arow = [&](const char* name, const AngularErrorStats& s) {
-      md << "| " << name << " | " << f2(s.meanDegrees) << " | " << f2(s.p95Degrees) << " | " << f2(s.maxDegrees) << " |\n";
+      md << "| " << name << " | " << f2(s.meanDegrees) << " | " << f2(s.p95Degrees) << " | " << f2(s.maxDegrees)
+         << " |\n";
     };
     arow("database (ideal map, uncompressed)", ev.normalDatabase);
     arow("selection (predicted map, uncompressed)", ev.normalSelection);
@@ -187,8 +216,8 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
     arow("all database maps: VQ vs uncompressed", out.vqVsUncompressed);
     arow("all database maps: BC5 vs uncompressed", out.bc5VsUncompressed);
     if (out.bc5AtVqMemoryWidth > 0) {
-      const std::string name = "all database maps: BC5 at VQ's memory (" + std::to_string(out.bc5AtVqMemoryWidth) + "x" +
-                               std::to_string(out.bc5AtVqMemoryHeight) + ", sampled up) vs uncompressed";
+      const std::string name = "all database maps: BC5 at VQ's memory (" + std::to_string(out.bc5AtVqMemoryWidth) +
+                               "x" + std::to_string(out.bc5AtVqMemoryHeight) + ", sampled up) vs uncompressed";
       arow(name.c_str(), out.bc5AtVqMemoryVsUncompressed);
     }
     md << "\nPredicted map = ideal map for " << f2(100.0 * ev.selectionAgreement) << "% of held-out poses.\n\n";
@@ -202,8 +231,10 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
     md << "\n\n";
   }
   md << "## Worst held-out poses\n\nThe gallery shows, per pose, the model (as the run time shows it"
-     << (out.model.bodyProxy.empty() ? "" : ", after the push-out") << ") beside the truth and an error heat map "
-        "(per-vertex distance to the truth, 0 to 10 mm and beyond), then the truth's and the run time's normal maps.\n\n"
+     << (out.model.bodyProxy.empty() ? "" : ", after the push-out")
+     << ") beside the truth and an error heat map "
+        "(per-vertex distance to the truth, 0 to 10 mm and beyond), then the truth's and the run time's normal "
+        "maps.\n\n"
      << "| pose | mean mm | max mm | truncation mm | rest skinned mm | normal deg | gallery |\n"
         "|---|---|---|---|---|---|---|\n";
   std::filesystem::create_directories(dir / "gallery");
@@ -230,7 +261,8 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
       cell = "![model, truth, error](" + stem + "_heat.png)";
       if (ev.hasNormalMaps) {
         const std::string truthPng = stem + "_truth.png", runtimePng = stem + "_runtime.png";
-        io::writePng(dir / truthPng, io::encodeNormalMap(pose->normalMap.width, pose->normalMap.height, pose->normalMap.xy, 8));
+        io::writePng(dir / truthPng,
+                     io::encodeNormalMap(pose->normalMap.width, pose->normalMap.height, pose->normalMap.xy, 8));
         const auto dec = runtime::referenceVqDecode(out.model.normalMaps, p.selectedMap);
         std::vector<float> xy(dec.xy.size());
         for (size_t k = 0; k < xy.size(); ++k) xy[k] = runtime::snorm8ToFloat(dec.xy[k]);

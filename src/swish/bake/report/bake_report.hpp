@@ -17,7 +17,8 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& dataset
 // Writes the report files into `dir` (created if needed). Returns the path of report.md.
 // With `subjects` (part1.holdout), the report shows the held-out subjects beside the random held-out
 // frames (subject_evaluation.hpp), in report.md and as report.json's "held_out_subjects".
-std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset& dataset, const std::filesystem::path& dir,
-                                      size_t galleryPoses = 4, const SubjectEvaluation* subjects = nullptr);
+std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset& dataset,
+                                      const std::filesystem::path& dir, size_t galleryPoses = 4,
+                                      const SubjectEvaluation* subjects = nullptr);
 
 }  // namespace swish::bake

@@ -37,7 +37,7 @@ double PenetrationPool::deepestPercentileMm(double q) const {
   if (frameDeepestMm.empty()) return 0.0;
   std::vector<double> d = frameDeepestMm;
   std::sort(d.begin(), d.end());
-  const size_t i = size_t(std::ceil(q * double(d.size()))) ;
+  const size_t i = size_t(std::ceil(q * double(d.size())));
   return d[std::min(d.size() - 1, i == 0 ? 0 : i - 1)];
 }
 

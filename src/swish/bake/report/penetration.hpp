@@ -19,10 +19,10 @@ inline constexpr float kPenetrationSearch = 0.15f;
 inline constexpr float kPenetrationNearSearch = 0.03f;  // tried first
 
 struct PenetrationStats {
-  uint32_t vertices = 0;    // garment vertices measured
-  uint32_t inside = 0;      // with signed distance < 0
-  uint32_t visible = 0;     // deeper than kVisiblePenetrationMm
-  double deepestMm = 0;     // 0 when none is inside
+  uint32_t vertices = 0;  // garment vertices measured
+  uint32_t inside = 0;    // with signed distance < 0
+  uint32_t visible = 0;   // deeper than kVisiblePenetrationMm
+  double deepestMm = 0;   // 0 when none is inside
   double share() const { return vertices ? double(inside) / vertices : 0.0; }
 };
 

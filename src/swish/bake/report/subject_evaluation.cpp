@@ -40,7 +40,9 @@ nlohmann::json SubjectEvaluation::toJson() const {
     j["subject"] = c.subject;
     clips.push_back(std::move(j));
   }
-  nlohmann::json j = {{"subjects", subjects}, {"poses_planned", posesPlanned}, {"overall", evaluationSummary(overall)},
+  nlohmann::json j = {{"subjects", subjects},
+                      {"poses_planned", posesPlanned},
+                      {"overall", evaluationSummary(overall)},
                       {"per_clip", clips}};
   if (!guard.rows.empty()) j["novelty_guard_study"] = guard.toJson();
   return j;
@@ -55,14 +57,19 @@ std::string GuardSetting::name() const {
 nlohmann::json GuardStudy::toJson() const {
   nlohmann::json rs = nlohmann::json::array();
   for (const Row& r : rows)
-    rs.push_back({{"clamp", r.setting.clamp}, {"blend_start", r.setting.start}, {"blend_end", r.setting.end},
-                  {"held_out_subjects", bake::toJson(r.subjects)}, {"random_frames", bake::toJson(r.random)}});
-  return {{"novelty_unit", unit},
-          {"novelty_held_out_subjects", {{"mean", noveltySubjects.mean}, {"p95", noveltySubjects.p95}, {"max", noveltySubjects.max}}},
-          {"novelty_random_frames", {{"mean", noveltyRandom.mean}, {"p95", noveltyRandom.p95}, {"max", noveltyRandom.max}}},
-          {"error_novelty_correlation", errorNoveltyCorrelation},
-          {"settings", rs},
-          {"chosen", chosen}};
+    rs.push_back({{"clamp", r.setting.clamp},
+                  {"blend_start", r.setting.start},
+                  {"blend_end", r.setting.end},
+                  {"held_out_subjects", bake::toJson(r.subjects)},
+                  {"random_frames", bake::toJson(r.random)}});
+  return {
+      {"novelty_unit", unit},
+      {"novelty_held_out_subjects",
+       {{"mean", noveltySubjects.mean}, {"p95", noveltySubjects.p95}, {"max", noveltySubjects.max}}},
+      {"novelty_random_frames", {{"mean", noveltyRandom.mean}, {"p95", noveltyRandom.p95}, {"max", noveltyRandom.max}}},
+      {"error_novelty_correlation", errorNoveltyCorrelation},
+      {"settings", rs},
+      {"chosen", chosen}};
 }
 
 std::string GuardStudy::markdown() const {
@@ -74,7 +81,8 @@ std::string GuardStudy::markdown() const {
      << f2(noveltySubjects.p95) << ", max " << f2(noveltySubjects.max) << "; random held-out frames: mean "
      << f2(noveltyRandom.mean) << ", p95 " << f2(noveltyRandom.p95) << ", max " << f2(noveltyRandom.max)
      << ". Per-pose mean error against novelty on the held-out subjects: correlation " << f2(errorNoveltyCorrelation)
-     << ".\n\n| guard | held-out subjects mean | p95 | max | random frames mean | p95 | max |\n|---|---|---|---|---|---|---|\n";
+     << ".\n\n| guard | held-out subjects mean | p95 | max | random frames mean | p95 | max "
+        "|\n|---|---|---|---|---|---|---|\n";
   for (size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     md << "| " << r.setting.name() << (i == chosen ? " (lowest held-out mean)" : "") << " | " << f2(r.subjects.mean)
@@ -87,7 +95,8 @@ std::string GuardStudy::markdown() const {
 }
 
 GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const DatasetPose*>& trainingPoses,
-                             const std::vector<const DatasetPose*>& subjects, const std::vector<const DatasetPose*>& random) {
+                             const std::vector<const DatasetPose*>& subjects,
+                             const std::vector<const DatasetPose*>& random) {
   GuardStudy g;
   if (trainingPoses.size() < 2) return g;
   const runtime::MlpEvaluator mlp(model);
@@ -101,7 +110,8 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
     return x;
   };
   MatXf train(D, Eigen::Index(trainingPoses.size()));
-  VecXf lo = VecXf::Constant(K, std::numeric_limits<float>::max()), hi = VecXf::Constant(K, -std::numeric_limits<float>::max());
+  VecXf lo = VecXf::Constant(K, std::numeric_limits<float>::max()),
+        hi = VecXf::Constant(K, -std::numeric_limits<float>::max());
   for (size_t i = 0; i < trainingPoses.size(); ++i) {
     train.col(Eigen::Index(i)) = input(trainingPoses[i]);
     const VecXf pre = Eigen::Map<const VecXf>(trainingPoses[i]->gameMeshPreSkin.data(), Eigen::Index(3 * n));
@@ -129,7 +139,8 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
   auto prepare = [&](const std::vector<const DatasetPose*>& set) {
     std::vector<Prepared> out;
     for (const DatasetPose* p : set) {
-      Prepared q{p, nearest(input(p), -1) / g.unit, std::vector<float>(size_t(mlp.outputSize())), model.skeleton.skinningMatrices(p->pose)};
+      Prepared q{p, nearest(input(p), -1) / g.unit, std::vector<float>(size_t(mlp.outputSize())),
+                 model.skeleton.skinningMatrices(p->pose)};
       mlp.evaluate(runtime::computeTheta(model.inputJoints, p->pose.local), q.lambda);
       out.push_back(std::move(q));
     }
@@ -159,10 +170,12 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
         const float b = float(std::clamp((p.novelty - s.start) / (s.end - s.start), 0.0, 1.0));
         for (float& v : w) v *= 1.f - b;
       }
-      const Points3f shape = runtime::referenceSkin(runtime::referencePcaReconstruct(model.meshPca, w), model.gameMesh.skin, p.mats);
+      const Points3f shape =
+          runtime::referenceSkin(runtime::referencePcaReconstruct(model.meshPca, w), model.gameMesh.skin, p.mats);
       double sum = 0.0;
       for (size_t v = 0; v < n; ++v) {
-        const double e = 1000.0 * double((shape.row(Eigen::Index(v)) - p.pose->gameMeshWorld.row(Eigen::Index(v))).norm());
+        const double e =
+            1000.0 * double((shape.row(Eigen::Index(v)) - p.pose->gameMeshWorld.row(Eigen::Index(v))).norm());
         all.push_back(e);
         sum += e;
       }
@@ -175,7 +188,8 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
     for (double width : {1.0, 2.0, 4.0}) settings.push_back({true, start, start + width});
   std::vector<double> perPose;
   for (size_t i = 0; i < settings.size(); ++i) {
-    g.rows.push_back({settings[i], errors(subj, settings[i], i == 0 ? &perPose : nullptr), errors(rand, settings[i], nullptr)});
+    g.rows.push_back(
+        {settings[i], errors(subj, settings[i], i == 0 ? &perPose : nullptr), errors(rand, settings[i], nullptr)});
     if (g.rows.back().subjects.mean < g.rows[g.chosen].subjects.mean) g.chosen = i;
   }
   // Pearson correlation of per-pose error and novelty (held-out subjects, no guard).
@@ -226,12 +240,13 @@ std::string SubjectEvaluation::markdown(const BakeEvaluation& random) const {
 }
 
 SubjectEvaluation evaluateHeldOutSubjects(const BakeTrainOutput& out, const Dataset& training, const Dataset& holdout,
-                                          const nlohmann::json& origins,
-                                          const std::vector<std::string>& subjects, size_t posesPlanned) {
+                                          const nlohmann::json& origins, const std::vector<std::string>& subjects,
+                                          size_t posesPlanned) {
   if (holdout.poses.empty()) throw Error("held-out subjects: the dataset holds no pose (every simulation failed?)");
   if (holdout.character.garment.vertexCount() != out.model.gameMesh.vertexCount())
-    throw Error("held-out subjects: the dataset's game mesh has " + std::to_string(holdout.character.garment.vertexCount()) +
-                " vertices, the model's " + std::to_string(out.model.gameMesh.vertexCount()));
+    throw Error("held-out subjects: the dataset's game mesh has " +
+                std::to_string(holdout.character.garment.vertexCount()) + " vertices, the model's " +
+                std::to_string(out.model.gameMesh.vertexCount()));
   const PcaResult* normalPca = out.model.normalMaps.mapCount() > 0 ? &out.normalPca.pca : nullptr;
   SubjectEvaluation r;
   r.subjects = subjects;

@@ -27,9 +27,9 @@ struct GuardSetting {
   std::string name() const;
 };
 struct GuardStudy {
-  double unit = 0.0;  // the training poses' nearest-neighbour distance, p95 (RMS per input)
+  double unit = 0.0;                             // the training poses' nearest-neighbour distance, p95 (RMS per input)
   DistanceStats noveltySubjects, noveltyRandom;  // of the novelty values (no unit)
-  double errorNoveltyCorrelation = 0.0;         // held-out subjects: per-pose mean error vs novelty (Pearson)
+  double errorNoveltyCorrelation = 0.0;          // held-out subjects: per-pose mean error vs novelty (Pearson)
   struct Row {
     GuardSetting setting;
     DistanceStats subjects, random;  // vertex error (mm)

@@ -52,13 +52,12 @@ std::vector<Vec3f> surfaceSamples(const BodyCapsule& c) {
   return out;
 }
 
-float boxDistance(const Vec3f& p, const Vec3f& lo, const Vec3f& hi) {
-  return (p.cwiseMax(lo).cwiseMin(hi) - p).norm();
-}
+float boxDistance(const Vec3f& p, const Vec3f& lo, const Vec3f& hi) { return (p.cwiseMax(lo).cwiseMin(hi) - p).norm(); }
 
 }  // namespace
 
-BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh* garment, const BodyProxyFitSettings& s) {
+BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh* garment,
+                          const BodyProxyFitSettings& s) {
   body.validate("body proxy fit: body", skeleton.size());
   if (body.triangleCount() == 0) throw Error("body proxy fit: the body has no triangles");
   const size_t n = body.vertexCount();
@@ -88,7 +87,8 @@ BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh
     int best = 0;
     for (int i = 1; i < inf; ++i)
       if (body.skin.weights[v * size_t(inf) + size_t(i)] > body.skin.weights[v * size_t(inf) + size_t(best)]) best = i;
-    groups[{body.skin.joints[v * size_t(inf) + size_t(best)], part[v]}].push_back(body.positions.row(Eigen::Index(v)).transpose());
+    groups[{body.skin.joints[v * size_t(inf) + size_t(best)], part[v]}].push_back(
+        body.positions.row(Eigen::Index(v)).transpose());
   }
 
   BodyCollider collider(body, 0.05f, "body proxy fit: body");
@@ -177,7 +177,8 @@ BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh
     kept.resize(kMaxBodyCapsules);
   }
   // In skeleton order (stable for equal joints): neighbouring threads' capsules near each other.
-  std::stable_sort(kept.begin(), kept.end(), [](const Kept& a, const Kept& b) { return a.capsule.joint < b.capsule.joint; });
+  std::stable_sort(kept.begin(), kept.end(),
+                   [](const Kept& a, const Kept& b) { return a.capsule.joint < b.capsule.joint; });
   for (const Kept& k : kept) {
     fit.proxy.capsules.push_back(k.capsule);
     fit.capsuleJoints.push_back(skeleton.joints[k.capsule.joint].name);

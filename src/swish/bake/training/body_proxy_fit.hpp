@@ -26,9 +26,9 @@
 namespace swish::bake {
 
 struct BodyProxyFitSettings {
-  float reach = 0.5f;        // metres from the garment's rest bounds; < 0 keeps every capsule
-  float minRadius = 0.01f;   // metres
-  size_t minVertices = 8;    // smaller groups get no capsule
+  float reach = 0.5f;       // metres from the garment's rest bounds; < 0 keeps every capsule
+  float minRadius = 0.01f;  // metres
+  size_t minVertices = 8;   // smaller groups get no capsule
 };
 
 // How far (metres) a capsule's surface may stand outside the body after the check: the sampling's
@@ -40,12 +40,13 @@ struct BodyProxyFit {
   std::vector<std::string> capsuleJoints;  // joint name of each capsule (for reports)
   size_t groups = 0;                       // (joint, part) groups considered
   size_t dropped = 0;                      // too thin, too far from the garment, or beyond the cap
-  float worstOutsideMm = 0;                // largest distance outside the body of a checked surface point, after shrinking
+  float worstOutsideMm = 0;  // largest distance outside the body of a checked surface point, after shrinking
 };
 
 // `body` skinned to `skeleton` (rest positions, triangles, skin); `garment`: the game mesh at rest
 // (its bounds decide `reach`; nullptr keeps every capsule). Throws Error naming the problem for an
 // invalid body. Deterministic.
-BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh* garment, const BodyProxyFitSettings& settings = {});
+BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh* garment,
+                          const BodyProxyFitSettings& settings = {});
 
 }  // namespace swish::bake

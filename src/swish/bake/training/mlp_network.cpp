@@ -15,10 +15,15 @@ void activate(Activation a, M& z) {
   using S = typename M::Scalar;
   switch (a) {
     case Activation::Selu:
-      z = z.unaryExpr([](S v) { return v > S(0) ? S(kSeluLambda) * v : S(kSeluLambda * kSeluAlpha) * (std::exp(v) - S(1)); });
+      z = z.unaryExpr(
+          [](S v) { return v > S(0) ? S(kSeluLambda) * v : S(kSeluLambda * kSeluAlpha) * (std::exp(v) - S(1)); });
       break;
-    case Activation::Relu: z = z.cwiseMax(S(0)); break;
-    case Activation::Tanh: z = z.array().tanh().matrix(); break;
+    case Activation::Relu:
+      z = z.cwiseMax(S(0));
+      break;
+    case Activation::Tanh:
+      z = z.array().tanh().matrix();
+      break;
   }
 }
 
@@ -29,8 +34,10 @@ M activationDerivative(Activation a, const M& z) {
   switch (a) {
     case Activation::Selu:
       return z.unaryExpr([](S v) { return v > S(0) ? S(kSeluLambda) : S(kSeluLambda * kSeluAlpha) * std::exp(v); });
-    case Activation::Relu: return z.unaryExpr([](S v) { return v > S(0) ? S(1) : S(0); });
-    case Activation::Tanh: return (S(1) - z.array().tanh().square()).matrix();
+    case Activation::Relu:
+      return z.unaryExpr([](S v) { return v > S(0) ? S(1) : S(0); });
+    case Activation::Tanh:
+      return (S(1) - z.array().tanh().square()).matrix();
   }
   return z;
 }
@@ -45,9 +52,12 @@ Activation activationFromName(const std::string& name) {
 
 std::string activationName(Activation a) {
   switch (a) {
-    case Activation::Selu: return "selu";
-    case Activation::Relu: return "relu";
-    case Activation::Tanh: return "tanh";
+    case Activation::Selu:
+      return "selu";
+    case Activation::Relu:
+      return "relu";
+    case Activation::Tanh:
+      return "tanh";
   }
   return "?";
 }

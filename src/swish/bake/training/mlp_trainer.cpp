@@ -90,7 +90,8 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
 
   // Split: a seeded shuffle; validation takes the first share, never an alwaysTrain sample.
   for (uint32_t i : o.alwaysTrain)
-    if (Eigen::Index(i) >= n) throw Error("MLP training: always-train sample " + std::to_string(i) + " of " + std::to_string(n));
+    if (Eigen::Index(i) >= n)
+      throw Error("MLP training: always-train sample " + std::to_string(i) + " of " + std::to_string(n));
   const size_t nVal = std::clamp<size_t>(size_t(std::lround(o.validationFraction * double(n))), 1, size_t(n) - 1);
   IndexSplit split = seededSplit(size_t(n), nVal, rng, o.alwaysTrain);
   if (split.held.empty()) throw Error("MLP training: every sample is always-train; none left for validation");
@@ -169,7 +170,8 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
     const double valLoss = double(net.loss(xVal, yVal, weights));
     r.curve.push_back({epoch, trainSum / double(nTrain), valLoss, double(lr)});
     r.epochsRun = epoch;
-    if (!std::isfinite(valLoss)) throw Error("MLP training diverged (non-finite loss) at epoch " + std::to_string(epoch));
+    if (!std::isfinite(valLoss))
+      throw Error("MLP training diverged (non-finite loss) at epoch " + std::to_string(epoch));
     if (valLoss < r.bestValidationLoss) {
       r.bestValidationLoss = valLoss;
       r.bestEpoch = epoch;

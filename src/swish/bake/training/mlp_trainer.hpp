@@ -20,10 +20,10 @@ struct MlpTrainOptions {
   double minLearningRate = 2e-5;
   int batchSize = 32;
   int maxEpochs = 3000;
-  int patience = 300;             // epochs without a better validation loss before stopping
-  int plateauEpochs = 60;         // epochs without improvement before the learning rate halves
+  int patience = 300;      // epochs without a better validation loss before stopping
+  int plateauEpochs = 60;  // epochs without improvement before the learning rate halves
   double validationFraction = 0.1;
-  double maxSeconds = 0.0;        // wall-clock cap (0: none); stopping early keeps the best epoch
+  double maxSeconds = 0.0;  // wall-clock cap (0: none); stopping early keeps the best epoch
   uint64_t seed = 1;
   // Per output weight in the loss (empty: all 1). The bake weights mesh components by their variance
   // so that the loss follows the vertex error the PCA basis turns them into.
@@ -43,13 +43,13 @@ IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t
 
 struct TrainingEpoch {
   int epoch = 0;
-  double trainLoss = 0.0;       // on standardised outputs, weighted
+  double trainLoss = 0.0;  // on standardised outputs, weighted
   double validationLoss = 0.0;
   double learningRate = 0.0;
 };
 
 struct MlpTrainResult {
-  Mlp mlp;                      // model.hpp form (float), best validation epoch
+  Mlp mlp;  // model.hpp form (float), best validation epoch
   Normalisation inputNorm, outputNorm;
   Activation activation = Activation::Selu;
   std::vector<TrainingEpoch> curve;

@@ -8,7 +8,8 @@
 namespace swish::bake {
 
 Model buildModel(const ModelParts& p) {
-  if (!p.character || !p.regressor || !p.meshPca) throw Error("model builder: character, regressor and mesh PCA are required");
+  if (!p.character || !p.regressor || !p.meshPca)
+    throw Error("model builder: character, regressor and mesh PCA are required");
   if (p.regressor->activation != Activation::Selu)
     throw Error("model builder: the MLP uses " + activationName(p.regressor->activation) +
                 " but the .swish runtime evaluates SELU only; train with activation \"selu\" to export a model");
@@ -34,9 +35,9 @@ Model buildModel(const ModelParts& p) {
   m.temporalFilter = p.temporalFilter;
   m.metadata = p.metadata.dump();
   if (m.mlp.outputSize() != m.lambdaSize())
-    throw Error("model builder: the MLP predicts " + std::to_string(m.mlp.outputSize()) + " values but the model needs " +
-                std::to_string(m.meshComponents()) + " mesh weights + " + std::to_string(m.normalCodeDims()) +
-                " normal-code dimensions");
+    throw Error("model builder: the MLP predicts " + std::to_string(m.mlp.outputSize()) +
+                " values but the model needs " + std::to_string(m.meshComponents()) + " mesh weights + " +
+                std::to_string(m.normalCodeDims()) + " normal-code dimensions");
   m.validate("baked model of '" + ch.name + "'");
   return m;
 }

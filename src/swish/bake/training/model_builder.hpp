@@ -5,19 +5,19 @@
 // filter and metadata JSON. The result is validated before it is returned.
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/bake/compression/pca.hpp"
+#include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/core/character.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::bake {
 
 struct ModelParts {
-  const Character* character = nullptr;     // skeleton + garment (game mesh, skinned, with UVs)
+  const Character* character = nullptr;  // skeleton + garment (game mesh, skinned, with UVs)
   std::vector<uint32_t> inputJoints;
   const MlpTrainResult* regressor = nullptr;
-  const PcaResult* meshPca = nullptr;       // over 3N pre-skin coordinates (vertex v, axis a at 3v + a)
-  NormalMapDatabase normalMaps;             // keys + VQ data (may be empty)
+  const PcaResult* meshPca = nullptr;  // over 3N pre-skin coordinates (vertex v, axis a at 3v + a)
+  NormalMapDatabase normalMaps;        // keys + VQ data (may be empty)
   TemporalFilterParams temporalFilter;
   nlohmann::json metadata = nlohmann::json::object();
 };

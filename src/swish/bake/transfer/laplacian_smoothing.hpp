@@ -32,8 +32,8 @@ struct LaplacianSmoothingSettings {
 class LaplacianSmoother {
  public:
   // restPositions: for the weld map and the cotangent weights. Throws Error for bad settings or meshes.
-  LaplacianSmoother(const Triangles& triangles, const Points3f& restPositions, const LaplacianSmoothingSettings& settings,
-                    const std::string& what = "Laplacian smoothing");
+  LaplacianSmoother(const Triangles& triangles, const Points3f& restPositions,
+                    const LaplacianSmoothingSettings& settings, const std::string& what = "Laplacian smoothing");
 
   Points3f smooth(const Points3f& positions) const;
   // reference + smooth(positions - reference), see above.

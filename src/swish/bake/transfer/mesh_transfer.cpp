@@ -75,8 +75,8 @@ Points3f MeshTransfer::follow(const Points3f& simPosed) const {
   tbb::parallel_for(size_t(0), bindings_.size(), [&](size_t i) {
     const GameVertexBinding& b = bindings_[i];
     const LocalFrame f = surfaceFrame(simPosed, normals, simTriangles_, b.triangle, b.u, b.v);
-    const Vec3f x = f.point + f.tangent * b.localOffset.x() + f.bitangent * b.localOffset.y() +
-                    f.normal * b.localOffset.z();
+    const Vec3f x =
+        f.point + f.tangent * b.localOffset.x() + f.bitangent * b.localOffset.y() + f.normal * b.localOffset.z();
     out.row(Eigen::Index(i)) = x.transpose();
   });
   return out;

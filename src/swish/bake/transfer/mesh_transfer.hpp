@@ -16,8 +16,8 @@
 namespace swish::bake {
 
 struct GameVertexBinding {
-  uint32_t triangle = 0;            // simulation triangle
-  float u = 0.f, v = 0.f;           // barycentrics of its corners 1 and 2
+  uint32_t triangle = 0;              // simulation triangle
+  float u = 0.f, v = 0.f;             // barycentrics of its corners 1 and 2
   Vec3f localOffset = Vec3f::Zero();  // (tangent, bitangent, normal) components of game - surface point
 };
 

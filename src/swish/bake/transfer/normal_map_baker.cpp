@@ -27,7 +27,8 @@ NormalMapBaker::NormalMapBaker(const Points2f& uvs, const Triangles& tris, const
   if (!uvs.allFinite()) throw Error(what + ": non-finite UVs");
   for (Eigen::Index t = 0; t < tris.rows(); ++t)
     for (int k = 0; k < 3; ++k)
-      if (tris(t, k) >= uint32_t(rest.rows())) throw Error(what + ": triangle " + std::to_string(t) + " index out of range");
+      if (tris(t, k) >= uint32_t(rest.rows()))
+        throw Error(what + ": triangle " + std::to_string(t) + " index out of range");
   topology_ = buildFrameTopology(tris, rest);
 
   // Rasterise the UV layout: texel centres inside each triangle, first (lowest) triangle wins.
@@ -41,8 +42,10 @@ NormalMapBaker::NormalMapBaker(const Points2f& uvs, const Triangles& tris, const
     if (!(std::abs(det) > 1e-14f)) continue;  // zero UV area: covers no texel
     const float minU = std::min({a.x(), b.x(), c.x()}), maxU = std::max({a.x(), b.x(), c.x()});
     const float minV = std::min({a.y(), b.y(), c.y()}), maxV = std::max({a.y(), b.y(), c.y()});
-    const int x0 = std::max(0, int(std::floor(minU * W - 0.5f))), x1 = std::min(int(W) - 1, int(std::ceil(maxU * W - 0.5f)));
-    const int y0 = std::max(0, int(std::floor(minV * H - 0.5f))), y1 = std::min(int(H) - 1, int(std::ceil(maxV * H - 0.5f)));
+    const int x0 = std::max(0, int(std::floor(minU * W - 0.5f))),
+              x1 = std::min(int(W) - 1, int(std::ceil(maxU * W - 0.5f)));
+    const int y0 = std::max(0, int(std::floor(minV * H - 0.5f))),
+              y1 = std::min(int(H) - 1, int(std::ceil(maxV * H - 0.5f)));
     // Texels on a shared edge belong to whichever triangle comes first; the small tolerance closes
     // the cracks that rounding would leave between neighbours.
     const float eps = -1e-6f;

@@ -59,8 +59,9 @@ TriangleRayScene::TriangleRayScene(const Points3f& positions, const Triangles& t
         throw Error(what + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(triangles(t, k)) +
                     " of " + std::to_string(positions.rows()));
   impl_->device = rtcNewDevice("threads=1");  // queries are parallel outside; the build is small
-  if (!impl_->device) throw Error(what + ": cannot create an Embree device (error " +
-                                  std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+  if (!impl_->device)
+    throw Error(what + ": cannot create an Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) +
+                ")");
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   // Robust mode: watertight edges, so a ray through a shared edge or vertex cannot slip between the

@@ -7,8 +7,8 @@ namespace swish::bake {
 DilationResult dilateNormalMap(NormalMapImage& im, std::vector<uint8_t>& filled, int rings) {
   const size_t n = size_t(im.width) * im.height;
   if (filled.size() != n || im.xy.size() != 2 * n)
-    throw Error("UV dilation: image " + std::to_string(im.width) + "x" + std::to_string(im.height) +
-                " with " + std::to_string(im.xy.size()) + " floats and " + std::to_string(filled.size()) + " flags");
+    throw Error("UV dilation: image " + std::to_string(im.width) + "x" + std::to_string(im.height) + " with " +
+                std::to_string(im.xy.size()) + " floats and " + std::to_string(filled.size()) + " flags");
   DilationResult r;
   const int w = int(im.width), h = int(im.height);
   std::vector<uint32_t> frontier;

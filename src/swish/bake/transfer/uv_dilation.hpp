@@ -12,8 +12,8 @@
 namespace swish::bake {
 
 struct DilationResult {
-  size_t dilated = 0;      // texels filled from neighbours
-  size_t setToFlat = 0;    // texels still empty after the last ring, set to (0, 0)
+  size_t dilated = 0;    // texels filled from neighbours
+  size_t setToFlat = 0;  // texels still empty after the last ring, set to (0, 0)
 };
 
 // filled: width * height flags (non-zero = holds a baked value); updated to all ones.

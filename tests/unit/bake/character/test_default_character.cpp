@@ -56,7 +56,8 @@ double pointTriangleDistance(const Vec3d& p, const Vec3d& a, const Vec3d& b, con
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + ac * (d2 / (d2 - d6)))).norm();
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
   const double denom = 1.0 / (va + vb + vc);
   return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
 }
@@ -103,11 +104,17 @@ TEST(DefaultCharacter, CommittedRecipeIsTheEmbeddedOne) {
 TEST(DefaultCharacter, SkeletonHasTheCmuJointsOfTheSharedCharacter) {
   const Skeleton& s = defaultCharacter().skeleton;
   ASSERT_EQ(s.size(), 31u);
-  const std::pair<const char*, const char*> childParent[] = {
-      {"LHipJoint", "Hips"},        {"LeftUpLeg", "LHipJoint"},   {"LowerBack", "Hips"},
-      {"Spine1", "Spine"},          {"LeftShoulder", "Spine1"},   {"LeftForeArm", "LeftArm"},
-      {"RightArm", "RightShoulder"}, {"RThumb", "RightHand"},      {"Head", "Neck1"},
-      {"RightToeBase", "RightFoot"}, {"RightHandFinger1", "RightFingerBase"}};
+  const std::pair<const char*, const char*> childParent[] = {{"LHipJoint", "Hips"},
+                                                             {"LeftUpLeg", "LHipJoint"},
+                                                             {"LowerBack", "Hips"},
+                                                             {"Spine1", "Spine"},
+                                                             {"LeftShoulder", "Spine1"},
+                                                             {"LeftForeArm", "LeftArm"},
+                                                             {"RightArm", "RightShoulder"},
+                                                             {"RThumb", "RightHand"},
+                                                             {"Head", "Neck1"},
+                                                             {"RightToeBase", "RightFoot"},
+                                                             {"RightHandFinger1", "RightFingerBase"}};
   for (const auto& [child, parent] : childParent) {
     const int c = s.find(child);
     ASSERT_GE(c, 0) << child;
@@ -116,7 +123,8 @@ TEST(DefaultCharacter, SkeletonHasTheCmuJointsOfTheSharedCharacter) {
   for (const Joint& j : s.joints) EXPECT_EQ(j.rest.rotation.coeffs(), Quatf::Identity().coeffs());
   // A-pose: the upper arm points 40-60 degrees below horizontal; faces +Z (toes forward), left = +X.
   const auto g = s.globalTransforms(s.restPose());
-  const Vec3f arm = (g[size_t(s.find("LeftForeArm"))].translation - g[size_t(s.find("LeftArm"))].translation).normalized();
+  const Vec3f arm =
+      (g[size_t(s.find("LeftForeArm"))].translation - g[size_t(s.find("LeftArm"))].translation).normalized();
   const float below = std::asin(-arm.y()) * 180.f / float(M_PI);
   EXPECT_GT(arm.x(), 0.f);
   EXPECT_GT(below, 40.f);
@@ -136,8 +144,10 @@ TEST(DefaultCharacter, CountsAndSkinWeights) {
   expectValidSkin(c.garment, c.skeleton.size(), "jersey");
   // The jersey follows the spine and the upper arms, not the legs or the head.
   std::vector<double> perJoint(c.skeleton.size(), 0.0);
-  for (size_t i = 0; i < c.garment.skin.weights.size(); ++i) perJoint[c.garment.skin.joints[i]] += c.garment.skin.weights[i];
-  for (const char* j : {"Spine", "Spine1", "LeftArm", "RightArm"}) EXPECT_GT(perJoint[size_t(c.skeleton.find(j))], 20.0) << j;
+  for (size_t i = 0; i < c.garment.skin.weights.size(); ++i)
+    perJoint[c.garment.skin.joints[i]] += c.garment.skin.weights[i];
+  for (const char* j : {"Spine", "Spine1", "LeftArm", "RightArm"})
+    EXPECT_GT(perJoint[size_t(c.skeleton.find(j))], 20.0) << j;
   for (const char* j : {"LeftLeg", "Head", "LeftHand"}) EXPECT_LT(perJoint[size_t(c.skeleton.find(j))], 1.0) << j;
   // Body: feet on the floor, about 1.8 m tall.
   EXPECT_NEAR(c.body.positions.col(1).minCoeff(), 0.f, 0.02f);
@@ -206,14 +216,15 @@ TEST(DefaultCharacter, JerseyEdgesAreEvenAndWeightsSmooth) {
     std::vector<float> simLengths;
     for (Eigen::Index t = 0; t < sim.triangles.rows(); ++t)
       for (int e = 0; e < 3; ++e)
-        simLengths.push_back((sim.restPositions.row(sim.triangles(t, e)) - sim.restPositions.row(sim.triangles(t, (e + 1) % 3))).norm());
+        simLengths.push_back(
+            (sim.restPositions.row(sim.triangles(t, e)) - sim.restPositions.row(sim.triangles(t, (e + 1) % 3))).norm());
     std::sort(simLengths.begin(), simLengths.end());
     const float median = simLengths[simLengths.size() / 2];
     // Collapses aim at a quarter of the refined (longest) or the median edge; some at the armhole
     // corners are refused as flips, which leaves 0.136 x median unrefined and more at 6000 vertices.
     // 0.1 still catches the jersey's own 0.026 x median by a factor of four.
-    EXPECT_GT(simLengths.front(), 0.1f * median) << "target " << target << ": shortest " << simLengths.front()
-                                                  << " m, median " << median;
+    EXPECT_GT(simLengths.front(), 0.1f * median)
+        << "target " << target << ": shortest " << simLengths.front() << " m, median " << median;
   }
 }
 
@@ -248,7 +259,8 @@ TEST(DefaultCharacter, UVsAreInUnitSquareWithoutOverlaps) {
       }
   }
   EXPECT_EQ(overlaps, 0u);
-  EXPECT_EQ(std::min(positive, negative), 0u) << positive << " triangles wound one way in UV space, " << negative << " the other";
+  EXPECT_EQ(std::min(positive, negative), 0u)
+      << positive << " triangles wound one way in UV space, " << negative << " the other";
   size_t covered = 0;
   for (uint8_t c : cover) covered += c ? 1 : 0;
   EXPECT_GT(double(covered) / (res * res), 0.45) << "UV space use";

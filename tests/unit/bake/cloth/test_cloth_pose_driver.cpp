@@ -6,11 +6,11 @@
 #include <fstream>
 #include <limits>
 
+#include "support/cloth_fixture.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/bake/cloth/pose_driver.hpp"
 #include "swish/bake/cloth/simulated_pose_file.hpp"
 #include "swish/core/error.hpp"
-#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;
@@ -59,13 +59,15 @@ TEST(ClothPoseDriver, ResumesWithoutLosingOrRedoingFinishedPoses) {
 
   // Interrupted after two poses (one thread, so exactly two are done), then run again.
   size_t calls = 0;
-  const PoseSimulationRun first =
-      simulatePoses(solver, poses, resumed, [&](size_t done, size_t total, double left) {
+  const PoseSimulationRun first = simulatePoses(
+      solver, poses, resumed,
+      [&](size_t done, size_t total, double left) {
         ++calls;
         EXPECT_EQ(total, 6u);
         EXPECT_GE(left, 0.0);
         return done < 2;
-      }, 1);
+      },
+      1);
   EXPECT_TRUE(first.stopped);
   EXPECT_EQ(first.simulated, 2u);
   std::vector<fs::file_time_type> stamps;

@@ -8,10 +8,10 @@
 #include <cmath>
 #include <map>
 
+#include "support/cloth_fixture.hpp"
 #include "swish/bake/cloth/cloth_solver.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
 #include "swish/core/error.hpp"
-#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;
@@ -22,8 +22,8 @@ float longestEdge(const SimulationMesh& m) {
   float longest = 0.f;
   for (Eigen::Index t = 0; t < m.triangles.rows(); ++t)
     for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, (m.restPositions.row(m.triangles(t, k)) -
-                                   m.restPositions.row(m.triangles(t, (k + 1) % 3))).norm());
+      longest = std::max(
+          longest, (m.restPositions.row(m.triangles(t, k)) - m.restPositions.row(m.triangles(t, (k + 1) % 3))).norm());
   return longest;
 }
 
@@ -108,7 +108,8 @@ TEST(ClothRestShape, ShortEdgesAreCollapsedKeepingTheSurfaceManifold) {
   EXPECT_GT(shortest, 0.004f);
   ASSERT_EQ(merged.gameToSim.size(), ch.garment.vertexCount());
   for (size_t g = 0; g < merged.gameToSim.size(); ++g)
-    ASSERT_LT((merged.restPositions.row(merged.gameToSim[g]) - ch.garment.positions.row(Eigen::Index(g))).norm(), 0.005f);
+    ASSERT_LT((merged.restPositions.row(merged.gameToSim[g]) - ch.garment.positions.row(Eigen::Index(g))).norm(),
+              0.005f);
   // And the solve on it keeps its rest shape without gravity (no sliver left to fight over).
   ClothSimSettings s;
   s.gravity = Vec3f::Zero();

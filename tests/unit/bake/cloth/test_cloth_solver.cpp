@@ -5,21 +5,21 @@
 
 #include <array>
 #include <cmath>
-#include <span>
 #include <cstring>
 #include <limits>
 #include <set>
+#include <span>
 #include <thread>
 
+#include "support/cloth_fixture.hpp"
 #include "support/random_model.hpp"
+#include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/cloth/cloth_constraints.hpp"
 #include "swish/bake/cloth/cloth_solver.hpp"
-#include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rng.hpp"
-#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;
@@ -97,7 +97,8 @@ TEST(ClothSimulationMesh, RejectsGarmentWithoutSkinAndNonManifoldEdges) {
   EXPECT_THROW(buildSimulationMesh(noSkin), Error);
   Character fan = ch;  // a third triangle on an interior edge
   fan.garment.triangles.conservativeResize(fan.garment.triangles.rows() + 1, 3);
-  fan.garment.triangles.bottomRows(1) << fan.garment.triangles(0, 0), fan.garment.triangles(0, 2), 100;  // a-e: interior
+  fan.garment.triangles.bottomRows(1) << fan.garment.triangles(0, 0), fan.garment.triangles(0, 2),
+      100;  // a-e: interior
   EXPECT_THROW(buildSimulationMesh(fan), Error);
 }
 
@@ -138,7 +139,8 @@ TEST(ClothBodyCollider, ASurfaceSplitAtUvSeamsIsWeldedClosed) {
   int seamSide = 0;
   for (Eigen::Index t = 0; t < split.triangles.rows(); ++t) {
     const Vec3f centre = (closed.positions.row(closed.triangles(t, 0)) + closed.positions.row(closed.triangles(t, 1)) +
-                          closed.positions.row(closed.triangles(t, 2))) / 3.f;
+                          closed.positions.row(closed.triangles(t, 2))) /
+                         3.f;
     if (centre.x() > 0.f) split.triangles.row(t).array() += uint32_t(n), ++seamSide;
   }
   ASSERT_GT(seamSide, 0);
@@ -289,7 +291,8 @@ std::vector<Vec3f> hairpinPath(int rowsPerPiece, std::vector<Vec3f>* tangents = 
   for (int k = 0; k <= rowsPerPiece; ++k) add({0.f, kPinLeg * float(k) / float(rowsPerPiece), 0.f}, Vec3f::UnitY());
   for (int k = 1; k < rowsPerPiece; ++k) {
     const float a = float(M_PI) * float(k) / float(rowsPerPiece);
-    add({kPinBend - kPinBend * std::cos(a), kPinLeg + kPinBend * std::sin(a), 0.f}, Vec3f(std::sin(a), std::cos(a), 0.f));
+    add({kPinBend - kPinBend * std::cos(a), kPinLeg + kPinBend * std::sin(a), 0.f},
+        Vec3f(std::sin(a), std::cos(a), 0.f));
   }
   for (int k = 0; k <= rowsPerPiece; ++k)
     add({2.f * kPinBend, kPinLeg * (1.f - float(k) / float(rowsPerPiece)), 0.f}, -Vec3f::UnitY());
@@ -307,7 +310,8 @@ Mesh armAndTrunkHairpin() {
     const Vec3f n = tangents[size_t(k)].cross(Vec3f::UnitZ());  // in the plane, towards the gap
     for (int j = 0; j < kPinRing; ++j) {
       const float ph = 2.f * float(M_PI) * float(j) / kPinRing;
-      m.positions.row(k * kPinRing + j) = path[size_t(k)] + kPinRadius * (std::cos(ph) * n + std::sin(ph) * Vec3f::UnitZ());
+      m.positions.row(k * kPinRing + j) =
+          path[size_t(k)] + kPinRadius * (std::cos(ph) * n + std::sin(ph) * Vec3f::UnitZ());
       m.skin.joints.push_back(k <= kPinRows ? 1 : 0);
       m.skin.weights.push_back(1.f);
     }
@@ -349,8 +353,9 @@ TEST(ClothBodyCollider, AOneSurfaceBodyGetsAPlanePerSkinningRegion) {
   const Mesh pin = armAndTrunkHairpin();
   double volume = 0.0;
   for (Eigen::Index t = 0; t < pin.triangles.rows(); ++t)
-    volume += double(pin.positions.row(pin.triangles(t, 0)).dot(
-                  pin.positions.row(pin.triangles(t, 1)).cross(pin.positions.row(pin.triangles(t, 2))))) / 6.0;
+    volume += double(pin.positions.row(pin.triangles(t, 0))
+                         .dot(pin.positions.row(pin.triangles(t, 1)).cross(pin.positions.row(pin.triangles(t, 2))))) /
+              6.0;
   ASSERT_GT(volume, 0.0) << "outward triangles";
   const std::vector<uint8_t> groups = {0, 1};
   BodyCollider whole(pin, 0.03f), split(pin, 0.03f, "hairpin", groups);
@@ -360,7 +365,7 @@ TEST(ClothBodyCollider, AOneSurfaceBodyGetsAPlanePerSkinningRegion) {
   const Vec3f p(0.045f, 0.15f, 0.f);
   std::array<BodyCollider::Hit, 3> hits;
   EXPECT_EQ(whole.closestParts(p, 0.03f, std::span(hits)), 1u);
-  EXPECT_EQ(split.closestParts(p, 0.03f, std::span(hits)), 1u);  // parts are parts: one
+  EXPECT_EQ(split.closestParts(p, 0.03f, std::span(hits)), 1u);    // parts are parts: one
   EXPECT_EQ(whole.closestRegions(p, 0.03f, std::span(hits)), 1u);  // nothing split, nothing more
   ASSERT_EQ(split.closestRegions(p, 0.03f, std::span(hits)), 2u);
   EXPECT_EQ(hits[0].part, hits[1].part);
@@ -369,7 +374,8 @@ TEST(ClothBodyCollider, AOneSurfaceBodyGetsAPlanePerSkinningRegion) {
   EXPECT_NEAR(hits[1].signedDistance, 0.015f, 5e-4f);  // the trunk's
   EXPECT_GT(hits[0].normal.dot(Vec3f::UnitX()), 0.99f);
   EXPECT_GT(hits[1].normal.dot(-Vec3f::UnitX()), 0.99f);
-  for (size_t k = 0; k < 2; ++k) EXPECT_NEAR((hits[k].point + hits[k].normal * hits[k].signedDistance - p).norm(), 0.f, 1e-4f);
+  for (size_t k = 0; k < 2; ++k)
+    EXPECT_NEAR((hits[k].point + hits[k].normal * hits[k].signedDistance - p).norm(), 0.f, 1e-4f);
   // Were joint 1 most of the part (or all of it), the arm would be the part (a mannequin's arm tube
   // with a few shoulder triangles), not in it: nothing is split.
   Mesh mostlyArm = pin;
@@ -412,7 +418,8 @@ TEST(ClothBodyCollider, RegionsOfAPointOutsideAreAllOutside) {
     }
     ++outside;
     twoRegions += n > 1;
-    for (size_t k = 0; k < n; ++k) EXPECT_GT(hits[k].signedDistance, 0.f) << "point " << p.transpose() << " region " << k;
+    for (size_t k = 0; k < n; ++k)
+      EXPECT_GT(hits[k].signedDistance, 0.f) << "point " << p.transpose() << " region " << k;
   }
   EXPECT_GT(outside, 200);
   EXPECT_GT(twoRegions, 100) << "the sample must straddle the regions' border";
@@ -438,7 +445,8 @@ TEST(ClothBodyCollider, TheDefaultMannequinIsNotSplitIntoRegions) {
   for (int i = 0; i < 300; ++i) {
     const Vec3f p(rng.uniformf(-0.3f, 0.3f), rng.uniformf(1.2f, 1.5f), rng.uniformf(-0.15f, 0.15f));
     std::array<BodyCollider::Hit, 2> a, b;
-    const size_t na = collider.closestRegions(p, 0.024f, std::span(a)), nb = plain.closestParts(p, 0.024f, std::span(b));
+    const size_t na = collider.closestRegions(p, 0.024f, std::span(a)),
+                 nb = plain.closestParts(p, 0.024f, std::span(b));
     ASSERT_EQ(na, nb);
     for (size_t k = 0; k < na; ++k) {
       EXPECT_EQ(a[k].signedDistance, b[k].signedDistance);

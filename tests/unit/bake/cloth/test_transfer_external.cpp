@@ -6,9 +6,9 @@
 // (The whole round trip through `swish bake` is tests/e2e/test_bake_external.cpp.)
 #include <gtest/gtest.h>
 
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -18,8 +18,8 @@
 #include "support/temp_dir.hpp"
 #include "swish/bake/cloth/external_simulation.hpp"
 #include "swish/bake/pipeline/bake_config.hpp"
-#include "swish/files/atomic_write.hpp"
 #include "swish/core/error.hpp"
+#include "swish/files/atomic_write.hpp"
 #include "swish/io/mesh_import.hpp"
 
 using namespace swish;
@@ -146,7 +146,8 @@ Points3f bend(const Points3f& p, float amount) {
 }
 
 // The same mesh in another vertex order (new vertex k is old vertex order[k]).
-void permute(const Points3f& p, const Triangles& t, Points3f& outP, Triangles& outT, const std::vector<uint32_t>& order) {
+void permute(const Points3f& p, const Triangles& t, Points3f& outP, Triangles& outT,
+             const std::vector<uint32_t>& order) {
   std::vector<uint32_t> inv(order.size());
   outP.resize(p.rows(), 3);
   for (uint32_t k = 0; k < order.size(); ++k) {
@@ -283,8 +284,8 @@ namespace {
 
 // A .gltf holding `base` with one morph target per frame (glTF stores targets as offsets from the
 // base), target names in mesh.extras.targetNames as Blender writes them.
-void writeMorphGltf(const fs::path& file, const Points3f& base, const Triangles& tris, const std::vector<Points3f>& frames,
-                    const std::vector<std::string>& names) {
+void writeMorphGltf(const fs::path& file, const Points3f& base, const Triangles& tris,
+                    const std::vector<Points3f>& frames, const std::vector<std::string>& names) {
   std::vector<uint8_t> bin;
   nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array();
   auto add = [&](const void* data, size_t bytes, size_t count, int type, const char* kind, const Points3f* bounds) {
@@ -318,15 +319,20 @@ void writeMorphGltf(const fs::path& file, const Points3f& base, const Triangles&
     b64 += i + 1 < bin.size() ? t[v >> 6 & 63] : '=';
     b64 += i + 2 < bin.size() ? t[v & 63] : '=';
   }
-  nlohmann::json mesh = {{"name", "garment"},
-                         {"primitives", {{{"attributes", {{"POSITION", pos}}}, {"indices", idx}, {"targets", targets}}}},
-                         {"weights", std::vector<float>(frames.size(), 0.f)}};
+  nlohmann::json mesh = {
+      {"name", "garment"},
+      {"primitives", {{{"attributes", {{"POSITION", pos}}}, {"indices", idx}, {"targets", targets}}}},
+      {"weights", std::vector<float>(frames.size(), 0.f)}};
   if (!names.empty()) mesh["extras"] = {{"targetNames", names}};
   const nlohmann::json j = {
-      {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {{{"name", "garment"}, {"mesh", 0}}}}, {"meshes", {mesh}},
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"name", "garment"}, {"mesh", 0}}}},
+      {"meshes", {mesh}},
       {"buffers", {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + b64}}}},
-      {"bufferViews", views}, {"accessors", accessors}};
+      {"bufferViews", views},
+      {"accessors", accessors}};
   writeTextFileAtomic(file, j.dump());
 }
 
@@ -388,8 +394,12 @@ TEST(ExternalSimulation, BakeConfigChecksTheSourceKeys) {
   EXPECT_EQ(c.part1->toJson()["simulation"]["source"], "external");
   EXPECT_FALSE(parse(nlohmann::json::object()).part1->external.enabled());
   EXPECT_FALSE(parse(nlohmann::json::object()).part1->toJson()["simulation"].contains("source"));
-  const BakeConfig w = parse({{"source", "external"}, {"path", "results"}, {"space", "world"},
-                              {"units_per_metre", 100}, {"up_axis", "z"}, {"origin", {1, 2, 3}}});
+  const BakeConfig w = parse({{"source", "external"},
+                              {"path", "results"},
+                              {"space", "world"},
+                              {"units_per_metre", 100},
+                              {"up_axis", "z"},
+                              {"origin", {1, 2, 3}}});
   EXPECT_TRUE(w.part1->external.worldSpace);
   EXPECT_EQ(w.part1->external.upAxis, 'z');
   EXPECT_EQ(w.part1->external.origin, Vec3d(1, 2, 3));

@@ -45,7 +45,8 @@ TEST(BakeKMeans, FindsSeparatedClustersDeterministically) {
   }
   for (uint32_t s : a.clusterSizes) EXPECT_EQ(s, 40u);
   double direct = 0.0;
-  for (Eigen::Index i = 0; i < p.rows(); ++i) direct += (p.row(i) - a.centres.row(a.assignment[size_t(i)])).squaredNorm();
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    direct += (p.row(i) - a.centres.row(a.assignment[size_t(i)])).squaredNorm();
   EXPECT_NEAR(a.inertia, direct, 1e-3 * direct);
   EXPECT_GE(a.iterations, 1);
   EXPECT_LT(a.inertia, 200 * 3 * 0.3 * 0.3 * 1.5);

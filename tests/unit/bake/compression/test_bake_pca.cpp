@@ -36,7 +36,8 @@ TEST(BakePca, ExactFitRecoversLowRankDataAndReportsPerKErrors) {
   EXPECT_EQ(p.components(), 5);  // rank-limited
   EXPECT_NEAR(p.explainedVariance[5], 1.0, 1e-6);
   EXPECT_LT(p.explainedVariance[1], p.explainedVariance[2]);
-  for (int k = 1; k < p.residualSquaredNorm.size(); ++k) EXPECT_LE(p.residualSquaredNorm[k], p.residualSquaredNorm[k - 1] + 1e-6);
+  for (int k = 1; k < p.residualSquaredNorm.size(); ++k)
+    EXPECT_LE(p.residualSquaredNorm[k], p.residualSquaredNorm[k - 1] + 1e-6);
   const MatXf back = p.reconstruct(p.project(x));
   EXPECT_LT((back - x).cwiseAbs().maxCoeff(), 1e-3f);
   EXPECT_LT((p.basis.transpose() * p.basis - MatXf::Identity(5, 5)).cwiseAbs().maxCoeff(), 1e-5f);

@@ -97,7 +97,7 @@ TEST(BakeVq, BeatsBc5MemoryAtComparableErrorOnSmoothMaps) {
   const double vqMean = vq.stats().meanDegrees, bc5Mean = bc5.stats().meanDegrees;
   EXPECT_GT(bc5Mean, 0.0);
   EXPECT_LT(bc5Mean, 1.0);  // BC5 of smooth maps is good (8-bit endpoints, 8 levels per block)
-  EXPECT_LT(vqMean, 2.0);  // smooth maps, 256 entries: well under the 1.5-degree budget's scale
+  EXPECT_LT(vqMean, 2.0);   // smooth maps, 256 entries: well under the 1.5-degree budget's scale
   EXPECT_LT(rep.totalBytes(), 8 * bc5Bytes(64, 64));
   // Deterministic for a seed.
   NormalMapDatabase again;
@@ -148,7 +148,7 @@ TEST(BakeBc5AtEqualMemory, SizeFitsTheBytesAndKeepsBlocksWhole) {
   EXPECT_EQ(h % 4, 0u);
   EXPECT_LE(bc5Bytes(w, h), 12288u);
   EXPECT_GT(bc5Bytes(w + 4, h + 4), 12288u);  // the largest that fits
-  EXPECT_EQ(w, 108u);                          // 27 x 27 blocks of 16 bytes = 11664 bytes
+  EXPECT_EQ(w, 108u);                         // 27 x 27 blocks of 16 bytes = 11664 bytes
   EXPECT_EQ(bc5SizeWithin(256, 128, 16 * 8 * 4).second * 2, bc5SizeWithin(256, 128, 16 * 8 * 4).first);  // aspect
   EXPECT_EQ(bc5SizeWithin(64, 64, 15), std::make_pair(0u, 0u));  // not one block
 }

@@ -36,9 +36,9 @@ TEST(DatasetPreview, NormalMapChangesTheShadingOfTheMesh) {
   const PreviewImage tilted = renderShadedFrontView(m, m.positions, constantMap(0.6f, 0), 64);
   ASSERT_EQ(flat.rgb.size(), 64u * 64u * 3u);
   const size_t centre = 3 * (32 * 64 + 32), corner = 0;
-  EXPECT_EQ(flat.rgb[corner], 60);                        // background outside the mesh (margin)
-  EXPECT_GT(flat.rgb[centre], 100);                       // lit front face
-  EXPECT_NE(flat.rgb[centre], tilted.rgb[centre]);        // the normal map shows
+  EXPECT_EQ(flat.rgb[corner], 60);                            // background outside the mesh (margin)
+  EXPECT_GT(flat.rgb[centre], 100);                           // lit front face
+  EXPECT_NE(flat.rgb[centre], tilted.rgb[centre]);            // the normal map shows
   EXPECT_EQ(flat.rgb[centre], flat.rgb[3 * (20 * 64 + 40)]);  // a flat map shades a flat quad evenly
 }
 

@@ -35,35 +35,44 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_EQ(c.train.databaseSize, 128);
   EXPECT_EQ(c.train.normalCodeWeight, 1.0);
   EXPECT_EQ(c.train.meshWeightFloor, 0.0);
-  const BakeConfig f = parseBakeConfig({{"output", "out"}, {"train", {{"mesh_weight_floor", 0.5}}}}, "recipe.json", "/base");
+  const BakeConfig f =
+      parseBakeConfig({{"output", "out"}, {"train", {{"mesh_weight_floor", 0.5}}}}, "recipe.json", "/base");
   EXPECT_DOUBLE_EQ(f.train.meshWeightFloor, 0.5);
   EXPECT_DOUBLE_EQ(f.train.toJson()["mesh_weight_floor"].get<double>(), 0.5);
-  const BakeConfig w = parseBakeConfig({{"output", "out"}, {"train", {{"normal_code_weight", 0.1}}}}, "recipe.json", "/base");
+  const BakeConfig w =
+      parseBakeConfig({{"output", "out"}, {"train", {{"normal_code_weight", 0.1}}}}, "recipe.json", "/base");
   EXPECT_DOUBLE_EQ(w.train.normalCodeWeight, 0.1);
   EXPECT_DOUBLE_EQ(w.train.toJson()["normal_code_weight"].get<double>(), 0.1);  // what the model's metadata records
-  EXPECT_TRUE(w.train.inputJoints.empty());  // the dataset's (part 1's) joints
+  EXPECT_TRUE(w.train.inputJoints.empty());                                     // the dataset's (part 1's) joints
   EXPECT_FALSE(w.train.toJson().contains("input_joints"));
-  const BakeConfig j = parseBakeConfig({{"output", "out"}, {"train", {{"input_joints", {"Spine", "LeftForeArm"}}}}}, "recipe.json", "/base");
+  const BakeConfig j = parseBakeConfig({{"output", "out"}, {"train", {{"input_joints", {"Spine", "LeftForeArm"}}}}},
+                                       "recipe.json", "/base");
   EXPECT_EQ(j.train.inputJoints, (std::vector<std::string>{"Spine", "LeftForeArm"}));
   EXPECT_EQ(j.train.toJson()["input_joints"], nlohmann::json({"Spine", "LeftForeArm"}));
 }
 
 TEST(BakeConfig, ErrorsNameTheKey) {
   EXPECT_NE(errorOf({{"output", "o"}, {"colour", 1}}).find("colour: unknown key"), std::string::npos);
-  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"codebook_size", 70000}}}}).find("train.codebook_size: 70000 is outside"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf({{"output", "o"}, {"train", {{"codebook_size", 70000}}}}).find("train.codebook_size: 70000 is outside"),
+      std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"hidden_layerz", 3}}}}).find("train.hidden_layerz: unknown key"),
             std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"max_epochs", 1.5}}}}).find("train.max_epochs: must be an integer"),
             std::string::npos);
-  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"activation", "relu"}}}}).find("train.activation"), std::string::npos);
-  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"learning_rate", "fast"}}}}).find("train.learning_rate: must be a number"),
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"activation", "relu"}}}}).find("train.activation"),
             std::string::npos);
-  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"normal_code_weight", 0}}}}).find("train.normal_code_weight: 0 is outside"),
+  EXPECT_NE(
+      errorOf({{"output", "o"}, {"train", {{"learning_rate", "fast"}}}}).find("train.learning_rate: must be a number"),
+      std::string::npos);
+  EXPECT_NE(
+      errorOf({{"output", "o"}, {"train", {{"normal_code_weight", 0}}}}).find("train.normal_code_weight: 0 is outside"),
+      std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"mesh_weight_floor", 1.5}}}})
+                .find("train.mesh_weight_floor: 1.5 is outside"),
             std::string::npos);
-  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"mesh_weight_floor", 1.5}}}}).find("train.mesh_weight_floor: 1.5 is outside"),
-            std::string::npos);
-  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"input_joints", "Spine"}}}}).find("train.input_joints: must be a non-empty array"),
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"input_joints", "Spine"}}}})
+                .find("train.input_joints: must be a non-empty array"),
             std::string::npos);
   EXPECT_NE(errorOf({{"name", "../x"}, {"output", "o"}}).find("name"), std::string::npos);
   EXPECT_NE(errorOf({{"name", "x"}}).find("output: is required"), std::string::npos);
@@ -90,7 +99,7 @@ bool says(const std::string& error, const std::string& what) {
 TEST(BakeConfig, Part1DefaultsAndValues) {
   const BakeConfig d = parseBakeConfig({{"output", "o"}, {"part1", part1()}}, "recipe.json", "/base");
   ASSERT_TRUE(d.part1.has_value());
-  EXPECT_TRUE(d.part1->characterFile.empty());   // the embedded default character
+  EXPECT_TRUE(d.part1->characterFile.empty());  // the embedded default character
   EXPECT_TRUE(d.part1->characterRecipe.empty());
   EXPECT_EQ(d.part1->clips.size(), 1u);
   EXPECT_EQ(d.part1->targetPoses, 200u);
@@ -101,14 +110,19 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(d.part1->transfer.normalMap.width, 360u);
 
   const BakeConfig c = parseBakeConfig(
-      {{"output", "o"}, {"work", "/tmp/w"},
+      {{"output", "o"},
+       {"work", "/tmp/w"},
        {"part1", part1({{"character", {{"file", kThisFile}, {"garment_mesh", {"shirt"}}}},
-                        {"clips", {{{"file", kThisFile}, {"naming", "mixamo"},
-                                    {"joint_map", {{"Hips", "Hips"}}}}}},
+                        {"clips", {{{"file", kThisFile}, {"naming", "mixamo"}, {"joint_map", {{"Hips", "Hips"}}}}}},
                         {"input_joints", {"Spine", "Spine1"}},
                         {"thinning", {{"tolerance", 0.25}, {"include_rest_pose", false}}},
-                        {"simulation", {{"preset", "stiff"}, {"vertices", 4000}, {"threads", 2}, {"substeps", 4}, {"gravity", 0},
-                                        {"attach_band", 0.03}}},
+                        {"simulation",
+                         {{"preset", "stiff"},
+                          {"vertices", 4000},
+                          {"threads", 2},
+                          {"substeps", 4},
+                          {"gravity", 0},
+                          {"attach_band", 0.03}}},
                         {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
                         {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
       "recipe.json", "/base");
@@ -149,7 +163,8 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");
   says(part1Error({{"thinning", nlohmann::json::object()}}), "part1.thinning: give exactly one");
   says(part1Error({{"thinning", {{"target_poses", 1}}}}), "part1.thinning.target_poses: 1 is outside");
-  says(part1Error({{"thinning", {{"target_poses", 10}, {"include_rest_pose", 1}}}}), "part1.thinning.include_rest_pose");
+  says(part1Error({{"thinning", {{"target_poses", 10}, {"include_rest_pose", 1}}}}),
+       "part1.thinning.include_rest_pose");
   says(part1Error({{"clips", {"/nonexistent/walk.bvh"}}}), "part1.clips[0]: file /nonexistent/walk.bvh does not exist");
   says(part1Error({{"clips", nlohmann::json::array()}}), "part1.clips: must be a non-empty array");
   says(part1Error({{"clips", {{{"file", kThisFile}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");
@@ -163,9 +178,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(errorOf({{"output", "o"}, {"part1", {{"clips", {kThisFile}}}}}), "part1.thinning: is required");
 }
 
-TEST(BakeConfig, MissingFileIsAClearError) {
-  EXPECT_THROW(loadBakeConfig("/nonexistent/recipe.json"), Error);
-}
+TEST(BakeConfig, MissingFileIsAClearError) { EXPECT_THROW(loadBakeConfig("/nonexistent/recipe.json"), Error); }
 
 // The committed default model is what its committed recipe makes: the part 2 settings the model's
 // metadata records (and its input joints) are the recipe's. Editing assets/default/bake.json without

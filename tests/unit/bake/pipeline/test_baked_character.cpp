@@ -50,7 +50,8 @@ TEST(BakedCharacter, FilesAreFoundAsWrittenOrBesideTheModel) {
   const auto recipe = test::sourceDir() / "assets/default/recipe.json";
   std::filesystem::copy_file(recipe, dir / "recipe.json");
   // As written (absolute), and relative names beside the model.
-  EXPECT_EQ(findBakedCharacter(metadataNaming({{"recipe", recipe.string()}}), dir / "m.swish").settings.characterRecipe, recipe);
+  EXPECT_EQ(findBakedCharacter(metadataNaming({{"recipe", recipe.string()}}), dir / "m.swish").settings.characterRecipe,
+            recipe);
   const BakedCharacter beside = findBakedCharacter(metadataNaming({{"recipe", "recipe.json"}}), dir / "m.swish");
   EXPECT_EQ(beside.kind, BakedCharacter::Kind::Recipe);
   EXPECT_TRUE(beside.available()) << beside.problem;

@@ -14,12 +14,12 @@
 #include "support/error_message.hpp"
 #include "support/paths.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/bake/pipeline/bake_config.hpp"
-#include "swish/bake/poses/clip_list.hpp"
-#include "swish/bake/report/bake_evaluation.hpp"
-#include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/character/default_character.hpp"
+#include "swish/bake/pipeline/bake_config.hpp"
+#include "swish/bake/pipeline/bake_pipeline.hpp"
+#include "swish/bake/poses/clip_list.hpp"
 #include "swish/bake/poses/pose_sampling.hpp"
+#include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rotation.hpp"
 #include "swish/io/animation_import.hpp"
@@ -75,8 +75,11 @@ TEST(ClipList, FoldersGlobsAndIndexFilesExpandSortedWithSubjects) {
   ASSERT_EQ(glob.size(), 2u);
   EXPECT_EQ(glob[1].file.filename(), "02_07.bvh");
 
-  const auto index = parse({{{"index", "mocap/index.tsv"}, {"exclude_subjects", {"02"}}, {"weights", {{"01_02", 3}}},
-                             {"weight", 0.5}, {"joint_map", {{"abdomen", "LowerBack"}, {"chest", {"Spine", "Spine1"}}}}}},
+  const auto index = parse({{{"index", "mocap/index.tsv"},
+                             {"exclude_subjects", {"02"}},
+                             {"weights", {{"01_02", 3}}},
+                             {"weight", 0.5},
+                             {"joint_map", {{"abdomen", "LowerBack"}, {"chest", {"Spine", "Spine1"}}}}}},
                            c.base());
   ASSERT_EQ(index.size(), 2u);
   EXPECT_EQ(index[0].subject, "1");
@@ -96,18 +99,22 @@ TEST(ClipList, FoldersGlobsAndIndexFilesExpandSortedWithSubjects) {
   EXPECT_EQ(other[0].file, c.dir / "mocap" / "02_07.bvh");
 
   // Per-subject weights, a subject filter, and a joint map file.
-  touch(c.dir / "maps" / "daz.json", R"({"hip": "Hips", "chest": {"joints": ["Spine", "Spine1"], "shares": [0.3, 0.7]}})");
-  const auto two = parse({{{"glob", "mocap/*.bvh"}, {"subjects", {"2"}}, {"weights", {{"2", 2}}}, {"joint_map", "maps/daz.json"}}},
-                         c.base());
+  touch(c.dir / "maps" / "daz.json",
+        R"({"hip": "Hips", "chest": {"joints": ["Spine", "Spine1"], "shares": [0.3, 0.7]}})");
+  const auto two =
+      parse({{{"glob", "mocap/*.bvh"}, {"subjects", {"2"}}, {"weights", {{"2", 2}}}, {"joint_map", "maps/daz.json"}}},
+            c.base());
   ASSERT_EQ(two.size(), 2u);
   EXPECT_DOUBLE_EQ(two[0].weight, 2.0);
   ASSERT_EQ(two[0].jointChains.size(), 1u);
   EXPECT_FLOAT_EQ(two[0].jointChains[0].shares[1], 0.7f);
 
   // The whole recipe takes the list.
-  const BakeConfig cfg = parseBakeConfig({{"output", "o"}, {"part1", {{"clips", {"mocap", "/usr/share/assimp/models/BVH/01_01.bvh"}},
-                                                                      {"thinning", {{"target_poses", 10}}}}}},
-                                         "recipe.json", c.base());
+  const BakeConfig cfg = parseBakeConfig(
+      {{"output", "o"},
+       {"part1",
+        {{"clips", {"mocap", "/usr/share/assimp/models/BVH/01_01.bvh"}}, {"thinning", {{"target_poses", 10}}}}}},
+      "recipe.json", c.base());
   EXPECT_EQ(cfg.part1->clips.size(), 5u);
 }
 
@@ -123,7 +130,8 @@ TEST(ClipList, MistakesNameTheEntryAndTheFile) {
   EXPECT_SAYS(parseError({{{"index", "mocap/index.tsv"}, {"subjects", {"7"}}}}, c.base()), "no clip of subject '7'");
   EXPECT_SAYS(parseError({{{"index", "mocap/index.tsv"}, {"weights", {{"99_01", 2}}}}}, c.base()),
               "part1.clips[0].weights.99_01: names neither a clip");
-  EXPECT_SAYS(parseError({{{"file", "mocap/01_01.bvh"}, {"weight", 0}}}, c.base()), "part1.clips[0].weight: must be a number in 0.01..100");
+  EXPECT_SAYS(parseError({{{"file", "mocap/01_01.bvh"}, {"weight", 0}}}, c.base()),
+              "part1.clips[0].weight: must be a number in 0.01..100");
   EXPECT_SAYS(parseError({{{"file", "mocap/01_01.bvh"}, {"joint_map", "none.json"}}}, c.base()), "joint map file");
   const auto badShares = nlohmann::json::parse(
       R"([{"file": "mocap/01_01.bvh", "joint_map": {"chest": {"joints": ["Spine", "Spine1"], "shares": [0.3, 0.3]}}}])");
@@ -132,11 +140,13 @@ TEST(ClipList, MistakesNameTheEntryAndTheFile) {
   EXPECT_SAYS(parseError({{{"folder", "mocap"}, {"subject", "1"}}}, c.base()), "applies to a \"file\" entry only");
 
   touch(c.dir / "bad" / "index.tsv", "subject\tframes\n1\t10\n");
-  EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()), "index.tsv:1: the header row names no \"file\" column");
+  EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()),
+              "index.tsv:1: the header row names no \"file\" column");
   touch(c.dir / "bad" / "index.tsv", "file\tframes\n01_01.bvh\t10\nlost.bvh\t3\n");
   EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()), "index.tsv:2: clip file");
   touch(c.dir / "bad" / "01_01.bvh");
-  EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()), "index.tsv:3: clip file " + (c.dir / "bad" / "lost.bvh").string());
+  EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()),
+              "index.tsv:3: clip file " + (c.dir / "bad" / "lost.bvh").string());
   touch(c.dir / "bad" / "index.tsv", "file\tframes\n01_01.bvh\tmany\n");
   EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()), "frames 'many' is not a positive integer");
 }
@@ -191,22 +201,23 @@ TEST(JointMapChain, SharesTheRotationAlongTheChainAndKeepsTheLastJointsGlobal) {
   clip.name = "bend";
   clip.jointNames = {"hip", "x", "y", "z"};
   clip.parents = {-1, 0, 1, 2};
-  clip.rest = {{Quatf::Identity(), Vec3f(0, 1, 0)}, {Quatf::Identity(), Vec3f(0, 0.1f, 0)},
-               {Quatf::Identity(), Vec3f(0, 0.2f, 0)}, {Quatf::Identity(), Vec3f(0, 0.1f, 0)}};
+  clip.rest = {{Quatf::Identity(), Vec3f(0, 1, 0)},
+               {Quatf::Identity(), Vec3f(0, 0.1f, 0)},
+               {Quatf::Identity(), Vec3f(0, 0.2f, 0)},
+               {Quatf::Identity(), Vec3f(0, 0.1f, 0)}};
   const Quatf bend(Eigen::AngleAxisf(0.8f, Vec3f::UnitZ()));
   clip.frames = {clip.rest};
   clip.frames[0][2].rotation = bend;
   io::RetargetOptions o;
   o.requiredJoints = {"A", "C"};
-  o.jointMap = io::parseJointMap({{"hip", "Hips"}, {"x", "A"}, {"y", {{"joints", {"B", "C"}}, {"shares", {0.25, 0.75}}}},
-                                  {"z", "D"}},
-                                 "map");
+  o.jointMap = io::parseJointMap(
+      {{"hip", "Hips"}, {"x", "A"}, {"y", {{"joints", {"B", "C"}}, {"shares", {0.25, 0.75}}}}, {"z", "D"}}, "map");
   const AnimationClip out = io::retarget(clip, ch, o);
   const Pose& p = out.frames[0];
   EXPECT_NEAR(p.local[2].angularDistance(Quatf::Identity()), 0.25f * 0.8f, 1e-4f);  // B: a quarter
   EXPECT_NEAR(p.local[3].angularDistance(Quatf::Identity()), 0.75f * 0.8f, 1e-4f);  // C: the rest
-  EXPECT_NEAR((p.local[2] * p.local[3]).angularDistance(bend), 0.f, 1e-4f);          // C's global is the clip's
-  EXPECT_NEAR(p.local[4].angularDistance(Quatf::Identity()), 0.f, 1e-4f);            // D unchanged below it
+  EXPECT_NEAR((p.local[2] * p.local[3]).angularDistance(bend), 0.f, 1e-4f);         // C's global is the clip's
+  EXPECT_NEAR(p.local[4].angularDistance(Quatf::Identity()), 0.f, 1e-4f);           // D unchanged below it
   // Without the chain, C takes the whole bend and B stays at rest.
   o.jointMap = io::parseJointMap({{"hip", "Hips"}, {"x", "A"}, {"y", "C"}, {"z", "D"}}, "map");
   const AnimationClip plain = io::retarget(clip, ch, o);
@@ -218,35 +229,40 @@ TEST(JointMapChain, SharesTheRotationAlongTheChainAndKeepsTheLastJointsGlobal) {
   o.jointMap = io::parseJointMap({{"hip", "Hips"}, {"nothing", {"B", "C"}}}, "map");
   o.requiredJoints = {};
   EXPECT_SAYS(test::errorOf([&] { io::retarget(clip, ch, o); }), "no clip joint drives its last joint 'C'");
-  EXPECT_SAYS(test::errorOf([&] { io::parseJointMap({{"y", nlohmann::json::array()}}, "m"); }), "m.y: a chain must list");
+  EXPECT_SAYS(test::errorOf([&] {
+                io::parseJointMap({{"y", nlohmann::json::array()}}, "m");
+              }),
+              "m.y: a chain must list");
   // Round trip through the JSON form.
   const io::JointMapOptions m = io::parseJointMap({{"y", {{"joints", {"B", "C"}}, {"shares", {0.25, 0.75}}}}}, "m");
   EXPECT_EQ(io::jointMapToJson(m)["y"]["joints"], nlohmann::json({"B", "C"}));
 }
 
 namespace {
-#define SKIP_WITHOUT_CORPUS()                                                                                  \
-  if (!fs::exists(test::sharedMocap("cmu-daz/index.tsv")) || !fs::exists(test::sharedMocap("index.tsv"))) { \
-    if (std::getenv("CI")) FAIL() << "the shared mocap corpus " << test::sharedMocap() << " is absent in CI";     \
-    GTEST_SKIP() << "the shared mocap corpus " << test::sharedMocap() << " is absent";                           \
+#define SKIP_WITHOUT_CORPUS()                                                                                 \
+  if (!fs::exists(test::sharedMocap("cmu-daz/index.tsv")) || !fs::exists(test::sharedMocap("index.tsv"))) {   \
+    if (std::getenv("CI")) FAIL() << "the shared mocap corpus " << test::sharedMocap() << " is absent in CI"; \
+    GTEST_SKIP() << "the shared mocap corpus " << test::sharedMocap() << " is absent";                        \
   }
 
-const std::vector<std::string> kNetworkJoints = {"LowerBack", "Spine", "Spine1", "LeftShoulder", "RightShoulder",
-                                                 "LeftArm", "RightArm", "LeftForeArm", "RightForeArm", "LeftUpLeg",
-                                                 "RightUpLeg"};
+const std::vector<std::string> kNetworkJoints = {"LowerBack",     "Spine",     "Spine1",    "LeftShoulder",
+                                                 "RightShoulder", "LeftArm",   "RightArm",  "LeftForeArm",
+                                                 "RightForeArm",  "LeftUpLeg", "RightUpLeg"};
 }  // namespace
 
 TEST(ClipListCorpus, EveryClipOfBothSkeletonsReadsOntoTheDefaultCharacter) {
   SKIP_WITHOUT_CORPUS();
   const fs::path map = test::sourceDir() / "assets/joint_maps/cmu_daz.json";
-  const auto sources = parse({{{"index", test::sharedMocap("index.tsv").string()}, {"folder", test::sharedMocap("cmu").string()}},
-                              {{"index", test::sharedMocap("cmu-daz/index.tsv").string()}, {"joint_map", map.string()}}},
-                             "/");
+  const auto sources =
+      parse({{{"index", test::sharedMocap("index.tsv").string()}, {"folder", test::sharedMocap("cmu").string()}},
+             {{"index", test::sharedMocap("cmu-daz/index.tsv").string()}, {"joint_map", map.string()}}},
+            "/");
   ASSERT_EQ(sources.size(), 150u);
   const Character character = makeDefaultCharacter();
   const auto clips = importClips(sources, character.skeleton, kNetworkJoints, 0);
   ASSERT_EQ(clips.size(), 150u);
-  for (size_t i = 0; i < clips.size(); ++i) EXPECT_EQ(clips[i].frames.size(), sources[i].expectedFrames) << sources[i].file;
+  for (size_t i = 0; i < clips.size(); ++i)
+    EXPECT_EQ(clips[i].frames.size(), sources[i].expectedFrames) << sources[i].file;
 
   // Frame 0 of both conversions is a reference T-pose (arms along +-X, legs down). Through the joint map
   // the character's upper arms, forearms and thighs point the same way in both (within 10 degrees, the forearms 30; a
@@ -254,8 +270,8 @@ TEST(ClipListCorpus, EveryClipOfBothSkeletonsReadsOntoTheDefaultCharacter) {
   // twist their limbs differently at rest, and direction-based retargeting keeps that twist (printed).
   const auto gc = character.skeleton.globalTransforms(clips[0].frames[0]);
   const auto gd = character.skeleton.globalTransforms(clips[67].frames[0]);
-  for (const char* pair : {"LeftArm>LeftForeArm", "RightArm>RightForeArm", "LeftForeArm>LeftHand", "RightForeArm>RightHand",
-                           "LeftUpLeg>LeftLeg", "RightUpLeg>RightLeg", "LowerBack>Neck"}) {
+  for (const char* pair : {"LeftArm>LeftForeArm", "RightArm>RightForeArm", "LeftForeArm>LeftHand",
+                           "RightForeArm>RightHand", "LeftUpLeg>LeftLeg", "RightUpLeg>RightLeg", "LowerBack>Neck"}) {
     const std::string p(pair);
     const size_t a = size_t(character.skeleton.find(p.substr(0, p.find('>'))));
     const size_t b = size_t(character.skeleton.find(p.substr(p.find('>') + 1)));
@@ -263,7 +279,8 @@ TEST(ClipListCorpus, EveryClipOfBothSkeletonsReadsOntoTheDefaultCharacter) {
     const Vec3f dd = (gd[b].translation - gd[a].translation).normalized();
     const double degrees = std::acos(std::clamp(double(dc.dot(dd)), -1.0, 1.0)) * 180.0 / M_PI;
     const double rotation = gc[a].rotation.angularDistance(gd[a].rotation) * 180.0 / M_PI;
-    std::printf("T-pose, CMU vs Daz conversion: %-24s direction %5.1f deg, global rotation %5.1f deg\n", pair, degrees, rotation);
+    std::printf("T-pose, CMU vs Daz conversion: %-24s direction %5.1f deg, global rotation %5.1f deg\n", pair, degrees,
+                rotation);
     // The forearms differ by about 20 degrees: the Daz reference pose bends the elbows a little.
     EXPECT_LT(degrees, p.find("ForeArm>") != std::string::npos ? 30.0 : 10.0) << pair << " of " << sources[67].file;
   }
@@ -321,7 +338,8 @@ Vec3d rotationVector(const Quatf& qf) {
 // recorded rotations, beside the errors of leaving Spine at rest (the map without a chain).
 TEST(ClipListCorpus, TheSpineChainSharesAreWhatTheCmuClipsShow) {
   SKIP_WITHOUT_CORPUS();
-  const auto sources = parse({{{"index", test::sharedMocap("index.tsv").string()}, {"folder", test::sharedMocap("cmu").string()}}}, "/");
+  const auto sources =
+      parse({{{"index", test::sharedMocap("index.tsv").string()}, {"folder", test::sharedMocap("cmu").string()}}}, "/");
   const Character character = makeDefaultCharacter();
   const auto clips = importClips(sources, character.skeleton, kNetworkJoints, 0);
   const size_t spine = size_t(character.skeleton.find("Spine")), spine1 = size_t(character.skeleton.find("Spine1"));
@@ -352,11 +370,12 @@ TEST(ClipListCorpus, TheSpineChainSharesAreWhatTheCmuClipsShow) {
   const double committed = map.chains[0].joints[0] == "Spine" ? map.chains[0].shares[0] : map.chains[1].shares[0];
   const auto [split0, split1] = errors(committed);
   const auto [rest0, rest1] = errors(0.0);
-  std::printf("CMU spine over %zu frames of %zu clips: least-squares share of Spine %.3f (committed %.3f)\n"
-              "  split:        Spine error mean %.2f p95 %.2f deg, Spine1 mean %.2f p95 %.2f deg\n"
-              "  Spine at rest: Spine error mean %.2f p95 %.2f deg, Spine1 mean %.2f p95 %.2f deg\n",
-              frames.size(), clips.size(), share, committed, split0.mean, split0.p95, split1.mean, split1.p95,
-              rest0.mean, rest0.p95, rest1.mean, rest1.p95);
+  std::printf(
+      "CMU spine over %zu frames of %zu clips: least-squares share of Spine %.3f (committed %.3f)\n"
+      "  split:        Spine error mean %.2f p95 %.2f deg, Spine1 mean %.2f p95 %.2f deg\n"
+      "  Spine at rest: Spine error mean %.2f p95 %.2f deg, Spine1 mean %.2f p95 %.2f deg\n",
+      frames.size(), clips.size(), share, committed, split0.mean, split0.p95, split1.mean, split1.p95, rest0.mean,
+      rest0.p95, rest1.mean, rest1.p95);
   EXPECT_NEAR(committed, share, 0.1);
   EXPECT_LT(split0.mean + split1.mean, rest0.mean + rest1.mean);
 }
@@ -378,8 +397,8 @@ TEST(ClipListCorpus, TheSmallCorpusRecipeLoads) {
 TEST(ClipList, HeldOutSubjectsMustBeInTheListAndLeaveSomethingToTrainOn) {
   const Corpus c;
   auto config = [&](const nlohmann::json& holdout) {
-    return nlohmann::json{{"output", "o"},
-                          {"part1", {{"clips", {"mocap"}}, {"thinning", {{"target_poses", 10}}}, {"holdout", holdout}}}};
+    return nlohmann::json{
+        {"output", "o"}, {"part1", {{"clips", {"mocap"}}, {"thinning", {{"target_poses", 10}}}, {"holdout", holdout}}}};
   };
   const BakeConfig ok = parseBakeConfig(config({{"subjects", {"2"}}, {"poses", 12}}), "recipe.json", c.base());
   EXPECT_EQ(ok.part1->holdoutPoses, 12u);

@@ -4,13 +4,13 @@
 
 #include <cmath>
 
-#include "swish/bake/cloth/body_collider.hpp"
+#include "support/cloth_fixture.hpp"
 #include "swish/bake/character/default_character.hpp"
+#include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/poses/limb_clearance.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rotation.hpp"
 #include "swish/core/skinning.hpp"
-#include "support/cloth_fixture.hpp"
 
 using namespace swish;
 using namespace swish::bake;

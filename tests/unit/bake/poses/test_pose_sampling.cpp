@@ -34,7 +34,8 @@ AnimationClip randomClip(const Skeleton& s, size_t frames, uint64_t seed) {
   c.framesPerSecond = 30.f;
   for (size_t f = 0; f < frames; ++f) {
     Pose p = s.restPose();
-    for (auto& q : p.local) q = Quatf(float(rng.normal()), float(rng.normal()), float(rng.normal()), float(rng.normal())).normalized();
+    for (auto& q : p.local)
+      q = Quatf(float(rng.normal()), float(rng.normal()), float(rng.normal()), float(rng.normal())).normalized();
     c.frames.push_back(p);
   }
   return c;
@@ -73,12 +74,14 @@ TEST(PoseSampling, SamplesAreTheRuntimeTheta) {
   const std::vector<AnimationClip> clips{randomClip(s, 12, test::testSeed(7))};
   PoseSamplingOptions o;
   o.joints = {"LeftArm", "LowerBack", "Spine1"};
-  const std::vector<uint32_t> joints{uint32_t(s.find("LeftArm")), uint32_t(s.find("LowerBack")), uint32_t(s.find("Spine1"))};
+  const std::vector<uint32_t> joints{uint32_t(s.find("LeftArm")), uint32_t(s.find("LowerBack")),
+                                     uint32_t(s.find("Spine1"))};
   const PoseSamples samples = samplePoses(s, clips, o);
   for (size_t f = 0; f < clips[0].frames.size(); ++f) {
     const std::vector<float> x = runtime::computeTheta(joints, clips[0].frames[f].local);
     ASSERT_EQ(x.size(), size_t(samples.dim));
-    for (int k = 0; k < samples.dim; ++k) EXPECT_NEAR(x[size_t(k)], samples.row(f)[k], 1e-6f) << "frame " << f << " value " << k;
+    for (int k = 0; k < samples.dim; ++k)
+      EXPECT_NEAR(x[size_t(k)], samples.row(f)[k], 1e-6f) << "frame " << f << " value " << k;
   }
 }
 

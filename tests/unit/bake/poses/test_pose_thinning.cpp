@@ -80,7 +80,8 @@ TEST(PoseThinning, KeptPosesAreSeparatedAndEveryRejectedPoseIsCovered) {
 TEST(PoseThinning, EqualsBruteForceGreedy) {
   for (uint64_t seed : {4u, 5u}) {
     const PoseSamples s = randomWalks(5, 800, 12, test::testSeed(seed));
-    for (float tol : {0.5f, 0.9f, 2.f}) EXPECT_EQ(thinPoses(s, tol).kept, bruteForceGreedy(s, tol)) << "tolerance " << tol;
+    for (float tol : {0.5f, 0.9f, 2.f})
+      EXPECT_EQ(thinPoses(s, tol).kept, bruteForceGreedy(s, tol)) << "tolerance " << tol;
   }
 }
 

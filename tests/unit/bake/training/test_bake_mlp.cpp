@@ -100,7 +100,7 @@ TEST(BakeMlp, TrainsASmoothMapDeterministicallyAndKeepsTheBestEpoch) {
   double minVal = 1e30;
   for (const auto& e : a.curve) minVal = std::min(minVal, e.validationLoss);
   EXPECT_DOUBLE_EQ(a.bestValidationLoss, minVal);
-  EXPECT_LT(a.bestValidationLoss, 0.05);               // standardised MSE: much better than the mean (1.0)
+  EXPECT_LT(a.bestValidationLoss, 0.05);  // standardised MSE: much better than the mean (1.0)
   EXPECT_LT(a.curve.back().trainLoss, a.curve.front().trainLoss * 0.2);
   // evaluateMlp undoes the standardisation: predictions land in the original units.
   double err = 0.0, spread = 0.0;
@@ -165,7 +165,7 @@ TEST(BakeMlp, ConstantInputsAndOutputsStayFinite) {
   MatXf x = MatXf::Random(6, 40), y(2, 40);
   x.row(2).setConstant(0.5f);  // a joint coordinate that never changes
   y.row(0) = x.row(0) * 2.f;
-  y.row(1).setConstant(3.f);   // an output that never changes
+  y.row(1).setConstant(3.f);  // an output that never changes
   MlpTrainOptions o;
   o.hiddenLayers = 1;
   o.maxEpochs = 20;

@@ -5,13 +5,13 @@
 
 #include <cmath>
 
-#include "swish/bake/cloth/body_collider.hpp"
-#include "swish/bake/training/body_proxy_fit.hpp"
+#include "support/cloth_fixture.hpp"
 #include "swish/bake/character/default_character.hpp"
+#include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/report/penetration.hpp"
+#include "swish/bake/training/body_proxy_fit.hpp"
 #include "swish/core/error.hpp"
 #include "swish/runtime/reference_push_out.hpp"
-#include "support/cloth_fixture.hpp"
 
 namespace swish {
 namespace {
@@ -45,10 +45,10 @@ TEST(Penetration, CountsAndDepthOnAnAnalyticBody) {
   bake::BodyCollider collider(ch.body, 0.05f);
   collider.pose(std::vector<Mat4f>(ch.skeleton.size(), Mat4f::Identity()));
   Points3f p(4, 3);
-  p.row(0) << 0.f, 0.35f, spec.radius - 0.001f;   // 1 mm inside: inside, not visible
-  p.row(1) << 0.f, 0.35f, spec.radius - 0.010f;   // 10 mm inside: visible
-  p.row(2) << 0.f, 0.35f, spec.radius + 0.005f;   // outside
-  p.row(3) << spec.radius - 0.004f, 0.5f, 0.f;    // 4 mm inside: visible
+  p.row(0) << 0.f, 0.35f, spec.radius - 0.001f;  // 1 mm inside: inside, not visible
+  p.row(1) << 0.f, 0.35f, spec.radius - 0.010f;  // 10 mm inside: visible
+  p.row(2) << 0.f, 0.35f, spec.radius + 0.005f;  // outside
+  p.row(3) << spec.radius - 0.004f, 0.5f, 0.f;   // 4 mm inside: visible
   const bake::PenetrationStats s = bake::measurePenetration(collider, p);
   EXPECT_EQ(s.vertices, 4u);
   EXPECT_EQ(s.inside, 3u);
@@ -68,10 +68,10 @@ TEST(PushOutReference, KnownAnswers) {
   BodyProxy proxy;
   proxy.capsules = {{0, Vec3f(0, 1, 0), Vec3f(0.2f, 1, 0), 0.05f}, {0, Vec3f(1, 1, 1), Vec3f(1, 1, 1), 0.1f}};
   Points3f p(4, 3);
-  p.row(0) << 0.1f, 1.01f, 0.f;     // in capsule 0: to y = 1.05
-  p.row(1) << 1.f, 1.f, 1.05f;      // in sphere 1: to z = 1.1
-  p.row(2) << 0.1f, 1.f, 0.f;       // on the axis: stays
-  p.row(3) << 0.5f, 0.5f, 0.5f;     // outside both
+  p.row(0) << 0.1f, 1.01f, 0.f;  // in capsule 0: to y = 1.05
+  p.row(1) << 1.f, 1.f, 1.05f;   // in sphere 1: to z = 1.1
+  p.row(2) << 0.1f, 1.f, 0.f;    // on the axis: stays
+  p.row(3) << 0.5f, 0.5f, 0.5f;  // outside both
   const Points3f before = p;
   EXPECT_EQ(runtime::referencePushOut(p, restPosed(proxy, 1)), 2u);
   EXPECT_NEAR(p(0, 1), 1.05f, 1e-6f);

@@ -87,7 +87,8 @@ TEST(NormalMapBaker, RecoversAnAnalyticBumpInTheTangentFrame) {
 }
 
 TEST(NormalMapBaker, MirroredChartFlipsX) {
-  const Sheet game = makeSheet(2, 0.f, 1.f, [](float, float) { return 0.f; }, true);
+  const Sheet game = makeSheet(
+      2, 0.f, 1.f, [](float, float) { return 0.f; }, true);
   const Sheet sim = makeSheet(161, 0.f, 1.f, bump);
   NormalMapBakeSettings s;
   s.width = s.height = 32;
@@ -99,7 +100,8 @@ TEST(NormalMapBaker, MirroredChartFlipsX) {
       // Texel u maps to x = 1 - u; tangent = -x, bitangent = +y.
       const float px = 1.f - (float(x) + .5f) / 32.f, py = (float(y) + .5f) / 32.f;
       const Vec3f n = bumpNormal(px, py);
-      worst = std::max({worst, std::abs(im.xy[2 * (y * 32 + x)] - (-n.x())), std::abs(im.xy[2 * (y * 32 + x) + 1] - n.y())});
+      worst = std::max(
+          {worst, std::abs(im.xy[2 * (y * 32 + x)] - (-n.x())), std::abs(im.xy[2 * (y * 32 + x) + 1] - n.y())});
     }
   EXPECT_LT(worst, 0.01f);
 }
@@ -125,8 +127,8 @@ TEST(NormalMapBaker, DilationFillsTheTexelsOutsideTheChart) {
   s.width = s.height = 32;
   s.dilationRings = 4;
   NormalMapBakeStats stats;
-  const NormalMapImage im = NormalMapBaker(game.uv, game.t, game.p, s)
-                                .bake(game.p, sim.p, sim.t, buildFrameTopology(sim.t, sim.p), &stats);
+  const NormalMapImage im =
+      NormalMapBaker(game.uv, game.t, game.p, s).bake(game.p, sim.p, sim.t, buildFrameTopology(sim.t, sim.p), &stats);
   EXPECT_EQ(stats.chartTexels, size_t(16 * 16));
   EXPECT_EQ(stats.hitTexels, stats.chartTexels);
   // Rings 1..4 around the 16x16 chart: 24^2 - 16^2 texels dilated; the rest set flat.
