@@ -8,6 +8,8 @@
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/files/byte_reader.hpp"
+#include "swish/files/byte_writer.hpp"
 
 namespace swish::cluster {
 namespace {
@@ -16,27 +18,6 @@ constexpr char kMagic[8] = {'S', 'W', 'P', 'O', 'S', 'E', 'S', '1'};
 constexpr uint32_t kVersion = 1;
 constexpr uint32_t kMaxPoses = 10'000'000, kMaxJoints = 4096;
 
-template <class T>
-void put(std::vector<uint8_t>& out, const T& v) {
-  const auto* b = reinterpret_cast<const uint8_t*>(&v);
-  out.insert(out.end(), b, b + sizeof(T));
-}
-
-struct Reader {
-  const std::vector<uint8_t>& bytes;
-  const std::filesystem::path& file;
-  size_t at = 0;
-  template <class T>
-  T get() {
-    T v;
-    if (sizeof v > bytes.size() - 8 - at)
-      throw Error(file.string() + ": truncated pose list (" + std::to_string(bytes.size()) + " bytes)");
-    std::memcpy(&v, bytes.data() + at, sizeof v);
-    at += sizeof v;
-    return v;
-  }
-};
-
 }  // namespace
 
 void writePoseList(const std::filesystem::path& file, const PoseList& list) {
@@ -44,22 +25,22 @@ void writePoseList(const std::filesystem::path& file, const PoseList& list) {
     throw Error(file.string() + ": pose list with " + std::to_string(list.poses.size()) + " poses and " +
                 std::to_string(list.poseFingerprints.size()) + " fingerprints");
   const uint32_t joints = list.poses.empty() ? 0 : uint32_t(list.poses.front().local.size());
-  std::vector<uint8_t> out(kMagic, kMagic + 8);
-  put(out, kVersion);
-  put(out, list.fingerprint);
-  put(out, list.settingsDigest);
-  put(out, uint32_t(list.poses.size()));
-  put(out, joints);
+  ByteWriter w;
+  w.bytes({reinterpret_cast<const uint8_t*>(kMagic), 8});
+  w.u32(kVersion);
+  w.u64(list.fingerprint);
+  w.u64(list.settingsDigest);
+  w.u32(uint32_t(list.poses.size()));
+  w.u32(joints);
   for (size_t i = 0; i < list.poses.size(); ++i) {
     const Pose& p = list.poses[i];
     if (p.local.size() != joints) throw Error(file.string() + ": poses of different joint counts");
-    put(out, list.poseFingerprints[i]);
-    for (int k = 0; k < 3; ++k) put(out, p.rootTranslation[k]);
-    for (const Quatf& q : p.local)
-      for (int k = 0; k < 4; ++k) put(out, q.coeffs()[k]);
+    w.u64(list.poseFingerprints[i]);
+    w.f32s({p.rootTranslation.data(), 3});
+    for (const Quatf& q : p.local) w.f32s({q.coeffs().data(), 4});
   }
-  put(out, fnv1a(out.data(), out.size()));
-  writeFileAtomic(file, out);
+  w.u64(fnv1a(w.data().data(), w.size()));
+  writeFileAtomic(file, w.data());
 }
 
 PoseList readPoseList(const std::filesystem::path& file) {
@@ -72,27 +53,27 @@ PoseList readPoseList(const std::filesystem::path& file) {
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
   if (stored != fnv1a(bytes.data(), bytes.size() - 8))
     throw Error(file.string() + ": checksum mismatch (corrupt or partly written pose list)");
-  Reader rd{bytes, file, 8};
-  if (const uint32_t v = rd.get<uint32_t>(); v != kVersion)
+  // Between the magic and the checksum; every read bounds-checked, every count checked before allocating.
+  ByteReader rd(std::span<const uint8_t>(bytes).subspan(8, bytes.size() - 16), file.string(), "pose list");
+  if (const uint32_t v = rd.u32("version"); v != kVersion)
     throw Error(file.string() + ": pose list version " + std::to_string(v) + ", expected " + std::to_string(kVersion));
   PoseList list;
-  list.fingerprint = rd.get<uint64_t>();
-  list.settingsDigest = rd.get<uint64_t>();
-  const uint32_t n = rd.get<uint32_t>(), joints = rd.get<uint32_t>();
+  list.fingerprint = rd.u64("list fingerprint");
+  list.settingsDigest = rd.u64("settings digest");
+  const uint32_t n = rd.u32("pose count"), joints = rd.u32("joint count");
   if (n > kMaxPoses || joints > kMaxJoints)
     throw Error(file.string() + ": implausible pose list (" + std::to_string(n) + " poses, " + std::to_string(joints) +
                 " joints)");
-  if (size_t(n) * (8 + 12 + size_t(joints) * 16) != bytes.size() - 8 - rd.at)
+  if (size_t(n) * (8 + 12 + size_t(joints) * 16) != rd.remaining())
     throw Error(file.string() + ": pose list size does not match its " + std::to_string(n) + " poses");
   list.poses.resize(n);
   list.poseFingerprints.resize(n);
   for (uint32_t i = 0; i < n; ++i) {
-    list.poseFingerprints[i] = rd.get<uint64_t>();
+    list.poseFingerprints[i] = rd.u64("pose fingerprint");
     Pose& p = list.poses[i];
-    for (int k = 0; k < 3; ++k) p.rootTranslation[k] = rd.get<float>();
+    rd.f32s(p.rootTranslation.data(), 3, "root translation");
     p.local.resize(joints);
-    for (Quatf& q : p.local)
-      for (int k = 0; k < 4; ++k) q.coeffs()[k] = rd.get<float>();
+    for (Quatf& q : p.local) rd.f32s(q.coeffs().data(), 4, "rotation");
   }
   return list;
 }
