@@ -125,22 +125,19 @@ std::unique_ptr<Character> rebuildBakeCharacter(const ModelEntry& entry, std::st
 }
 
 void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
-  {
-    const json meta = json::parse(entry.model.metadata, nullptr, false);
-    const json ds = meta.is_object() ? meta.value("dataset_settings", json::object()) : json::object();
-    if (ds.is_object() && ds.contains("simulation") && ds["simulation"].is_object() &&
-        ds["simulation"].value("source", "") == "external") {
-      note_ = "the model was baked from an external cloth tool's shapes (" +
-              ds["simulation"].value("path", std::string()) +
-              "): swish's own solver is not its source simulation, so there is no truth to run";
-      return;
-    }
+  const json meta = json::parse(entry.model.metadata, nullptr, false);
+  const json ds = meta.is_object() && meta.contains("dataset_settings") && meta["dataset_settings"].is_object()
+                      ? meta["dataset_settings"]
+                      : json::object();
+  if (ds.contains("simulation") && ds["simulation"].is_object() && ds["simulation"].value("source", "") == "external") {
+    note_ = "the model was baked from an external cloth tool's shapes (" +
+            ds["simulation"].value("path", std::string()) +
+            "): swish's own solver is not its source simulation, so there is no truth to run";
+    return;
   }
   std::string how;
-  character_ = rebuildBakeCharacter(entry, note_, &how);
+  character_ = rebuildBakeCharacter(entry, note_, &how);  // says why not when the metadata names no bake
   if (!character_) return;
-  const json meta = json::parse(entry.model.metadata, nullptr, false);
-  const json& ds = meta["dataset_settings"];
   bake::PoseShapeSettings ps;
   try {
     ps = bake::poseShapeSettingsFromJson(ds, "model metadata dataset_settings");
