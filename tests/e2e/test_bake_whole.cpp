@@ -50,7 +50,9 @@ nlohmann::json smallConfig() {
               {"settle_seconds", 0.2},
               {"frame_rate", 20},
               {"threads", 2},
-              {"gravity", 0}}},
+              {"gravity", 0},
+              {"equilibrium_seconds", 0.1},
+              {"check_poses", 2}}},
             {"normal_maps", {{"size", 16}, {"dilation_rings", 2}}},
             {"preview", {{"poses", 2}, {"size", 96}}}}},
           {"train",
@@ -105,6 +107,25 @@ TEST(BakeWhole, DefaultCharacterAndMocapToLoadableModel) {
   EXPECT_GE(inDataset, kept * 3 / 4);
   EXPECT_TRUE(fs::exists(w.config.reportDir() / "part1.json"));
   EXPECT_TRUE(fs::exists(w.config.reportDir() / "report.md"));
+  // The simulation's own figures (issue 18): failures per reason, retries, CPU seconds per pose,
+  // equilibrium residuals, and convergence and noise on the 2 sampled poses.
+  const nlohmann::json& sim = p1["simulation"];
+  ASSERT_TRUE(sim.is_object()) << p1.dump();
+  EXPECT_EQ(sim["poses"].get<size_t>(), kept);
+  EXPECT_TRUE(sim["failures_by_reason"].is_object());
+  EXPECT_TRUE(sim["retried"].is_array());
+  EXPECT_GT(sim["seconds_per_pose_per_core"].get<double>(), 0.0);
+  EXPECT_GE(sim["equilibrium_residual_mean"].get<double>(), 0.0);
+  const nlohmann::json& q = sim["quality"];
+  ASSERT_TRUE(q.is_object()) << sim.dump();
+  // Every sampled pose has its reference solve, or the failure is listed.
+  EXPECT_LE(q["convergence_poses"].get<size_t>(), 2u);
+  EXPECT_GE(q["convergence_poses"].get<size_t>() + q["reference_failures"].size(), 2u);
+  if (q["convergence_poses"].get<size_t>() > 0) {
+    EXPECT_GT(q["convergence_mean_mm"].get<double>(), 0.0);  // twice the substeps moves something
+    EXPECT_GT(q["convergence_p95_mm"].get<double>(), 0.0);
+  }
+  EXPECT_GE(q["noise_mean_mm"].get<double>(), 0.0);
   EXPECT_TRUE(fs::exists(w.config.previewDir() / "preview.json"));
 
   // Progress lines with the time left for the long steps.

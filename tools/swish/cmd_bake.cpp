@@ -17,10 +17,12 @@
 #include "swish/bake/cloth/pose_export.hpp"
 #include "swish/bake/pipeline/bake_config.hpp"
 #include "swish/bake/pipeline/bake_pipeline.hpp"
+#include "swish/bake/pipeline/part1_dataset.hpp"
 #include "swish/cluster/pose_list_file.hpp"
 #include "swish/cluster/slurm_bake.hpp"
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
+#include "swish/files/atomic_write.hpp"
 #include "swish/io/gltf_export.hpp"
 
 namespace {
@@ -33,6 +35,8 @@ swish::cli::RunFn setup(CLI::App& sub) {
     swish::cluster::SlurmSubmitOptions submit;
     std::string task, poseList;
     size_t shardSize = 0;
+    size_t checkSimulation = 0, checkPoses = 0;
+    uint64_t seed = 1;
   };
   auto o = std::make_shared<Opts>();
   sub.add_option(
@@ -106,6 +110,16 @@ swish::cli::RunFn setup(CLI::App& sub) {
                  "write part 1's thinned poses for your own cloth tool to DIR (clip as BVH + glTF, target-frame "
                  "sidecar, body + garment OBJ, README for the artist) and stop")
       ->type_name("DIR");
+  sub.add_option("--check-simulation", o->checkSimulation,
+                 "simulate N of part 1's thinned poses (seeded sample) without building a dataset and report how far "
+                 "the source simulation can be trusted: failures per reason, retried poses, seconds per pose per core, "
+                 "equilibrium residuals, convergence (against twice the substeps and half the tolerance) and noise "
+                 "(second differences over small turns of the pose); writes <report>/simulation_check.json")
+      ->check(CLI::Range(size_t(1), size_t(100000)));
+  sub.add_option("--check-poses", o->checkPoses,
+                 "with --check-simulation: how many of the N poses get the convergence and noise solves (3 more "
+                 "solves each; default: part1.simulation.check_poses, 6)");
+  sub.add_option("--seed", o->seed, "with --check-simulation: the sample's seed (default 1)");
   sub.footer(
       "Bring your own simulation (Marvelous Designer, Houdini, Maya...):\n"
       "  1. swish bake recipe.json --export-poses poses/   writes poses/poses.bvh, poses.glb (the clip: per pose\n"
@@ -136,6 +150,44 @@ swish::cli::RunFn setup(CLI::App& sub) {
       const auto r = swish::bake::exportPoses(*cfg.part1, o->exportPoses, log);
       std::printf("exported %zu poses to %s; read %s/README.md\n", r.poses, o->exportPoses.c_str(),
                   o->exportPoses.c_str());
+      return 0;
+    }
+    if (o->checkSimulation > 0) {
+      if (!cfg.part1) {
+        std::fprintf(stderr, "swish bake --check-simulation: %s has no \"part1\" section to take poses from\n",
+                     o->config.c_str());
+        return 2;
+      }
+      swish::bake::DatasetBuildSettings s = *cfg.part1;
+      if (o->checkPoses > 0) s.quality.poses = o->checkPoses;
+      const nlohmann::json r =
+          swish::bake::checkSimulation(s, o->checkSimulation, o->seed, [](const std::string& line) {
+            std::fprintf(stderr, "%s\n", line.c_str());
+            std::fflush(stderr);
+          });
+      std::filesystem::create_directories(cfg.reportDir());
+      const std::filesystem::path file = cfg.reportDir() / "simulation_check.json";
+      swish::writeTextFileAtomic(file, r.dump(2) + "\n");
+      const nlohmann::json& sim = r.at("simulation");
+      std::printf(
+          "simulated %zu poses: %zu failed (%.1f%%), %zu retried, %.2f s per pose per core, equilibrium residual "
+          "mean %.4f (max %.4f, tolerance %.4f)\n",
+          size_t(sim.value("poses", 0)), size_t(sim.value("failed", 0)), 100.0 * sim.value("failed_share", 0.0),
+          size_t(sim.value("retried_poses", 0)), sim.value("seconds_per_pose_per_core", 0.0),
+          sim.value("equilibrium_residual_mean", 0.0), sim.value("equilibrium_residual_max", 0.0),
+          sim.value("equilibrium_tolerance", 0.0));
+      for (const auto& [why, v] : sim.at("failures_by_reason").items())
+        std::printf("  %-12s %zu (%.1f%%)\n", why.c_str(), size_t(v.value("count", 0)), 100.0 * v.value("share", 0.0));
+      if (sim.contains("quality")) {
+        const nlohmann::json& q = sim.at("quality");
+        std::printf(
+            "convergence (2x substeps, half the tolerance; %zu poses): %.2f mm mean, %.2f mm p95\n"
+            "noise (%.1f degree turns; %zu poses): %.2f mm mean, %.2f mm p95\n",
+            size_t(q.value("convergence_poses", 0)), q.value("convergence_mean_mm", 0.0),
+            q.value("convergence_p95_mm", 0.0), q.value("noise_turn_degrees", 0.0), size_t(q.value("noise_poses", 0)),
+            q.value("noise_mean_mm", 0.0), q.value("noise_p95_mm", 0.0));
+      }
+      std::printf("report: %s\n", file.string().c_str());
       return 0;
     }
     if (o->checkOnly) {

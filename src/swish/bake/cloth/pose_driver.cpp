@@ -60,11 +60,16 @@ PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pos
   std::vector<uint64_t> fingerprints(poses.size());
   std::vector<uint32_t> todo;
   std::vector<std::pair<uint32_t, std::string>> failures;
+  std::vector<SimulatedPoseSummary> summaries;
+  auto summary = [](uint32_t id, const PoseSimulation& r) {
+    return SimulatedPoseSummary{id, r.ok, r.failure, r.attempts, r.firstFailure, r.residuals};
+  };
   for (uint32_t i : ids) {
     fingerprints[i] = poseFingerprint(solver, poses[i]);
     auto rec = loadFinishedPose(dir, i, fingerprints[i]);
     if (rec && (!rec->result.ok || size_t(rec->result.positions.rows()) == nv)) {
       ++run.reused;
+      summaries.push_back(summary(i, rec->result));
       if (!rec->result.ok) failures.push_back({i, rec->result.failure});
     } else {
       todo.push_back(i);
@@ -91,6 +96,7 @@ PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pos
       ++done;
       ++run.simulated;
       solveSeconds += rec.result.residuals.seconds;
+      summaries.push_back(summary(id, rec.result));
       if (!rec.result.ok) failures.push_back({id, rec.result.failure});
       // Time left from the wall-clock rate of this run (it already includes the parallelism).
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -108,6 +114,8 @@ PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pos
   std::sort(failures.begin(), failures.end());
   run.failed = failures.size();
   run.failures = std::move(failures);
+  std::sort(summaries.begin(), summaries.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  run.poses = std::move(summaries);
   return run;
 }
 

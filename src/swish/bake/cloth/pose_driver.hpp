@@ -13,6 +13,7 @@
 
 #include "swish/bake/cloth/cloth_solver.hpp"
 #include "swish/bake/cloth/simulated_pose_file.hpp"
+#include "swish/bake/cloth/simulation_quality.hpp"
 
 namespace swish::bake {
 
@@ -27,6 +28,8 @@ struct PoseSimulationRun {
   size_t failed = 0;     // failures, solved now or found recorded
   bool stopped = false;  // the progress callback asked to stop before all poses were done
   std::vector<std::pair<uint32_t, std::string>> failures;  // pose id, reason; ascending ids
+  // Every finished pose's outcome (solved now or reused; ascending ids): retries, residuals, seconds.
+  std::vector<SimulatedPoseSummary> poses;
 };
 
 // The fingerprint a pose's file must carry to be reused: the solver's setup and the pose's rotations.

@@ -14,7 +14,8 @@ namespace swish::bake {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'W', 'C', 'L', 'O', 'T', 'H', '1'};
-constexpr uint32_t kVersion = 1;
+// 2: the equilibrium residuals, the final projection's depth, the attempts and the first failure.
+constexpr uint32_t kVersion = 2;
 constexpr uint32_t kMaxVertices = 50'000'000;
 
 template <class T>
@@ -66,6 +67,13 @@ void writeSimulatedPose(const std::filesystem::path& file, const SimulatedPoseRe
   put(out, r.residuals.seconds);
   put(out, uint32_t(r.failure.size()));
   out.insert(out.end(), r.failure.begin(), r.failure.end());
+  put(out, r.residuals.equilibriumResidual);
+  put(out, r.residuals.equilibriumResidualMax);
+  put(out, int32_t(r.residuals.equilibriumFrames));
+  put(out, r.residuals.projectedDepth);
+  put(out, uint32_t(r.attempts));
+  put(out, uint32_t(r.firstFailure.size()));
+  out.insert(out.end(), r.firstFailure.begin(), r.firstFailure.end());
   const auto* p = reinterpret_cast<const uint8_t*>(r.positions.data());
   out.insert(out.end(), p, p + size_t(r.positions.size()) * sizeof(float));
   put(out, fnv1a(out.data(), out.size()));
@@ -83,8 +91,9 @@ SimulatedPoseRecord readSimulatedPose(const std::filesystem::path& file) {
   if (stored != fnv1a(bytes.data(), bytes.size() - 8))
     throw Error(file.string() + ": checksum mismatch (corrupt or partly written simulated-pose file)");
   Reader rd{bytes, file, 8};
-  if (const uint32_t v = rd.get<uint32_t>(); v != kVersion)
-    throw Error(file.string() + ": simulated-pose file version " + std::to_string(v) + ", expected " +
+  const uint32_t version = rd.get<uint32_t>();
+  if (version != 1 && version != kVersion)
+    throw Error(file.string() + ": simulated-pose file version " + std::to_string(version) + ", expected 1 or " +
                 std::to_string(kVersion));
   SimulatedPoseRecord rec;
   rec.poseId = rd.get<uint32_t>();
@@ -102,6 +111,17 @@ SimulatedPoseRecord readSimulatedPose(const std::filesystem::path& file) {
   if (len > bytes.size()) throw Error(file.string() + ": failure message longer than the file");
   r.failure.resize(len);
   rd.take(r.failure.data(), len);
+  if (version >= 2) {
+    r.residuals.equilibriumResidual = rd.get<float>();
+    r.residuals.equilibriumResidualMax = rd.get<float>();
+    r.residuals.equilibriumFrames = rd.get<int32_t>();
+    r.residuals.projectedDepth = rd.get<float>();
+    r.attempts = int(rd.get<uint32_t>());
+    const uint32_t firstLen = rd.get<uint32_t>();
+    if (firstLen > bytes.size()) throw Error(file.string() + ": first failure message longer than the file");
+    r.firstFailure.resize(firstLen);
+    rd.take(r.firstFailure.data(), firstLen);
+  }
   r.positions.resize(nv, 3);
   rd.take(r.positions.data(), size_t(nv) * 3 * sizeof(float));
   if (rd.at != bytes.size() - 8) throw Error(file.string() + ": trailing bytes in simulated-pose file");

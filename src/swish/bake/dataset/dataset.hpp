@@ -18,6 +18,14 @@ struct SimResiduals {
   bool converged = false;
   int iterations = 0;
   double seconds = 0.0;
+  // The solver's end condition (cloth_solver.hpp; not stored in dataset pose files): the
+  // mass-weighted RMS motion of the vertices over the last frame relative to gravity's free fall in
+  // a frame (the unbalanced share of gravity's load; -1: not measured), the worst vertex's, and the
+  // frames the equilibrium phase took.
+  float equilibriumResidual = -1.f;
+  float equilibriumResidualMax = -1.f;
+  int equilibriumFrames = 0;
+  float projectedDepth = 0.f;  // m: the deepest vertex the final projection moved out of the body
 };
 
 // A tangent-space normal map, X and Y only (Z = sqrt(1 - X^2 - Y^2)), in [-1, 1].

@@ -134,9 +134,30 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   const nlohmann::json sim = j.value("simulation", nlohmann::json::object());
   std::string p = prefix + ".simulation";
   c.onlyKeys(sim, p,
-             {"preset", "vertices", "thickness", "transition_seconds", "settle_seconds", "frame_rate", "substeps",
-              "iterations", "threads", "gravity", "limb_clearance", "attach_band", "source", "path", "space",
-              "units_per_metre", "up_axis", "origin"});
+             {"preset",
+              "vertices",
+              "thickness",
+              "transition_seconds",
+              "settle_seconds",
+              "frame_rate",
+              "substeps",
+              "iterations",
+              "threads",
+              "gravity",
+              "limb_clearance",
+              "attach_band",
+              "equilibrium_tolerance",
+              "equilibrium_seconds",
+              "equilibrium_iterations",
+              "retries",
+              "final_projection",
+              "check_poses",
+              "source",
+              "path",
+              "space",
+              "units_per_metre",
+              "up_axis",
+              "origin"});
   parseSimulationSource(c, sim, p, s);
   ClothSimSettings& cs = s.simulation;
   if (sim.contains("preset")) {
@@ -160,6 +181,18 @@ void parseShapeSections(const Checker& c, const nlohmann::json& j, const std::st
   s.limbClearance.clearance = float(c.number(sim, p, "limb_clearance", 0, 0.1, s.limbClearance.clearance));
   // The top band of the garment held on the body (share of its rest height; cloth_solver.hpp).
   cs.attachTopFraction = float(c.number(sim, p, "attach_band", 0, 0.5, cs.attachTopFraction));
+  // The end condition (cloth_solver.hpp): frames at the goal pose until the residual (the unbalanced
+  // share of gravity's load) is at most the tolerance, for at most equilibrium_seconds, with
+  // equilibrium_iterations sweeps per substep (0: "iterations").
+  cs.equilibriumTolerance = float(c.number(sim, p, "equilibrium_tolerance", 1e-6, 10, cs.equilibriumTolerance));
+  cs.equilibriumSeconds = float(c.number(sim, p, "equilibrium_seconds", 0, 60, cs.equilibriumSeconds));
+  cs.equilibriumIterations = int(c.number(sim, p, "equilibrium_iterations", 0, 1000, cs.equilibriumIterations, true));
+  // Retries of a failed pose along a slower path (twice the substeps and transition each) before it is left out.
+  cs.retries = int(c.number(sim, p, "retries", 0, 4, cs.retries, true));
+  // Vertices left within the thickness of the body at the end are moved out along its normal.
+  cs.finalProjection = c.boolean(sim, p, "final_projection", cs.finalProjection);
+  // Poses sampled for the report's convergence and noise figures (simulation_quality.hpp; 0: none).
+  s.quality.poses = size_t(c.number(sim, p, "check_poses", 0, 1000, double(s.quality.poses), true));
   try {
     cs.validate();
   } catch (const Error& e) {
@@ -268,6 +301,14 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (!datasetSettings.is_object()) c.fail(what, "the dataset settings must be a JSON object");
   DatasetBuildSettings s;
   parseShapeSections(c, datasetSettings, what, s);
+  // Settings recorded before cloth solver revision 7 have no end phase, retries or final projection:
+  // the truth of such a model (swish replay --truth-every) is its own bake's solve, step for step.
+  const nlohmann::json sim = datasetSettings.value("simulation", nlohmann::json::object());
+  if (sim.is_object() && !sim.contains("equilibrium_seconds")) {
+    s.simulation.equilibriumSeconds = 0.f;
+    s.simulation.retries = 0;
+    s.simulation.finalProjection = false;
+  }
   return s.poseShape();
 }
 

@@ -29,6 +29,11 @@
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
 //                      "attach_band" (top share of the garment's height held on the body),
+//                      "equilibrium_tolerance", "equilibrium_seconds", "equilibrium_iterations" (the
+//                      end condition: cloth_solver.hpp), "retries" (of a failed pose, slower each),
+//                      "final_projection" (out of the body at the end), "check_poses" (sampled for the
+//                      report's convergence and noise, 0: none),
+
 //                      "source": "solver" (default) | "external" with "path" (a folder of pose_<id>.obj/
 //                      .glb/.gltf/.fbx results, or one multi-frame .glb/.gltf/.fbx) and "space":
 //                      "character" (default) | "world" with "units_per_metre", "up_axis" (y|z), "origin"

@@ -236,6 +236,11 @@ nlohmann::json DatasetBuildSettings::toJson() const {
         {"frame_rate", m.frameRate},
         {"substeps", m.substeps},
         {"iterations", m.iterations},
+        {"equilibrium_tolerance", m.equilibriumTolerance},
+        {"equilibrium_seconds", m.equilibriumSeconds},
+        {"equilibrium_iterations", m.equilibriumIterations},
+        {"retries", m.retries},
+        {"final_projection", m.finalProjection},
         {"gravity", -m.gravity.y()},
         {"limb_clearance", limbClearance.clearance},
         {"attach_band", m.attachTopFraction}}},
@@ -277,6 +282,7 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"transfers_reused", transfersReused},
           {"failed", f},
           {"rebuilt", rebuilt},
+          {"simulation", simulationReport},
           {"steps", st}};
 }
 
@@ -652,6 +658,72 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   if (external) source["simulation"] = external->description();
   writer.writeManifest(res.failed, source);
   step("transfer + normal maps", t);
+
+  // The simulation's own figures: failures per reason, retries, residuals, seconds per pose per core;
+  // convergence and noise on a seeded sample of the kept poses (cached beside the simulations). An
+  // external tool's shapes have no solver figures: its report says which files it read instead.
+  if (!external) {
+    std::vector<std::pair<uint32_t, std::string>> transferFailures;
+    for (const FailedPose& f : res.failed)
+      if (f.reason.rfind("transfer", 0) == 0 || f.reason.rfind("simulation result", 0) == 0)
+        transferFailures.push_back({f.id, f.reason});
+    res.simulationReport = simulationRunJson(sim.poses, s.simulation, transferFailures);
+    for (const SimulatedPoseSummary& p : sim.poses)
+      if (p.attempts > 1)
+        log("part 1: pose " + std::to_string(p.id) + " needed " + std::to_string(p.attempts) + " attempts (" +
+            (p.ok ? "kept" : "left out") + "); first attempt: " + p.firstFailure);
+    if (s.quality.poses > 0) {
+      t = Clock::now();
+      std::vector<uint32_t> okIds;
+      for (const SimulatedPoseSummary& p : sim.poses)
+        if (p.ok) okIds.push_back(p.id);
+      const std::vector<uint32_t> ids = sampleQualityPoses(okIds, s.quality.poses, s.quality.seed);
+      const uint64_t fp = simulationQualityFingerprint(solver, poses, ids, s.quality);
+      const fs::path cache = simulationDir / "quality.json";
+      nlohmann::json quality;
+      try {
+        if (fs::exists(cache)) {
+          nlohmann::json old = nlohmann::json::parse(std::ifstream(cache));
+          if (old.value("fingerprint", std::string()) == std::to_string(fp)) quality = old.at("quality");
+        }
+      } catch (const std::exception&) {
+        quality = nullptr;  // unreadable: measured again
+      }
+      if (quality.is_null()) {
+        std::vector<Points3f> shapes;
+        for (uint32_t id : ids) {
+          const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
+          shapes.push_back(rec ? rec->result.positions : Points3f());
+        }
+        SimulationQualitySettings qs = s.quality;
+        qs.threads = s.threads;
+        log("part 1: measuring the simulation's convergence and noise on " + std::to_string(ids.size()) + " poses");
+        ProgressThrottle qThrottle;
+        const SimulationQuality q =
+            measureSimulationQuality(character, solver, poses, ids, shapes, qs, [&](const std::string& line) {
+              if (qThrottle.due(0, 1)) log("part 1: " + line);
+            });
+        quality = q.toJson();
+        writeTextFileAtomic(cache,
+                            nlohmann::json{{"fingerprint", std::to_string(fp)}, {"quality", quality}}.dump(2) + "\n");
+      }
+      res.simulationReport["quality"] = quality;
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "part 1: simulation convergence (2x substeps, half the tolerance) %.2f mm mean, %.2f mm p95; "
+                    "noise (%.0f degree turns) %.2f mm mean, %.2f mm p95",
+                    quality.value("convergence_mean_mm", 0.0), quality.value("convergence_p95_mm", 0.0),
+                    quality.value("noise_turn_degrees", 0.0), quality.value("noise_mean_mm", 0.0),
+                    quality.value("noise_p95_mm", 0.0));
+      log(line);
+      step("simulation quality", t);
+    }
+    char line[200];
+    std::snprintf(line, sizeof line, "part 1: %.2f s per pose per core; %zu poses retried",
+                  res.simulationReport.value("seconds_per_pose_per_core", 0.0),
+                  size_t(res.simulationReport.value("retried_poses", 0)));
+    log(line);
+  }
   if (res.transferred + res.transfersReused == 0)
     throw Error("bake part 1: every pose failed; nothing to train on (see the failures above)");
 
@@ -664,6 +736,91 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     step("preview", t);
   }
   return res;
+}
+
+nlohmann::json checkSimulation(const DatasetBuildSettings& s, size_t poseCount, uint64_t seed,
+                               const std::function<void(const std::string&)>& logFn) {
+  auto log = [&](const std::string& line) {
+    if (logFn) logFn(line);
+  };
+  const auto start = Clock::now();
+  if (s.external.enabled())
+    throw Error("simulation check: part1.simulation.source is \"external\": there is no solver to check");
+  const DatasetPosePlan plan = planDatasetPoses(s, log);
+  const Character& character = *plan.character;
+  const std::vector<Pose>& poses = plan.toSimulate;  // limbs already out of the trunk, as the bake simulates
+  std::vector<uint32_t> every(poses.size());
+  for (uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+  const std::vector<uint32_t> ids = sampleQualityPoses(every, poseCount, seed);
+  const ClothSolver& solver = plan.shapes->solver();
+  log("simulation check: " + std::to_string(ids.size()) + " of the " + std::to_string(poses.size()) +
+      " thinned poses (seed " + std::to_string(seed) + "), " + std::to_string(solver.mesh().vertexCount()) +
+      " simulation vertices, preset '" + s.simulation.material.name + "'");
+
+  // One solve per sampled pose.
+  std::vector<PoseSimulation> results(ids.size());
+  std::mutex mutex;
+  size_t done = 0;
+  ProgressThrottle throttle;
+  const auto simStart = Clock::now();
+  auto one = [&](size_t k) {
+    const uint32_t id = ids[k];
+    results[k] = solver.simulate(poses[id]);
+    std::lock_guard<std::mutex> lock(mutex);
+    ++done;
+    if (!results[k].ok)
+      log("simulation check: pose " + std::to_string(id) + " failed: " + results[k].failure);
+    else if (results[k].attempts > 1)
+      log("simulation check: pose " + std::to_string(id) +
+          " kept after a retry; first attempt: " + results[k].firstFailure);
+    if (throttle.due(done, ids.size())) {
+      const double el = since(simStart);
+      log(progressLine("simulation", done, ids.size(), el, el / double(done) * double(ids.size() - done)));
+    }
+  };
+  if (s.threads > 0) {
+    tbb::task_arena arena(s.threads);
+    arena.execute([&] { tbb::parallel_for(size_t(0), ids.size(), size_t(1), one); });
+  } else {
+    tbb::parallel_for(size_t(0), ids.size(), size_t(1), one);
+  }
+  std::vector<SimulatedPoseSummary> summaries;
+  std::vector<uint32_t> okIds;
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const PoseSimulation& r = results[k];
+    summaries.push_back({ids[k], r.ok, r.failure, r.attempts, r.firstFailure, r.residuals});
+    if (r.ok) okIds.push_back(ids[k]);
+  }
+  nlohmann::json out = {{"tool", "swish bake --check-simulation"},
+                        {"character", character.name},
+                        {"thinned_poses", poses.size()},
+                        {"sampled_poses", ids},
+                        {"seed", seed},
+                        {"simulation_vertices", solver.mesh().vertexCount()},
+                        {"settings", s.toJson()["simulation"]},
+                        {"simulation", simulationRunJson(summaries, s.simulation)}};
+  nlohmann::json failures = nlohmann::json::array();
+  for (const SimulatedPoseSummary& p : summaries)
+    if (!p.ok) failures.push_back({{"pose", p.id}, {"reason", p.failure}});
+  out["simulation"]["failures"] = failures;
+  if (s.quality.poses > 0 && !okIds.empty()) {
+    const std::vector<uint32_t> q = sampleQualityPoses(okIds, s.quality.poses, seed);
+    std::vector<Points3f> qShapes;
+    for (uint32_t id : q)
+      for (size_t k = 0; k < ids.size(); ++k)
+        if (ids[k] == id) qShapes.push_back(results[k].positions);
+    SimulationQualitySettings qs = s.quality;
+    qs.threads = s.threads;
+    qs.seed = seed;
+    log("simulation check: convergence and noise on " + std::to_string(q.size()) + " poses (3 solves each)");
+    ProgressThrottle qThrottle;
+    out["simulation"]["quality"] =
+        measureSimulationQuality(character, solver, poses, q, qShapes, qs, [&](const std::string& l) {
+          if (qThrottle.due(0, 1)) log(l);
+        }).toJson();
+  }
+  out["seconds"] = since(start);
+  return out;
 }
 
 }  // namespace swish::bake

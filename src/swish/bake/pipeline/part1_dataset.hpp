@@ -28,6 +28,7 @@
 #include "swish/bake/cloth/cloth_solver.hpp"
 #include "swish/bake/cloth/external_simulation.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
+#include "swish/bake/cloth/simulation_quality.hpp"
 #include "swish/bake/dataset/dataset_io.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/bake/poses/limb_clearance.hpp"
@@ -91,6 +92,9 @@ struct DatasetBuildSettings {
   // clearance 0 turns this off.
   LimbClearanceSettings limbClearance;
   int threads = 0;  // 0: all cores (TBB's default)
+  // Convergence and noise measured on a seeded sample of the simulated poses (simulation_quality.hpp;
+  // poses 0: not measured). Not part of the dataset's content: changing it rebuilds nothing.
+  SimulationQualitySettings quality;
 
   PoseTransferSettings transfer;
   uint32_t normalMapBitDepth = 16;
@@ -145,7 +149,10 @@ struct DatasetBuildResult {
   size_t simulated = 0, simulationsReused = 0;
   size_t transferred = 0, transfersReused = 0;
   std::vector<FailedPose> failed;  // left out of the dataset, with the reason
-  bool rebuilt = false;            // settings had changed: the dataset's pose files were deleted first
+  // The simulation's report (cloth/simulation_quality.hpp): failures per reason, retried poses, seconds
+  // per pose per core, equilibrium residuals, and "quality" (convergence, noise) when measured.
+  nlohmann::json simulationReport = nlohmann::json::object();
+  bool rebuilt = false;  // settings had changed: the dataset's pose files were deleted first
   std::vector<DatasetBuildStep> steps;
   std::vector<std::filesystem::path> previews;
   // Per pose id: where it came from ({"clip", "subject", "frame", "mirrored"}; the rest pose part 1
@@ -201,5 +208,12 @@ DatasetPoseList listDatasetPoses(const DatasetBuildSettings& settings, DatasetBu
 DatasetBuildResult buildDataset(const DatasetBuildSettings& settings, const std::filesystem::path& datasetDir,
                                 const std::filesystem::path& simulationDir, const std::filesystem::path& previewDir,
                                 const std::function<void(const std::string&)>& log = {});
+
+// `swish bake --check-simulation N CONFIG`: the source simulation's figures on a seeded sample of N of
+// part 1's thinned poses, without building a dataset: failures per reason, retried poses, seconds per
+// pose per core, equilibrium residuals, and convergence and noise on settings.quality.poses of them
+// (cloth/simulation_quality.hpp). Run it on a garment and clips of one's own before a long bake.
+nlohmann::json checkSimulation(const DatasetBuildSettings& settings, size_t poses, uint64_t seed,
+                               const std::function<void(const std::string&)>& log = {});
 
 }  // namespace swish::bake

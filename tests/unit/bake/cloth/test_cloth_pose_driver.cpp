@@ -1,6 +1,7 @@
 // The pose driver: parallel, deterministic, resumable; per-pose files written atomically.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,12 @@ TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {
   rec.result.residuals.maxPenetration = 0.001f;
   rec.result.residuals.converged = true;
   rec.result.residuals.iterations = 360;
+  rec.result.residuals.equilibriumResidual = 0.004f;
+  rec.result.residuals.equilibriumResidualMax = 0.05f;
+  rec.result.residuals.equilibriumFrames = 7;
+  rec.result.residuals.projectedDepth = 0.002f;
+  rec.result.attempts = 2;
+  rec.result.firstFailure = "the solve exploded at frame 3";
   const test::TempDir tmp("cloth_file");
   const fs::path dir = tmp.path();
   const fs::path file = simulatedPosePath(dir, 42);
@@ -139,6 +146,12 @@ TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {
   EXPECT_TRUE(sameBits(back.result.positions, rec.result.positions));
   EXPECT_EQ(back.result.residuals.iterations, 360);
   EXPECT_TRUE(back.result.residuals.converged);
+  EXPECT_EQ(back.result.residuals.equilibriumResidual, 0.004f);
+  EXPECT_EQ(back.result.residuals.equilibriumResidualMax, 0.05f);
+  EXPECT_EQ(back.result.residuals.equilibriumFrames, 7);
+  EXPECT_EQ(back.result.residuals.projectedDepth, 0.002f);
+  EXPECT_EQ(back.result.attempts, 2);
+  EXPECT_EQ(back.result.firstFailure, rec.result.firstFailure);
   // Truncated and foreign files give an Error naming the file.
   fs::resize_file(file, fs::file_size(file) - 5);
   try {
@@ -177,4 +190,45 @@ TEST(ClothPoseDriver, ShardOfIdsMatchesTheWholeRun) {
   EXPECT_EQ(simulatePoses(solver, poses, {1, 3}, tmp / "shard", {}, 1).reused, 2u);
   EXPECT_THROW(simulatePoses(solver, poses, {5}, tmp / "shard"), Error);
   EXPECT_FALSE(peekSimulatedPose(tmp / "none.clothsim").has_value());
+}
+
+// The report's simulation figures: failures per reason with their share, the retried poses, the
+// seconds per pose per core and the equilibrium residuals.
+TEST(ClothPoseDriver, SimulationReportCountsFailuresPerReasonAndRetries) {
+  EXPECT_EQ(failureCategory("the solve exploded at frame 26: 26 of 19482 edges"), "explosion");
+  EXPECT_EQ(failureCategory("the garment ends 0.0104 m inside the body (bound 0.01 m)"), "penetration");
+  EXPECT_EQ(failureCategory("after 2 attempts (...): the garment ends 0.02 m inside the body; first attempt: the "
+                            "solve exploded at frame 3"),
+            "penetration");
+  EXPECT_EQ(failureCategory("transfer: no triangle"), "transfer");
+  std::vector<SimulatedPoseSummary> poses(10);
+  for (uint32_t i = 0; i < 10; ++i) {
+    poses[i].id = i;
+    poses[i].ok = true;
+    poses[i].residuals.seconds = 1.0 + i;  // mean 5.5
+    poses[i].residuals.equilibriumResidual = 0.001f * float(i);
+  }
+  poses[3].ok = false;
+  poses[3].failure = "the solve exploded at frame 9";
+  poses[4].attempts = 2;
+  poses[4].firstFailure = "the garment ends 0.011 m inside the body";
+  ClothSimSettings s;
+  s.equilibriumTolerance = 0.0075f;
+  const nlohmann::json j = simulationRunJson(poses, s, {{7, "transfer: no triangle"}});
+  EXPECT_EQ(j.at("failed"), 2);
+  EXPECT_DOUBLE_EQ(j.at("failures_by_reason").at("explosion").at("share").get<double>(), 0.1);
+  EXPECT_EQ(j.at("failures_by_reason").at("transfer").at("count"), 1);
+  EXPECT_EQ(j.at("retried_poses"), 1);
+  EXPECT_EQ(j.at("retried")[0].at("pose"), 4);
+  EXPECT_DOUBLE_EQ(j.at("seconds_per_pose_per_core").get<double>(), 5.5);
+  EXPECT_EQ(j.at("poses_not_at_equilibrium"), 2);  // 0.008 and 0.009 of the 9 kept
+  // The sample is seeded: the same seed the same poses, ascending, without repeats.
+  std::vector<uint32_t> ids(100);
+  for (uint32_t i = 0; i < 100; ++i) ids[i] = 2 * i;
+  const std::vector<uint32_t> a = sampleQualityPoses(ids, 8, 3), b = sampleQualityPoses(ids, 8, 3);
+  EXPECT_EQ(a, b);
+  EXPECT_TRUE(std::is_sorted(a.begin(), a.end()));
+  EXPECT_EQ(std::adjacent_find(a.begin(), a.end()), a.end());
+  EXPECT_NE(a, sampleQualityPoses(ids, 8, 4));
+  EXPECT_EQ(sampleQualityPoses(ids, 500, 1).size(), 100u);
 }
