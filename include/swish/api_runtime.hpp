@@ -91,6 +91,9 @@ struct BatchOptions {
   // default: on the default character it has been measured to raise the vertex error against the source
   // simulation (README, issue notes), so a host opts in where the look matters more than that error.
   bool pushOut = false;
+  // The model's novelty guard (ModelInfo::hasNoveltyGuard): clamp the mesh weights to the range seen in
+  // training and blend towards the mean shape as a pose grows novel. Novelty is reported either way.
+  bool noveltyGuard = true;
 };
 
 class Model {

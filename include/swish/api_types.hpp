@@ -62,6 +62,11 @@ struct ModelInfo {
   uint32_t normalMapWidth = 0, normalMapHeight = 0, normalMapDatabaseSize = 0;
   float temporalFilterSeconds = 0;  // the normal-map filter's time constant
   uint32_t bodyCapsules = 0;        // capsules of the body proxy the push-out uses (0: none)
+  // The novelty guard (models of format 1.2): FrameReport::novelty is measured per character, and a
+  // character above noveltyFlagAbove is in FrameReport::novelCharacters. Novelty 1 is the sparse edge
+  // of the poses the model was trained on.
+  bool hasNoveltyGuard = false;
+  float noveltyFlagAbove = 0, noveltyBlendStart = 0, noveltyBlendEnd = 0;
 };
 
 // One vertex attribute of the deformed mesh. Character c's vertices start at
@@ -127,6 +132,10 @@ struct FrameReport {
   uint64_t frameIndex = 0;
   std::vector<std::string> warnings;  // renormalised / replaced quaternions, bad dt, non-finite codes
   double cpuMilliseconds = 0;         // network, lookup and filter on the CPU for all characters
+  // Per character: how far its pose is from the poses the model was trained on (NaN: the model has no
+  // guard), and how far the guard blended its shape towards the mean shape (0: not at all, 1: fully).
+  std::vector<float> novelty, guardBlend;
+  std::vector<uint32_t> novelCharacters;  // novelty above ModelInfo::noveltyFlagAbove
 };
 
 // GPU time of each pass of a retired frame in milliseconds (NaN: not run or no timestamps).

@@ -15,6 +15,7 @@
 #include "swish/core/rng.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
+#include "swish/runtime/novelty_guard.hpp"
 
 using namespace swish;
 using namespace swish::runtime;
@@ -90,8 +91,57 @@ void BM_MlpDefaultModel(benchmark::State& state) {
   timeBatches(state, eval, 11, std::string(toString(eval.kernel())) + " " + shape);
 }
 
+// The novelty guard's measure and clamp (runtime/novelty_guard.hpp) beside the default model's MLP, as
+// FrameEvaluator runs them: the bound is MLP + novelty no more than 10 % above the MLP alone
+// (compare BM_MlpDefaultModel at the same batch). The committed model may predate the guard (format
+// 1.2): then a guard of 128 centres (the bake's default count) drawn from random inputs stands in;
+// the cost depends only on the centre count and Theta's size. Arg(1) 0: the MLP alone, 1: MLP + guard.
+void BM_MlpDefaultModelWithNovelty(benchmark::State& state) {
+  const std::filesystem::path file = test::sourceDir() / "assets/default/default.swish";
+  if (!std::filesystem::exists(file)) {
+    state.SkipWithError("no committed default model");
+    return;
+  }
+  static const Model model = [&] {
+    Model m = loadModel(file);
+    if (m.noveltyGuard.empty()) {
+      Rng rng(5);
+      NoveltyGuard& g = m.noveltyGuard;
+      g.centres.resize(128, m.thetaSize());
+      for (Eigen::Index i = 0; i < g.centres.size(); ++i) g.centres.data()[i] = float(rng.normal(0, 1));
+      g.weightMin = VecXf::Constant(m.meshComponents(), -1.f);
+      g.weightMax = VecXf::Constant(m.meshComponents(), 1.f);
+      g.blendStart = 2.f, g.blendEnd = 4.f;
+    }
+    return m;
+  }();
+  const MlpEvaluator eval(model, CpuKernel::Auto);
+  const NoveltyGuardEvaluator guard(model);
+  const bool withGuard = state.range(1) != 0;
+  const size_t batch = size_t(state.range(0)), K = size_t(model.meshComponents());
+  Rng rng(11);
+  std::vector<float> theta(batch * size_t(eval.inputSize())), weights(batch * K),
+      codes(batch * size_t(eval.normalCodeDims())), novelty(batch);
+  for (float& t : theta) t = rng.uniformf(-1.f, 1.f);
+  for (auto _ : state) {
+    eval.evaluateBatchSplit(theta, weights, codes, uint32_t(batch));
+    if (withGuard) {
+      guard.measure(theta, uint32_t(batch), novelty);
+      for (size_t c = 0; c < batch; ++c) guard.apply(novelty[c], std::span<float>(weights.data() + c * K, K));
+    }
+    benchmark::DoNotOptimize(weights.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(std::string(withGuard ? "MLP + novelty guard, " : "MLP alone, ") +
+                 std::to_string(guard.guard().centres.rows()) + " centres");
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(batch));
+  state.counters["time_per_instance"] = benchmark::Counter(double(state.iterations()) * double(batch),
+                                                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
 
+BENCHMARK(BM_MlpDefaultModelWithNovelty)->Args({22, 0})->Args({22, 1})->Args({1, 0})->Args({1, 1});
 BENCHMARK(BM_MlpAuto)->Arg(22)->Arg(1)->Arg(256);
 BENCHMARK(BM_MlpPortable)->Arg(22)->Arg(1);
 BENCHMARK(BM_MlpDefaultModel)->Arg(22)->Arg(1);

@@ -20,6 +20,7 @@
 #include "swish/core/skinning.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
+#include "swish/runtime/novelty_guard.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/theta.hpp"
 
@@ -124,12 +125,16 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   EXPECT_EQ(loaded.metadata, out.model.metadata);
   const auto meta = nlohmann::json::parse(loaded.metadata);
   EXPECT_TRUE(meta.contains("errors"));
-  // The loaded model runs through the runtime: MLP -> reference frame (PCA, skinning, frames, VQ, blend).
+  // The loaded model runs through the runtime: MLP -> novelty guard -> reference frame (PCA, skinning,
+  // frames, VQ, blend).
+  ASSERT_FALSE(loaded.noveltyGuard.empty());
   const runtime::MlpEvaluator mlp(loaded);
+  const runtime::NoveltyGuardEvaluator guard(loaded);
   const DatasetPose& p = ds.poses[out.testPoses[0]];
   const auto theta = runtime::computeTheta(loaded.inputJoints, p.pose.local);
   std::vector<float> lambda(size_t(mlp.outputSize()));
   mlp.evaluate(theta, lambda);
+  guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(loaded.meshComponents())));
   runtime::FrameKernelInputs in;
   in.instanceCount = 1;
   in.meshWeights.assign(lambda.begin(), lambda.begin() + loaded.meshComponents());

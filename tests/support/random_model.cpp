@@ -130,6 +130,22 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
     cap.radius = rng.uniformf(0.005f, 0.05f);
     m.bodyProxy.capsules.push_back(cap);
   }
+  // Novelty guard: centres near the origin of the normalised input space, weight ranges around 0.
+  if (s.noveltyCentres > 0) {
+    NoveltyGuard& g = m.noveltyGuard;
+    g.centres.resize(s.noveltyCentres, in);
+    for (Eigen::Index i = 0; i < g.centres.size(); ++i) g.centres.data()[i] = float(rng.normal(0, 1));
+    g.unit = rng.uniformf(0.5f, 1.5f);
+    g.weightMin.resize(s.meshComponents);
+    g.weightMax.resize(s.meshComponents);
+    for (uint32_t k = 0; k < s.meshComponents; ++k) {
+      g.weightMin[k] = -rng.uniformf(0.1f, 1.f);
+      g.weightMax[k] = rng.uniformf(0.1f, 1.f);
+    }
+    g.blendStart = 1.5f;
+    g.blendEnd = 3.f;
+    g.flagAbove = 1.5f;
+  }
   m.validate("random model");
   return m;
 }

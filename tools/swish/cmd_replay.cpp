@@ -36,7 +36,7 @@ struct ReplayCliOptions {
   std::string scene, out, device;
   bool plan = false, quiet = false, validation = false, render = false;
   uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16, penetrationEvery = 30;
-  bool pushOut = false;
+  bool pushOut = false, noGuard = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
 };
@@ -80,6 +80,7 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.truth.substeps = o.truthSubsteps;
   jo.engine.penetrationEvery = o.penetrationEvery;
   jo.engine.pushOut = o.pushOut;
+  jo.engine.noveltyGuard = !o.noGuard;
   const replay::ReplayJobResult r = replay::runReplayJob(scene, jo);
   if (!o.quiet) {
     std::printf("Replayed %zu frames of '%s' on %s.\n", r.result.frames.size(), scene.name.c_str(),
@@ -112,6 +113,15 @@ int runReplay(const ReplayCliOptions& o) {
     } else {
       std::printf("Penetration: %s\n", r.result.penetrationNote.c_str());
     }
+    size_t measured = 0, flagged = 0;
+    float worst = 0.f;
+    for (const auto& f : r.result.frames)
+      for (const auto& nv : f.novelty) ++measured, flagged += nv.flagged, worst = std::max(worst, nv.novelty);
+    if (measured > 0)
+      std::printf("Novelty: %zu of %zu character frames above the flag threshold, highest %.2f; guard %s.\n", flagged,
+                  measured, double(worst), o.noGuard ? "off (--no-guard)" : "on");
+    else
+      std::printf("Novelty: not measured (no model in the scene carries a novelty guard).\n");
   }
   if (o.render) {
     // After the replay's outputs are in place, so that a render failure never loses the report.
@@ -165,6 +175,10 @@ swish::cli::CommandRegistration reg{
       app.add_flag("--push-out", o->pushOut,
                    "push the garment out of the model's body proxy on the GPU (models that carry one; off by default: "
                    "measured to raise the error against the source simulation)");
+      app.add_flag("--no-guard", o->noGuard,
+                   "measure each character's novelty (how far its pose is from the model's training poses) but do "
+                   "not apply the model's novelty guard (clamp of the mesh weights, blend towards the mean shape): "
+                   "with --truth-every, shows what the guard does to the error");
       app.add_option("--frames", o->frames, "replay only this many frames");
       app.add_flag("--quiet", o->quiet, "no progress bar or summary");
       app.add_flag("--validation", o->validation, "enable the Vulkan validation layers");

@@ -83,6 +83,9 @@ FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex
     for (uint32_t c : out.nonFiniteCode)
       report.warnings.push_back("character " + std::to_string(c) +
                                 ": the network's normal code was not finite; kept the previous map");
+    report.novelty = out.novelty;
+    report.guardBlend = out.guardBlend;
+    report.novelCharacters = out.novel;
     b.inputs.meshWeights = out.meshWeights;
     b.inputs.selectedMaps.clear();
     b.inputs.blendAlpha.clear();

@@ -67,6 +67,12 @@ ModelInfo describeModel(const swish::Model& m, const std::string& name) {
   info.normalMapDatabaseSize = m.normalMaps.mapCount();
   info.temporalFilterSeconds = m.temporalFilter.timeConstantSeconds;
   info.bodyCapsules = uint32_t(m.bodyProxy.capsules.size());
+  info.hasNoveltyGuard = !m.noveltyGuard.empty();
+  if (info.hasNoveltyGuard) {
+    info.noveltyFlagAbove = m.noveltyGuard.flagAbove;
+    info.noveltyBlendStart = m.noveltyGuard.blendStart;
+    info.noveltyBlendEnd = m.noveltyGuard.blendEnd;
+  }
   return info;
 }
 

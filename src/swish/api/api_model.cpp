@@ -72,7 +72,9 @@ CharacterBatch Model::createBatch(const BatchOptions& o) const {
     b->characters = o.characters;
     b->inputs.pushOut = o.pushOut;
     b->normalMaps = o.normalMaps && impl_->gpuModel->hasNormalMaps() && impl_->runtime->ctx.supportsNormalMaps();
-    b->evaluator = std::make_unique<runtime::FrameEvaluator>(impl_->model, o.characters);
+    runtime::FrameEvaluatorOptions eo;
+    eo.guard = o.noveltyGuard;
+    b->evaluator = std::make_unique<runtime::FrameEvaluator>(impl_->model, o.characters, eo);
     gpu::FrameRecorderOptions ro;
     ro.framesInFlight = o.framesInFlight;
     ro.tangentFrames = true;

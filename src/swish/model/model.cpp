@@ -96,6 +96,24 @@ void Model::validate(const std::string& what) const {
     if (!(cap.radius > 0.f) || !(cap.radius < 10.f))
       fail("body proxy", "capsule " + n2s(c) + " radius must be in (0, 10) metres");
   }
+  const NoveltyGuard& g = noveltyGuard;
+  if (!g.empty()) {
+    if (g.centres.cols() != thetaSize())
+      fail("novelty guard",
+           "centres have " + n2s(size_t(g.centres.cols())) + " inputs, Theta " + n2s(size_t(thetaSize())));
+    if (!g.centres.allFinite()) fail("novelty guard", "centres are not finite");
+    if (!(g.unit > 0.f) || !std::isfinite(g.unit)) fail("novelty guard", "unit must be finite and > 0");
+    if (g.weightMin.size() != g.weightMax.size() || (g.weightMin.size() != 0 && g.weightMin.size() != meshComponents()))
+      fail("novelty guard", "weight ranges have " + n2s(size_t(g.weightMin.size())) + " and " +
+                                n2s(size_t(g.weightMax.size())) + " values for " + n2s(size_t(meshComponents())) +
+                                " mesh components");
+    for (Eigen::Index k = 0; k < g.weightMin.size(); ++k)
+      if (!(g.weightMin[k] <= g.weightMax[k]) || !std::isfinite(g.weightMin[k]) || !std::isfinite(g.weightMax[k]))
+        fail("novelty guard", "weight range " + n2s(size_t(k)) + " is empty or not finite");
+    if (!std::isfinite(g.blendStart) || !std::isfinite(g.blendEnd) || !std::isfinite(g.flagAbove) ||
+        g.blendStart < 0.f || g.flagAbove < 0.f)
+      fail("novelty guard", "blend and flag thresholds must be finite and >= 0");
+  }
   if (!(temporalFilter.timeConstantSeconds >= 0.f) || !std::isfinite(temporalFilter.timeConstantSeconds))
     fail("temporal filter", "time constant must be finite and >= 0");
 }

@@ -84,6 +84,24 @@ struct BodyProxy {
 // Most capsules a proxy may hold (the deform kernel loops over all of them per vertex and instance).
 inline constexpr size_t kMaxBodyCapsules = 64;
 
+// The run-time novelty guard (format 1.2; runtime/novelty_guard.hpp): how far a frame's network input
+// lies from the poses the model was trained on, and what the run time does when it is far. Novelty is
+// the distance of the normalised Theta ((Theta - inputNorm.mean) / inputNorm.scale) to the nearest of
+// `centres` (k-means centres of the training poses' normalised Theta), as an RMS per input, divided by
+// `unit` (the 95th percentile of the training poses' own such distances): about 1 at the sparse edge of
+// the training set. The guard clamps the mesh weights to [weightMin, weightMax] (the range the training
+// shapes span) and, when blendEnd > blendStart, scales them towards 0 (the PCA mean shape) as novelty
+// goes from blendStart to blendEnd. Frames whose novelty is above flagAbove are reported as novel.
+struct NoveltyGuard {
+  MatXf centres;               // C x thetaSize; C == 0: no guard (models before 1.2)
+  float unit = 1.f;            // > 0
+  VecXf weightMin, weightMax;  // K each, or both empty: no clamp
+  float blendStart = 0.f, blendEnd = 0.f;
+  float flagAbove = 2.f;
+  bool empty() const { return centres.rows() == 0; }
+  bool blends() const { return blendEnd > blendStart; }
+};
+
 struct Model {
   Skeleton skeleton;                  // the character's skeleton (for FK and skinning)
   std::vector<uint32_t> inputJoints;  // skeleton joint indices forming Theta, in this order
@@ -95,6 +113,7 @@ struct Model {
   NormalMapDatabase normalMaps;  // may be empty (a model without normal maps)
   TemporalFilterParams temporalFilter;
   BodyProxy bodyProxy;          // may be empty (models of format 1.0, or baked without a body)
+  NoveltyGuard noveltyGuard;    // may be empty (models before format 1.2)
   std::string metadata = "{}";  // free-form JSON: bake settings, errors measured at bake time
 
   int thetaSize() const { return int(inputJoints.size()) * 6; }

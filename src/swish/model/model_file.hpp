@@ -1,7 +1,7 @@
 #pragma once
 // The .swish model file: everything the run time needs for one garment, in one checked binary file.
 //
-// ==================================== Layout, format version 1.1 ====================================
+// ==================================== Layout, format version 1.2 ====================================
 // All integers are unsigned little-endian unless marked i32 (two's complement). f32 is IEEE-754
 // binary32, little-endian, bit pattern kept exactly. There is no padding or alignment anywhere: fields
 // follow each other byte after byte. Matrices are column-major (Eigen's order) unless said otherwise.
@@ -9,7 +9,7 @@
 // File header, 32 bytes:
 //   0   u8[8]  magic: 0x89 'S' 'W' 'I' 'S' 'H' 0x0D 0x0A  (0x89 and CR LF catch text-mode mangling)
 //   8   u16    major version = 1. A reader refuses a larger major version.
-//   10  u16    minor version = 1. Minor versions only ADD sections; a reader skips tags it does not
+//   10  u16    minor version = 2. Minor versions only ADD sections; a reader skips tags it does not
 //              know when the file's minor version is newer than its own, and refuses them otherwise.
 //   12  u32    section count
 //   16  u64    total file size in bytes, header included (catches truncation before anything else)
@@ -22,7 +22,7 @@
 //   16  u8[payload size] payload; every payload must be read to its last byte (trailing bytes = error)
 //
 // Sections of version 1.0: each exactly once, all required, any order (the writer uses this one and
-// puts BPRX before META).
+// puts BPRX and NOVG before META).
 //   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
 //          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
 //          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
@@ -50,6 +50,11 @@
 // 1.0 file that holds one is refused):
 //   "BPRX" body proxy for the run-time push-out: u32 C capsules (0..64), then per capsule u32 joint,
 //          f32[3] end a, f32[3] end b (rest character space), f32 radius (metres). See BodyProxy.
+// Added in version 1.2 (required in 1.2 files; older files load with an empty guard):
+//   "NOVG" novelty guard: u32 C centres, u32 D inputs (C = 0: none; else D = Theta's size), f32[C*D]
+//          centres (centre after centre), f32 unit, u32 K weight ranges (0 or the mesh components),
+//          f32[K] minimum, f32[K] maximum, f32 blend start, f32 blend end, f32 flag threshold. See
+//          NoveltyGuard.
 // After parsing, Model::validate checks every index and size the run time relies on.
 // =====================================================================================================
 #include <array>
@@ -64,7 +69,7 @@
 namespace swish {
 
 constexpr uint16_t kModelFileMajorVersion = 1;
-constexpr uint16_t kModelFileMinorVersion = 1;
+constexpr uint16_t kModelFileMinorVersion = 2;
 constexpr std::array<uint8_t, 8> kModelFileMagic = {0x89, 'S', 'W', 'I', 'S', 'H', 0x0D, 0x0A};
 constexpr size_t kModelFileHeaderBytes = 32;
 constexpr size_t kModelSectionHeaderBytes = 16;

@@ -275,6 +275,41 @@ void readBodyProxy(ByteReader& r, Model& m) {
   }
 }
 
+// ---- NOVG (format 1.2) ------------------------------------------------------------------------
+void writeNoveltyGuard(const Model& m, ByteWriter& w) {
+  const NoveltyGuard& g = m.noveltyGuard;
+  w.u32(count32(size_t(g.centres.rows()), "novelty centre"));
+  w.u32(count32(size_t(g.centres.cols()), "novelty input"));
+  for (Eigen::Index i = 0; i < g.centres.rows(); ++i)
+    for (Eigen::Index j = 0; j < g.centres.cols(); ++j) w.f32(g.centres(i, j));
+  w.f32(g.unit);
+  w.u32(count32(size_t(g.weightMin.size()), "novelty weight range"));
+  w.f32s({g.weightMin.data(), size_t(g.weightMin.size())});
+  w.f32s({g.weightMax.data(), size_t(g.weightMax.size())});
+  w.f32(g.blendStart);
+  w.f32(g.blendEnd);
+  w.f32(g.flagAbove);
+}
+
+void readNoveltyGuard(ByteReader& r, Model& m) {
+  NoveltyGuard& g = m.noveltyGuard;
+  const uint32_t rows = r.u32("novelty centre count"), cols = r.u32("novelty input count");
+  r.checkCount(r.multiply(rows, cols, "novelty centre value"), 4, "novelty centre value");
+  g.centres.resize(rows, cols);
+  if (cols > 0)
+    for (Eigen::Index i = 0; i < g.centres.rows(); ++i)
+      for (Eigen::Index j = 0; j < g.centres.cols(); ++j) g.centres(i, j) = r.f32("novelty centre value");
+  g.unit = r.f32("novelty unit");
+  const size_t k = r.checkCount(r.u32("novelty weight range count"), 8, "novelty weight range");
+  g.weightMin.resize(Eigen::Index(k));
+  g.weightMax.resize(Eigen::Index(k));
+  r.f32s(g.weightMin.data(), k, "novelty weight minimum");
+  r.f32s(g.weightMax.data(), k, "novelty weight maximum");
+  g.blendStart = r.f32("novelty blend start");
+  g.blendEnd = r.f32("novelty blend end");
+  g.flagAbove = r.f32("novelty flag threshold");
+}
+
 // ---- TFLT, META -------------------------------------------------------------------------------
 void writeTemporalFilter(const Model& m, ByteWriter& w) { w.f32(m.temporalFilter.timeConstantSeconds); }
 void readTemporalFilter(ByteReader& r, Model& m) { m.temporalFilter.timeConstantSeconds = r.f32("time constant"); }
@@ -300,6 +335,7 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {"NMDB", writeNormalMaps, readNormalMaps},
       {"TFLT", writeTemporalFilter, readTemporalFilter},
       {"BPRX", writeBodyProxy, readBodyProxy, 1},
+      {"NOVG", writeNoveltyGuard, readNoveltyGuard, 2},
       {"META", writeMetadata, readMetadata},
   };
   return codecs;

@@ -19,10 +19,7 @@
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/replay/gpu_check.hpp"
 #include "swish/replay/pose_stream.hpp"
-#include "swish/runtime/mlp_evaluator.hpp"
-#include "swish/runtime/nearest_code.hpp"
-#include "swish/runtime/temporal_filter.hpp"
-#include "swish/runtime/theta.hpp"
+#include "swish/runtime/frame_evaluator.hpp"
 
 namespace swish::replay {
 
@@ -57,10 +54,9 @@ struct Batch {
   const Model* model = nullptr;
   std::optional<Model> withoutMaps;  // a copy without the database, only when the plan leaves maps out
   const Model& uploaded() const { return withoutMaps ? *withoutMaps : *model; }  // the model on the GPU
-  std::optional<runtime::MlpEvaluator> mlp;
-  std::optional<runtime::NearestCodeSearch> search;
-  std::vector<runtime::TemporalFilter> filters;
-  std::vector<uint32_t> lastMap;
+  // Theta -> MLP -> novelty guard -> nearest map -> temporal filter: the one CPU frame path the API
+  // uses too (runtime/frame_evaluator.hpp).
+  std::optional<runtime::FrameEvaluator> frames;
   std::vector<CharacterMotion> motions;
   std::unique_ptr<gpu::GpuModel> gpuModel;
   std::unique_ptr<gpu::FrameRecorder> recorder;
@@ -71,7 +67,6 @@ struct Batch {
   std::vector<bake::BodyCollider> colliders;
   // Per frame scratch.
   std::vector<Pose> poses;
-  std::vector<float> theta, meshWeights, codes;
   runtime::FrameKernelInputs inputs;
 };
 
@@ -121,13 +116,10 @@ void ReplayEngine::Impl::setUp() {
     Batch& B = batches[b];
     B.planned = &plan.batches[b];
     B.model = &models.at(B.planned->model).model;
-    B.mlp.emplace(*B.model);
-    if (B.planned->normalMaps) {
-      B.search.emplace(B.model->normalMaps.keys);
-      B.filters.assign(B.planned->characters.size(),
-                       runtime::TemporalFilter(B.model->temporalFilter.timeConstantSeconds));
-      B.lastMap.assign(B.planned->characters.size(), 0);
-    }
+    runtime::FrameEvaluatorOptions eo;
+    eo.normalMaps = B.planned->normalMaps;
+    eo.guard = options.noveltyGuard;
+    B.frames.emplace(*B.model, uint32_t(B.planned->characters.size()), eo);
     for (uint32_t c : B.planned->characters) {
       const runtime::SceneCharacter& ch = scene.characters[c];
       try {
@@ -226,36 +218,26 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
     }
     t.pose += msSince(t0);
 
-    t0 = Clock::now();
-    B.theta.resize(n * ts);
-    for (uint32_t i = 0; i < n; ++i)
-      runtime::computeTheta(m.inputJoints, poses[i].local, std::span<float>(B.theta).subspan(i * ts, ts));
-    t.theta += msSince(t0);
-
-    t0 = Clock::now();
-    B.meshWeights.resize(n * k);
-    B.codes.resize(n * size_t(m.normalCodeDims()));
-    B.mlp->evaluateBatchSplit(B.theta, B.meshWeights, B.codes, n);
-    t.mlp += msSince(t0);
-
-    t0 = Clock::now();
-    B.inputs.meshWeights = B.meshWeights;
+    const runtime::FrameOutput& o = B.frames->evaluate(std::span<const Pose>(poses), dt);
+    t.theta += 1000.0 * o.timings.theta;
+    t.mlp += 1000.0 * o.timings.mlp;
+    t.novelty += 1000.0 * o.timings.novelty;
+    t.lookup += 1000.0 * (o.timings.lookup + o.timings.filter);
+    for (uint32_t c : o.nonFiniteCode)
+      issues.push_back({rec.frame, scene.characters[B.planned->characters[c]].name, "", "non-finite normal code",
+                        "previous normal map kept"});
+    if (B.frames->hasNoveltyGuard())
+      for (uint32_t i = 0; i < n; ++i)
+        rec.novelty.push_back(
+            {B.planned->characters[i], o.novelty[i], o.guardBlend[i], !(o.novelty[i] <= m.noveltyGuard.flagAbove)});
+    B.inputs.meshWeights = o.meshWeights;
     B.inputs.selectedMaps.clear();
     B.inputs.blendAlpha.clear();
-    if (B.search) {
-      const size_t cd = size_t(m.normalCodeDims());
+    if (B.frames->hasNormalMaps())
       for (uint32_t i = 0; i < n; ++i) {
-        const auto hit = B.search->find(std::span<const float>(B.codes).subspan(i * cd, cd), B.lastMap[i]);
-        if (!hit.found)
-          issues.push_back({rec.frame, scene.characters[B.planned->characters[i]].name, "", "non-finite normal code",
-                            "previous normal map kept"});
-        B.lastMap[i] = hit.index;
-        const runtime::BlendStep step = B.filters[i].step(dt, hit.index);
-        B.inputs.selectedMaps.push_back(step.selectedMap);
-        B.inputs.blendAlpha.push_back(step.alpha);
+        B.inputs.selectedMaps.push_back(o.blend[i].selectedMap);
+        B.inputs.blendAlpha.push_back(o.blend[i].alpha);
       }
-    }
-    t.lookup += msSince(t0);
   }
 
   const bool check = plan.gpuWork && index % scene.outputs.gpuCheckEvery == 0;
@@ -449,6 +431,7 @@ ReplayResult ReplayEngine::run() {
     I.truthPools = std::vector<TruthPool>(I.scene.characters.size());
   }
   r.penetrationEvery = I.options.penetrationEvery;
+  r.noveltyGuard = I.options.noveltyGuard;
   for (const Batch& B : I.batches)
     if (I.options.pushOut && I.plan.gpuWork && !B.model->bodyProxy.empty()) r.pushOut = true;
   if (I.options.penetrationEvery == 0) {

@@ -43,6 +43,7 @@ struct ReplayOptions {
   gpu::Context* context = nullptr;  // use this device instead of creating one (tests, hosts)
   TruthOptions truth;               // truth.every 0: none; N: ground truth on every Nth frame
   bool pushOut = false;             // the run time's push-out of the body proxy (models that have one; --push-out)
+  bool noveltyGuard = true;         // apply the models' novelty guards (measured either way; --no-guard)
   // Penetration of the garment into the body it was baked on (the CPU reference's positions, with and
   // without the push-out) on every Nth frame; 0: not measured.
   uint32_t penetrationEvery =
@@ -59,10 +60,10 @@ struct ReplayOptions {
 
 // Milliseconds; NaN where a stage did not run.
 struct FrameTimes {
-  double pose = 0, theta = 0, mlp = 0, lookup = 0, record = 0;  // CPU stages (record: inputs + commands)
-  double gpuWait = 0;                                           // submit -> fence, wall clock
+  double pose = 0, theta = 0, mlp = 0, novelty = 0, lookup = 0, record = 0;  // CPU stages (record: inputs + commands)
+  double gpuWait = 0;                                                        // submit -> fence, wall clock
   double gpuDeform = 0, gpuTangents = 0, gpuDecode = 0, gpuBlend = 0, gpuTotal = 0;  // GPU timestamps
-  double cpuTotal() const { return pose + theta + mlp + lookup + record; }
+  double cpuTotal() const { return pose + theta + mlp + novelty + lookup + record; }
 };
 
 struct CharacterCheck {
@@ -82,6 +83,15 @@ struct CharacterPenetration {
   bake::PenetrationStats pushed;
 };
 
+// One character's novelty on one frame (runtime/novelty_guard.hpp): how far its pose is from the
+// model's training poses, the blend towards the mean shape the guard applied, and whether it is above
+// the model's flag threshold.
+struct CharacterNovelty {
+  uint32_t character = 0;
+  float novelty = 0, blend = 0;
+  bool flagged = false;
+};
+
 struct PenetrationSummary {
   bake::PenetrationPool model, pushed;
   bool pushedMeasured = false;
@@ -97,6 +107,7 @@ struct FrameRecord {
   bool truthFrame = false;                        // on the --truth-every grid, with a model that has truth
   std::vector<CharacterTruth> truth;              // when truthFrame: per on-screen character with truth, plan order
   std::vector<CharacterPenetration> penetration;  // per on-screen character with a body, plan order (measured frames)
+  std::vector<CharacterNovelty> novelty;          // per on-screen character of a model with a guard, plan order
   double maxPositionErrorMm() const;
   double maxNormalErrorDeg() const;
   int maxMapErrorSteps() const;
@@ -131,6 +142,7 @@ struct ReplayResult {
   std::vector<PenetrationSummary> penetrationPerCharacter;  // per scene character (empty when none measured)
   PenetrationSummary penetrationOverall;
   double penetrationSeconds = 0;  // wall time of the measurements
+  bool noveltyGuard = true;       // the guards were applied (ReplayOptions::noveltyGuard)
   bool failed() const { return !failures.empty() || issueCount > 0; }
 };
 

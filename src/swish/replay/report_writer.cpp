@@ -4,6 +4,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -28,6 +29,7 @@ const std::vector<StageColumn>& stageColumns() {
       {"pose", "CPU pose + FK + skin matrices", &FrameTimes::pose},
       {"theta", "CPU Theta (6D)", &FrameTimes::theta},
       {"mlp", "CPU MLP", &FrameTimes::mlp},
+      {"novelty", "CPU novelty guard", &FrameTimes::novelty},
       {"lookup", "CPU lookup + filter", &FrameTimes::lookup},
       {"record", "CPU record + upload", &FrameTimes::record},
       {"gpuDeform", "GPU deform", &FrameTimes::gpuDeform},
@@ -184,6 +186,14 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
         fj["penetration"].push_back(pj);
       }
     }
+    if (!f.novelty.empty()) {
+      fj["novelty"] = json::array();
+      for (const auto& nv : f.novelty)
+        fj["novelty"].push_back({{"character", scene.characters[nv.character].name},
+                                 {"novelty", nv.novelty},
+                                 {"blend", nv.blend},
+                                 {"flagged", nv.flagged}});
+    }
     if (f.checked)
       fj["gpuVsCpu"] = {{"maxPositionErrorMm", f.maxPositionErrorMm()},
                         {"maxNormalErrorDeg", f.maxNormalErrorDeg()},
@@ -206,6 +216,45 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
   for (size_t c = 0; c < r.penetrationPerCharacter.size() && c < perChar.size(); ++c)
     if (r.penetrationPerCharacter[c].model.frames > 0)
       perChar[c]["penetration"] = penetrationJson(r.penetrationPerCharacter[c]);
+  // Novelty per character over the replay, and the flagged frames (the first kMaxFlagged of them).
+  {
+    constexpr size_t kMaxFlagged = 200;
+    std::vector<std::vector<double>> perCharNovelty(scene.characters.size());
+    std::vector<size_t> flaggedPerChar(scene.characters.size(), 0);
+    json flagged = json::array();
+    size_t flaggedCount = 0, measured = 0;
+    std::vector<double> all;
+    for (const auto& f : r.frames)
+      for (const auto& nv : f.novelty) {
+        perCharNovelty[nv.character].push_back(nv.novelty);
+        all.push_back(nv.novelty);
+        ++measured;
+        if (!nv.flagged) continue;
+        ++flaggedPerChar[nv.character];
+        if (flaggedCount++ < kMaxFlagged)
+          flagged.push_back({{"frame", f.frame},
+                             {"character", scene.characters[nv.character].name},
+                             {"novelty", nv.novelty},
+                             {"blend", nv.blend}});
+      }
+    j["novelty"] = {{"measured", measured > 0},
+                    {"guard", r.noveltyGuard},
+                    {"characterFrames", measured},
+                    {"flaggedCharacterFrames", flaggedCount},
+                    {"flagged", flagged}};
+    if (measured > 0)
+      j["novelty"]["overall"] = {{"mean", std::accumulate(all.begin(), all.end(), 0.0) / double(all.size())},
+                                 {"p95", quantile(all, 0.95)},
+                                 {"max", *std::max_element(all.begin(), all.end())}};
+    for (size_t c = 0; c < perChar.size(); ++c) {
+      const auto& v = perCharNovelty[c];
+      if (v.empty()) continue;
+      perChar[c]["novelty"] = {{"mean", std::accumulate(v.begin(), v.end(), 0.0) / double(v.size())},
+                               {"p95", quantile(v, 0.95)},
+                               {"max", *std::max_element(v.begin(), v.end())},
+                               {"framesFlagged", flaggedPerChar[c]}};
+    }
+  }
   j["characters"] = perChar;
   json summary;
   for (const auto& s : stageColumns()) {
@@ -308,6 +357,43 @@ std::string reportMarkdown(const json& j) {
           << " mm and the p95 by " << fmt(num(t["p95Mm"]) - num(w["p95Mm"]), "%+.3f") << " mm.\n\n";
       }
       s << "![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
+    }
+  }
+  {
+    const json& nv = j["novelty"];
+    s << "## Novelty: poses the model never saw\n\n";
+    if (!nv["measured"].get<bool>()) {
+      s << "Not measured: no model in the scene carries a novelty guard (models of format 1.2 and later do; "
+           "re-bake to get one).\n\n";
+    } else {
+      s << "How far each character's pose is from the poses its model was trained on (the model's novelty guard: "
+           "distance of the network's input to the nearest training-pose centre; 1 is the sparse edge of the "
+           "training set). The guard, which clamps the mesh weights to their training range and blends towards the "
+           "mean shape as a pose grows novel, was "
+        << (nv["guard"].get<bool>() ? "ON" : "OFF (--no-guard: measured, not applied)") << ". Novelty over "
+        << nv["characterFrames"] << " character frames: mean " << fmt(num(nv["overall"]["mean"])) << ", p95 "
+        << fmt(num(nv["overall"]["p95"])) << ", max " << fmt(num(nv["overall"]["max"])) << "; "
+        << nv["flaggedCharacterFrames"] << " character frames above their model's flag threshold.\n\n"
+        << "![novelty per frame](plots/novelty_per_frame.svg)\n\n"
+        << "| character | mean | p95 | max | frames flagged |\n|---|---:|---:|---:|---:|\n";
+      for (const auto& c : j["characters"]) {
+        if (!c.contains("novelty")) continue;
+        const json& q = c["novelty"];
+        s << "| " << c["name"].get<std::string>() << " | " << fmt(num(q["mean"])) << " | " << fmt(num(q["p95"]))
+          << " | " << fmt(num(q["max"])) << " | " << q["framesFlagged"] << " |\n";
+      }
+      s << "\n";
+      if (!nv["flagged"].empty()) {
+        s << "First flagged frames:\n\n| frame | character | novelty | blend to the mean shape "
+             "|\n|---:|---|---:|---:|\n";
+        size_t shown = 0;
+        for (const auto& f : nv["flagged"]) {
+          if (shown++ == 20) break;
+          s << "| " << f["frame"] << " | " << f["character"].get<std::string>() << " | " << fmt(num(f["novelty"]))
+            << " | " << fmt(num(f["blend"])) << " |\n";
+        }
+        s << "\n";
+      }
     }
   }
   {
@@ -465,6 +551,36 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
     writeTextFileAtomic(dir / "plots/truth_error_per_frame.svg",
                         plot("Run time against ground truth (source simulation), per truth frame", "scene frame",
                              "vertex error (mm); normal maps (deg)", ts));
+  }
+  if (num(j["novelty"]["characterFrames"]) > 0) {
+    // One line per character up to 12 characters; beyond that the worst and the median per frame.
+    constexpr size_t kMaxLines = 12;
+    std::vector<uint32_t> shown;
+    for (const auto& f : r.frames)
+      for (const auto& nv : f.novelty)
+        if (std::find(shown.begin(), shown.end(), nv.character) == shown.end()) shown.push_back(nv.character);
+    std::vector<PlotSeries> ns;
+    if (shown.size() <= kMaxLines) {
+      for (uint32_t c : shown) ns.push_back({scene.characters[c].name, {}, {}, ""});
+      for (const auto& f : r.frames)
+        for (const auto& nv : f.novelty) {
+          const size_t k = size_t(std::find(shown.begin(), shown.end(), nv.character) - shown.begin());
+          ns[k].x.push_back(f.frame), ns[k].y.push_back(nv.novelty);
+        }
+    } else {
+      PlotSeries worst{"worst character", {}, {}, ""}, median{"median character", {}, {}, ""};
+      for (const auto& f : r.frames) {
+        if (f.novelty.empty()) continue;
+        std::vector<double> v;
+        for (const auto& nv : f.novelty) v.push_back(nv.novelty);
+        worst.x.push_back(f.frame), worst.y.push_back(*std::max_element(v.begin(), v.end()));
+        median.x.push_back(f.frame), median.y.push_back(quantile(v, 0.5));
+      }
+      ns = {worst, median};
+    }
+    writeTextFileAtomic(
+        dir / "plots/novelty_per_frame.svg",
+        plot("Novelty per character (1: the sparse edge of the training poses)", "scene frame", "novelty", ns));
   }
   if (!r.penetrationPerCharacter.empty()) {
     PlotSeries deepModel{"deepest, model (mm)", {}, {}, ""}, deepPushed{"deepest, after the push-out (mm)", {}, {}, ""};

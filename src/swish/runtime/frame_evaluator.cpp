@@ -1,6 +1,7 @@
 #include "swish/runtime/frame_evaluator.hpp"
 
 #include <chrono>
+#include <limits>
 #include <string>
 
 #include "swish/core/error.hpp"
@@ -17,11 +18,16 @@ const Model& validated(const Model& model) {
 }  // namespace
 
 FrameEvaluator::FrameEvaluator(const Model& model, uint32_t characters, CpuKernel kernel)
+    : FrameEvaluator(model, characters, FrameEvaluatorOptions{kernel, true, true}) {}
+
+FrameEvaluator::FrameEvaluator(const Model& model, uint32_t characters, const FrameEvaluatorOptions& options)
     : inputJoints_(validated(model).inputJoints),
       characters_(characters),
       joints_(uint32_t(model.skeleton.size())),
-      mlp_(model, kernel) {
-  if (!model.normalMaps.empty()) search_.emplace(model.normalMaps.keys, kernel);
+      mlp_(model, options.kernel),
+      guard_(model),
+      guardOn_(options.guard) {
+  if (!model.normalMaps.empty() && options.normalMaps) search_.emplace(model.normalMaps.keys, options.kernel);
   filters_.assign(characters, TemporalFilter(model.temporalFilter.timeConstantSeconds));
   theta_.resize(size_t(characters) * size_t(model.thetaSize()));
   out_.characters = characters;
@@ -32,6 +38,8 @@ FrameEvaluator::FrameEvaluator(const Model& model, uint32_t characters, CpuKerne
   out_.mapIndex.assign(characters, search_ ? 0u : kNoMap);
   out_.blendAlpha.assign(characters, 0.f);
   if (search_) out_.blend.resize(characters);
+  out_.novelty.assign(characters, std::numeric_limits<float>::quiet_NaN());
+  out_.guardBlend.assign(characters, 0.f);
 }
 
 void FrameEvaluator::resetCharacter(uint32_t character) {
@@ -44,6 +52,7 @@ void FrameEvaluator::beginFrame() {
   out_.jointIssues.clear();
   out_.nonFiniteCode.clear();
   out_.invalidDt.clear();
+  out_.novel.clear();
 }
 
 void FrameEvaluator::thetaOf(uint32_t c, std::span<const Quatf> localRotations) {
@@ -89,6 +98,17 @@ const FrameOutput& FrameEvaluator::finishFrame(std::span<const float> dt, double
                 " characters (give one, or one per character)");
   const double t1 = now();
   mlp_.evaluateBatchSplit(theta_, out_.meshWeights, out_.normalCodes, characters_);
+  const double tm = now();
+  if (guard_.active()) {
+    guard_.measure(theta_, characters_, out_.novelty);
+    const size_t k = out_.meshComponents;
+    const bool on = guardOn();
+    for (uint32_t c = 0; c < characters_; ++c) {
+      if (!(out_.novelty[c] <= guard_.guard().flagAbove)) out_.novel.push_back(c);
+      out_.guardBlend[c] = on ? guard_.blendOf(out_.novelty[c]) : 0.f;
+      if (on) guard_.apply(out_.novelty[c], std::span<float>(out_.meshWeights.data() + c * k, k));
+    }
+  }
   const double t2 = now();
   double t3 = t2;
   if (search_) {
@@ -114,7 +134,7 @@ const FrameOutput& FrameEvaluator::finishFrame(std::span<const float> dt, double
     }
   }
   const double t4 = now();
-  out_.timings = {t1 - t0, t2 - t1, t3 - t2, t4 - t3, t4 - t0};
+  out_.timings = {t1 - t0, tm - t1, t2 - tm, t3 - t2, t4 - t3, t4 - t0};
   return out_;
 }
 

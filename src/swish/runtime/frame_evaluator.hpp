@@ -1,8 +1,10 @@
 #pragma once
 // The per-frame CPU side of the runtime for N characters of one model (paper section 2.3, steps 1, 2
 // and 4): local joint rotations -> Theta -> MLP -> mesh weights + normal code -> nearest database map ->
-// temporal filter. What comes out is plain arrays for the GPU passes (no Vulkan here): mesh weights for
-// the deform pass, and per character the map to blend in and its blend factor for the normal-map pass.
+// temporal filter; beside the MLP, the novelty guard (novelty_guard.hpp) measures each character's
+// novelty and, when on, clamps and blends its mesh weights. What comes out is plain arrays for the GPU passes (no
+// Vulkan here): mesh weights for the deform pass, and per character the map to blend in and its blend factor for the
+// normal-map pass.
 //
 // Data problems never stop the frame and are never silent: each frame's output lists the joints whose
 // quaternions were renormalised or replaced (with the character), the characters whose normal code was
@@ -17,6 +19,7 @@
 #include "swish/model/model.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/nearest_code.hpp"
+#include "swish/runtime/novelty_guard.hpp"
 #include "swish/runtime/temporal_filter.hpp"
 #include "swish/runtime/theta.hpp"
 
@@ -25,7 +28,7 @@ namespace swish::runtime {
 inline constexpr uint32_t kNoMap = 0xFFFFFFFFu;  // mapIndex of a model without a normal-map database
 
 struct FrameTimings {  // seconds of wall clock spent in each stage of the last evaluate()
-  double theta = 0, mlp = 0, lookup = 0, filter = 0, total = 0;
+  double theta = 0, mlp = 0, novelty = 0, lookup = 0, filter = 0, total = 0;
 };
 
 struct CharacterJointIssue {
@@ -41,6 +44,10 @@ struct FrameOutput {
   std::vector<uint32_t> mapIndex;  // per character: the map to blend in (kNoMap without a database)
   std::vector<float> blendAlpha;   // per character: its blend factor (1 on a first frame; 0 without a database)
   std::vector<BlendStep> blend;    // per character: the full filter step (empty without a database)
+  // Per character: the novelty guard's measure (NaN for a model without a guard) and the blend towards
+  // the mean shape it applied (0 with the guard off); the characters above the model's flag threshold.
+  std::vector<float> novelty, guardBlend;
+  std::vector<uint32_t> novel;
   // This frame's data problems.
   std::vector<CharacterJointIssue> jointIssues;
   std::vector<uint32_t> nonFiniteCode;  // characters whose code was NaN/Inf (kept their previous map)
@@ -48,14 +55,25 @@ struct FrameOutput {
   FrameTimings timings;
 };
 
+struct FrameEvaluatorOptions {
+  CpuKernel kernel = CpuKernel::Auto;
+  bool normalMaps = true;  // false: no lookup or filter even when the model has maps (mapIndex kNoMap)
+  bool guard = true;       // apply the model's novelty guard to the mesh weights (measured either way)
+};
+
 class FrameEvaluator {
  public:
   // Validates the model (Model::validate) and builds the MLP, the search and one filter per character.
   FrameEvaluator(const Model& model, uint32_t characters, CpuKernel kernel = CpuKernel::Auto);
+  FrameEvaluator(const Model& model, uint32_t characters, const FrameEvaluatorOptions& options);
 
   uint32_t characters() const { return characters_; }
   uint32_t jointsPerCharacter() const { return joints_; }
   bool hasNormalMaps() const { return search_.has_value(); }
+  bool hasNoveltyGuard() const { return guard_.active(); }
+  // The guard's effect on the mesh weights from the next frame on (novelty is measured either way).
+  void setGuard(bool on) { guardOn_ = on; }
+  bool guardOn() const { return guardOn_ && guard_.active(); }
   const MlpEvaluator& mlp() const { return mlp_; }
 
   // rotations: characters() x jointsPerCharacter() local rotations (Pose::local of each character, one
@@ -77,6 +95,8 @@ class FrameEvaluator {
   std::vector<uint32_t> inputJoints_;
   uint32_t characters_ = 0, joints_ = 0;
   MlpEvaluator mlp_;
+  NoveltyGuardEvaluator guard_;
+  bool guardOn_ = true;
   std::optional<NearestCodeSearch> search_;
   std::vector<TemporalFilter> filters_;
   std::vector<float> theta_;  // characters x thetaSize

@@ -212,6 +212,12 @@ void expectBitwiseEqual(const Model& a, const Model& b) {
     EXPECT_TRUE(sameBits(ca.a, cb.a) && sameBits(ca.b, cb.b)) << "capsule " << c;
     EXPECT_EQ(std::memcmp(&ca.radius, &cb.radius, 4), 0) << "capsule " << c;
   }
+  const auto &na = a.noveltyGuard, &nb = b.noveltyGuard;
+  EXPECT_TRUE(sameBits(na.centres, nb.centres));
+  EXPECT_TRUE(sameBits(na.weightMin, nb.weightMin) && sameBits(na.weightMax, nb.weightMax));
+  const float fa[4] = {na.unit, na.blendStart, na.blendEnd, na.flagAbove};
+  const float fb[4] = {nb.unit, nb.blendStart, nb.blendEnd, nb.flagAbove};
+  EXPECT_EQ(std::memcmp(fa, fb, sizeof fa), 0);
   EXPECT_EQ(a.metadata, b.metadata);
 }
 
@@ -365,14 +371,14 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   auto u16 = [&](size_t at) { return uint32_t(bytes[at] | bytes[at + 1] << 8); };
   auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
   EXPECT_EQ(u16(8), 1u);
-  EXPECT_EQ(u16(10), 1u);
-  EXPECT_EQ(u32(12), 12u);
+  EXPECT_EQ(u16(10), 2u);
+  EXPECT_EQ(u32(12), 13u);
   EXPECT_EQ(uint64_t(u32(16)) | uint64_t(u32(20)) << 32, bytes.size());
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
-  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA",
-                                "MESH", "SKIN", "NMDB", "TFLT", "BPRX", "META"};
+  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH",
+                                "SKIN", "NMDB", "TFLT", "BPRX", "NOVG", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());
@@ -482,7 +488,7 @@ TEST(ModelFile, WrongMagicAndVersionsAreClearErrors) {
   const auto info = swish::readModelFileInfo(assemble(extended, 1, 7), "newer.swish");
   EXPECT_FALSE(info.sections[3].known);
   // The same unknown section in a file claiming the current version is corruption.
-  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.1 file");
+  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.2 file");
 }
 
 // Format 1.1 added the body proxy: a 1.0 file (no BPRX) still loads, with no proxy; a 1.1 file without
@@ -497,7 +503,8 @@ TEST(ModelFile, BodyProxySectionOfVersion11) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
 
   auto without = sections;
-  without.erase(std::find_if(without.begin(), without.end(), [](const RawSection& s) { return s.tag == "BPRX"; }));
+  for (const char* tag : {"BPRX", "NOVG"})  // a 1.0 file has neither
+    without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
   Model old = m;
   old.bodyProxy = {};
   expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 0), "old.swish"), old);
@@ -515,6 +522,42 @@ TEST(ModelFile, BodyProxySectionOfVersion11) {
   bad = sections;
   putU32(sectionOf(bad, "BPRX").payload, 0, 0x10000000u);
   EXPECT_CONTAINS(loadError(assemble(bad)), "body capsule");
+}
+
+// Format 1.2 added the novelty guard: older files load without one; a 1.2 file without it, or a 1.1
+// file with it, is refused; a guard that does not fit the model is refused naming the part.
+TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
+  swish::Rng rng(12);
+  RandomModelSpec spec;
+  spec.vertices = 9;
+  spec.noveltyCentres = 5;
+  const Model m = swish::test::makeRandomModel(rng, spec);
+  ASSERT_FALSE(m.noveltyGuard.empty());
+  auto sections = splitSections(swish::serializeModel(m));
+  expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
+
+  auto without = sections;
+  without.erase(std::find_if(without.begin(), without.end(), [](const RawSection& s) { return s.tag == "NOVG"; }));
+  Model old = m;
+  old.noveltyGuard = {};
+  expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 1), "old.swish"), old);
+  EXPECT_CONTAINS(loadError(assemble(without)), "section 'NOVG' is missing");
+  EXPECT_CONTAINS(loadError(assemble(sections, 1, 1)), "a section of format 1.2 in a version 1.1 file");
+
+  Model bad = m;
+  bad.noveltyGuard.centres.conservativeResize(Eigen::NoChange, m.thetaSize() - 1);
+  EXPECT_THROW(bad.validate(), swish::Error);
+  bad = m;
+  bad.noveltyGuard.weightMax[0] = bad.noveltyGuard.weightMin[0] - 1.f;
+  try {
+    bad.validate("m");
+    ADD_FAILURE() << "an empty weight range was accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "novelty guard: weight range 0 is empty or not finite");
+  }
+  auto hostile = sections;
+  putU32(sectionOf(hostile, "NOVG").payload, 0, 0x10000000u);
+  EXPECT_CONTAINS(loadError(assemble(hostile)), "novelty centre");
 }
 
 TEST(ModelFile, HostileCountsFailBeforeAllocating) {

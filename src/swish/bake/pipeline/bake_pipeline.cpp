@@ -170,6 +170,22 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   }
   Model model = out.model;
   nlohmann::json meta = nlohmann::json::parse(model.metadata);
+  // The novelty guard as measured best on the held-out subjects (no subjects: the clamp alone).
+  if (subjects && !subjects->guard.rows.empty()) {
+    const GuardSetting& chosen = subjects->guard.rows[subjects->guard.chosen].setting;
+    NoveltyGuard& g = model.noveltyGuard;
+    if (!chosen.clamp) g.weightMin = g.weightMax = VecXf();
+    g.blendStart = float(chosen.start);
+    g.blendEnd = float(chosen.end);
+    if (g.blends()) g.flagAbove = g.blendStart;
+    meta["novelty_guard"]["clamp"] = chosen.clamp;
+    meta["novelty_guard"]["blend"] = g.blends();
+    meta["novelty_guard"]["blend_start"] = g.blendStart;
+    meta["novelty_guard"]["blend_end"] = g.blendEnd;
+    meta["novelty_guard"]["chosen_on"] = "held-out subjects: " + chosen.name();
+    log("part 2: novelty guard: " + chosen.name() + " (the lowest mean error on the held-out subjects)");
+  }
+  meta["novelty_guard"]["flag_above"] = model.noveltyGuard.flagAbove;
   if (subjects) meta["errors"]["held_out_subjects"] = subjects->toJson();
   meta["bake_fingerprint"] = fingerprint(cfg);
   meta["name"] = cfg.name;

@@ -7,6 +7,7 @@
 #include "swish/bake/compression/bc5_baseline.hpp"
 #include "swish/bake/training/body_proxy_fit.hpp"
 #include "swish/bake/training/model_builder.hpp"
+#include "swish/bake/training/novelty_guard_fit.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/runtime/theta.hpp"
@@ -195,6 +196,15 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   parts.temporalFilter.timeConstantSeconds = st.temporalTimeConstant;
   parts.metadata = out.metadata;
   out.model = buildModel(parts);
+  // The run-time novelty guard: centres and unit from the training inputs, the clamp from the training
+  // shapes' weights; the blend is chosen on held-out subjects afterwards (bake_pipeline.cpp).
+  NoveltyGuardFitOptions guardOptions;
+  guardOptions.seed = st.seed + 7;
+  out.model.noveltyGuard = fitNoveltyGuard(out.model, theta, meshCodes, guardOptions);
+  out.metadata["novelty_guard"] = {{"centres", out.model.noveltyGuard.centres.rows()},
+                                   {"unit", out.model.noveltyGuard.unit},
+                                   {"clamp", true},
+                                   {"blend", false}};
   // The run-time push-out's body proxy, fitted to the character's body (none for a body-less character).
   if (ds.character.body.triangleCount() > 0) {
     report("body proxy", 0.92);

@@ -10,6 +10,7 @@
 #include "swish/core/error.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/nearest_code.hpp"
+#include "swish/runtime/novelty_guard.hpp"
 #include "swish/runtime/reference_pca.hpp"
 #include "swish/runtime/reference_push_out.hpp"
 #include "swish/runtime/reference_skinning.hpp"
@@ -60,8 +61,11 @@ DistanceStats distanceStats(std::vector<double> v) {
 
 Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut) {
   const runtime::MlpEvaluator mlp(model);
+  const runtime::NoveltyGuardEvaluator guard(model);
   std::vector<float> lambda(size_t(mlp.outputSize()));
-  mlp.evaluate(runtime::computeTheta(model.inputJoints, pose.local), lambda);
+  const std::vector<float> theta = runtime::computeTheta(model.inputJoints, pose.local);
+  mlp.evaluate(theta, lambda);
+  guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(model.meshComponents())));
   const auto mats = model.skeleton.skinningMatrices(pose);
   Points3f p =
       runtime::referenceSkin(runtime::referencePcaReconstruct(
@@ -90,6 +94,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
   const size_t n = model.gameMesh.vertexCount();
   const int K = model.meshComponents();
   const runtime::MlpEvaluator mlp(model);
+  const runtime::NoveltyGuardEvaluator guard(model);  // as the run time applies it (on by default)
   ev.hasNormalMaps = !model.normalMaps.empty();
   std::unique_ptr<runtime::NearestCodeSearch> search;
   std::vector<NormalMapImage> decoded;
@@ -117,6 +122,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
       throw Error("bake evaluation: pose " + std::to_string(p->id) + " has a game mesh of another size");
     const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
     mlp.evaluate(theta, lambda);
+    guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(K)));
     const auto mats = model.skeleton.skinningMatrices(p->pose);
     const Points3f predicted = runtime::referenceSkin(
         runtime::referencePcaReconstruct(model.meshPca, std::span<const float>(lambda.data(), size_t(K))),

@@ -9,6 +9,7 @@
 
 #include "swish/core/error.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
+#include "swish/runtime/novelty_guard.hpp"
 #include "swish/runtime/reference_pca.hpp"
 #include "swish/runtime/reference_skinning.hpp"
 #include "swish/runtime/theta.hpp"
@@ -75,8 +76,8 @@ nlohmann::json GuardStudy::toJson() const {
 std::string GuardStudy::markdown() const {
   std::ostringstream md;
   md << "### The novelty guard, measured offline\n\n"
-     << "Novelty: the distance of a pose's normalised network input to the nearest training pose, in units of the "
-        "training poses' own nearest-neighbour distance (p95, "
+     << "Novelty, as the run time measures it: the distance of a pose's normalised network input to the nearest of "
+        "the model's k-means centres of the training inputs, in units of the training poses' own such distance (p95, "
      << f2(unit) << " RMS per input). Held-out subjects: mean " << f2(noveltySubjects.mean) << ", p95 "
      << f2(noveltySubjects.p95) << ", max " << f2(noveltySubjects.max) << "; random held-out frames: mean "
      << f2(noveltyRandom.mean) << ", p95 " << f2(noveltyRandom.p95) << ", max " << f2(noveltyRandom.max)
@@ -89,8 +90,9 @@ std::string GuardStudy::markdown() const {
        << " | " << f2(r.subjects.p95) << " | " << f2(r.subjects.max) << " | " << f2(r.random.mean) << " | "
        << f2(r.random.p95) << " | " << f2(r.random.max) << " |\n";
   }
-  md << "\nThe thresholds are chosen on the same held-out subjects they are reported on (an optimistic figure "
-        "for the chosen row); the run time does not apply the guard yet.\n\n";
+  md << "\nThe model carries the chosen row and the run time applies it (runtime/novelty_guard.hpp; `swish replay "
+        "--no-guard` compares). The thresholds are chosen on the same held-out subjects they are reported on: an "
+        "optimistic figure for the chosen row.\n\n";
   return md.str();
 }
 
@@ -98,37 +100,13 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
                              const std::vector<const DatasetPose*>& subjects,
                              const std::vector<const DatasetPose*>& random) {
   GuardStudy g;
-  if (trainingPoses.size() < 2) return g;
+  if (trainingPoses.size() < 2 || model.noveltyGuard.empty()) return g;
   const runtime::MlpEvaluator mlp(model);
+  const runtime::NoveltyGuardEvaluator measure(model);  // the run time's own novelty
+  const NoveltyGuard& guard = model.noveltyGuard;
   const int K = model.meshComponents();
-  const int D = mlp.inputSize();
   const size_t n = model.gameMesh.vertexCount();
-  auto input = [&](const DatasetPose* p) {
-    const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
-    VecXf x(D);
-    for (int i = 0; i < D; ++i) x[i] = (theta[size_t(i)] - model.inputNorm.mean[i]) / model.inputNorm.scale[i];
-    return x;
-  };
-  MatXf train(D, Eigen::Index(trainingPoses.size()));
-  VecXf lo = VecXf::Constant(K, std::numeric_limits<float>::max()),
-        hi = VecXf::Constant(K, -std::numeric_limits<float>::max());
-  for (size_t i = 0; i < trainingPoses.size(); ++i) {
-    train.col(Eigen::Index(i)) = input(trainingPoses[i]);
-    const VecXf pre = Eigen::Map<const VecXf>(trainingPoses[i]->gameMeshPreSkin.data(), Eigen::Index(3 * n));
-    const VecXf w = model.meshPca.basis.transpose() * (pre - model.meshPca.mean);
-    lo = lo.cwiseMin(w);
-    hi = hi.cwiseMax(w);
-  }
-  const double rms = std::sqrt(double(D));
-  auto nearest = [&](const VecXf& x, Eigen::Index skip) {
-    double best = std::numeric_limits<double>::max();
-    for (Eigen::Index j = 0; j < train.cols(); ++j)
-      if (j != skip) best = std::min(best, double((train.col(j) - x).squaredNorm()));
-    return std::sqrt(best) / rms;
-  };
-  std::vector<double> own;
-  for (Eigen::Index j = 0; j < train.cols(); ++j) own.push_back(nearest(train.col(j), j));
-  g.unit = std::max(1e-9, distanceStats(own).p95);
+  g.unit = guard.unit;
 
   struct Prepared {
     const DatasetPose* pose;
@@ -139,9 +117,10 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
   auto prepare = [&](const std::vector<const DatasetPose*>& set) {
     std::vector<Prepared> out;
     for (const DatasetPose* p : set) {
-      Prepared q{p, nearest(input(p), -1) / g.unit, std::vector<float>(size_t(mlp.outputSize())),
+      const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
+      Prepared q{p, double(measure.measureOne(theta)), std::vector<float>(size_t(mlp.outputSize())),
                  model.skeleton.skinningMatrices(p->pose)};
-      mlp.evaluate(runtime::computeTheta(model.inputJoints, p->pose.local), q.lambda);
+      mlp.evaluate(theta, q.lambda);
       out.push_back(std::move(q));
     }
     return out;
@@ -163,7 +142,7 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
     for (const Prepared& p : set) {
       for (int k = 0; k < K; ++k) {
         float v = p.lambda[size_t(k)];
-        if (s.clamp) v = std::clamp(v, lo[k], hi[k]);
+        if (s.clamp) v = std::clamp(v, guard.weightMin[k], guard.weightMax[k]);
         w[size_t(k)] = v;
       }
       if (s.clamp && s.end > s.start) {

@@ -14,20 +14,20 @@
 
 namespace swish::bake {
 
-// A study of the run-time novelty guard, on the bake's own poses: how far each pose's network input
-// (Theta, normalised as the network normalises it) lies from the nearest training pose, and what a guard
-// would do to the error. Novelty is that distance (RMS over the inputs) divided by the 95th percentile
-// of the training poses' distances to their nearest other training pose: 1 is as far out as the sparse
-// end of the training set. The guard: clamp the mesh weights to the range the training shapes span
-// (their PCA projections), then blend them towards 0 (the PCA mean shape, the better of the two
-// baselines) as novelty goes from `start` to `end`.
+// A study of the run-time novelty guard (runtime/novelty_guard.hpp) on the bake's own poses: each
+// pose's novelty as the run time measures it with the model's guard (distance of the normalised network
+// input to the nearest k-means centre of the training inputs, over the guard's unit), and the error under
+// each setting: no guard, the clamp of the mesh weights to the training shapes' range, and the clamp
+// with a blend towards 0 (the PCA mean shape, the better of the two baselines) as novelty goes from
+// `start` to `end`. The chosen row (lowest mean on the held-out subjects) goes into the model
+// (bake_pipeline.cpp). The model must carry a fitted guard (trainBake fits one); else the study is empty.
 struct GuardSetting {
   bool clamp = false;
   double start = 0.0, end = 0.0;  // end > start: blend; else none
   std::string name() const;
 };
 struct GuardStudy {
-  double unit = 0.0;                             // the training poses' nearest-neighbour distance, p95 (RMS per input)
+  double unit = 0.0;                             // the guard's unit (RMS per input)
   DistanceStats noveltySubjects, noveltyRandom;  // of the novelty values (no unit)
   double errorNoveltyCorrelation = 0.0;          // held-out subjects: per-pose mean error vs novelty (Pearson)
   struct Row {
