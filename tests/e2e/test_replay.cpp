@@ -44,7 +44,8 @@ class ReplayE2E : public test::GpuTest {
     spec.vertices = 120;
     spec.normalMaps = 4;
     spec.mapSize = 16;
-    spec.bodyCapsules = 6;  // the push-out runs, and the GPU-vs-CPU checks cover it
+    spec.bodyCapsules = 6;    // the push-out runs, and the GPU-vs-CPU checks cover it
+    spec.noveltyCentres = 5;  // the novelty guard runs, and the checks cover its weights too
     model_ = test::makeRandomModel(rng, spec);
     // What the bake records of its evaluation on held-out poses (part2_training.cpp).
     model_.metadata =
@@ -136,6 +137,63 @@ TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
                         "plots/error_per_frame.svg", "plots/error_vs_time.svg"})
     EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".partial-"), std::string::npos);
+  EXPECT_EQ(ctx().validationMessageCount(), 0u);
+}
+
+// Novelty per character per frame in report.json (the flag agreeing with the model's threshold), a plot,
+// a section in report.md; --no-guard measures the same novelty and changes the weights where the guard
+// clamped them.
+TEST_F(ReplayE2E, ReportsNoveltyPerCharacterAndFlagsFrames) {
+  const runtime::Scene s = scene(sceneJson({"walk.json", "walk.json"}));
+  auto o = jobOptions();
+  std::vector<float> withGuard, withoutGuard;
+  o.engine.onCharacterOutput = [&](uint32_t, uint32_t, const runtime::ReferenceFrameOutputs& out, uint32_t i) {
+    for (Eigen::Index v = 0; v < out.positions[i].rows(); ++v) withGuard.push_back(out.positions[i](v, 0));
+  };
+  const auto r = replay::runReplayJob(s, o);
+  EXPECT_FALSE(r.result.failed()) << (r.result.failures.empty() ? "" : r.result.failures[0]);
+  const json rep = json::parse(std::ifstream(dir_ / "out/report.json"));
+  const json& nv = rep["novelty"];
+  EXPECT_TRUE(nv["measured"].get<bool>());
+  EXPECT_TRUE(nv["guard"].get<bool>());
+  EXPECT_EQ(nv["characterFrames"], 10);
+  size_t flagged = 0;
+  std::vector<float> novelty;
+  for (const auto& f : rep["frames"]) {
+    ASSERT_EQ(f["novelty"].size(), 2u) << f["frame"];
+    for (const auto& c : f["novelty"]) {
+      const float v = c["novelty"].get<float>();
+      novelty.push_back(v);
+      EXPECT_GT(v, 0.f);
+      EXPECT_EQ(c["flagged"].get<bool>(), v > model_.noveltyGuard.flagAbove);
+      flagged += c["flagged"].get<bool>();
+    }
+  }
+  EXPECT_EQ(nv["flaggedCharacterFrames"].get<size_t>(), flagged);
+  EXPECT_EQ(rep["characters"][0]["novelty"]["framesFlagged"].get<size_t>() +
+                rep["characters"][1]["novelty"]["framesFlagged"].get<size_t>(),
+            flagged);
+  EXPECT_TRUE(fs::exists(dir_ / "out/plots/novelty_per_frame.svg"));
+  const std::string md = [&] {
+    std::ifstream in(dir_ / "out/report.md");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }();
+  EXPECT_NE(md.find("## Novelty"), std::string::npos);
+
+  o.engine.noveltyGuard = false;
+  o.engine.onCharacterOutput = [&](uint32_t, uint32_t, const runtime::ReferenceFrameOutputs& out, uint32_t i) {
+    for (Eigen::Index v = 0; v < out.positions[i].rows(); ++v) withoutGuard.push_back(out.positions[i](v, 0));
+  };
+  const auto off = replay::runReplayJob(s, o);
+  EXPECT_FALSE(off.result.failed());
+  const json repOff = json::parse(std::ifstream(dir_ / "out/report.json"));
+  EXPECT_FALSE(repOff["novelty"]["guard"].get<bool>());
+  size_t k = 0;
+  for (const auto& f : repOff["frames"])
+    for (const auto& c : f["novelty"]) EXPECT_EQ(c["novelty"].get<float>(), novelty[k++]);
+  // The random network's weights leave the random ranges (clamped): the meshes differ somewhere.
+  ASSERT_EQ(withGuard.size(), withoutGuard.size());
+  EXPECT_NE(withGuard, withoutGuard);
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }
 

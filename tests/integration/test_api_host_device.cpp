@@ -111,6 +111,7 @@ Model randomModel(uint64_t seed, uint32_t vertices) {
   spec.meshComponents = 7;
   spec.normalMaps = 5;
   spec.mapSize = 16;
+  spec.noveltyCentres = 4;  // the guard runs: the reference below runs it too (FrameEvaluator)
   return test::makeRandomModel(rng, spec);
 }
 
@@ -121,6 +122,8 @@ TEST(ApiHostDevice, RecordsIntoHostCommandBuffersAcrossFramesInFlight) {
   api::Runtime rt = api::Runtime::adopt(device->handles());
   EXPECT_FALSE(rt.ownsDevice());
   api::Model m = rt.loadModelFromMemory(serializeModel(model), "random");
+  EXPECT_TRUE(m.info().hasNoveltyGuard);
+  EXPECT_EQ(m.info().noveltyFlagAbove, model.noveltyGuard.flagAbove);
   const uint32_t characters = 3, inFlight = 3, frames = 8;
   api::CharacterBatch batch = m.createBatch({characters, inFlight, true});
   HostFrames host(device->device(), device->queueFamily(), inFlight);
@@ -157,6 +160,10 @@ TEST(ApiHostDevice, RecordsIntoHostCommandBuffersAcrossFramesInFlight) {
     std::vector<Quatf> rots;
     for (const Pose& p : poses.internal) rots.insert(rots.end(), p.local.begin(), p.local.end());
     const auto& o = cpu.evaluate(rots, 1.f / 60.f);
+    // Novelty per instance, as the CPU frame path measures it.
+    EXPECT_EQ(report.novelty, o.novelty);
+    EXPECT_EQ(report.guardBlend, o.guardBlend);
+    EXPECT_EQ(report.novelCharacters, o.novel);
     runtime::FrameKernelInputs in;
     in.instanceCount = characters;
     in.meshWeights = o.meshWeights;

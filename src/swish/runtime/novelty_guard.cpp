@@ -66,7 +66,8 @@ void NoveltyGuardEvaluator::apply(float novelty, std::span<float> w) const {
       throw Error("novelty guard: " + std::to_string(w.size()) + " mesh weights for ranges of " +
                   std::to_string(guard_.weightMin.size()));
     for (size_t k = 0; k < w.size(); ++k)
-      w[k] = std::isnan(w[k]) ? 0.f : std::clamp(w[k], guard_.weightMin[Eigen::Index(k)], guard_.weightMax[Eigen::Index(k)]);
+      w[k] = std::isnan(w[k]) ? 0.f
+                              : std::clamp(w[k], guard_.weightMin[Eigen::Index(k)], guard_.weightMax[Eigen::Index(k)]);
   }
   const float keep = 1.f - blendOf(novelty);
   if (keep < 1.f)

@@ -82,7 +82,7 @@ TEST(NoveltyGuard, ClampsThenBlendsTowardsTheMeanShape) {
   const size_t K = size_t(m.meshComponents());
   std::vector<float> raw(K);
   for (size_t k = 0; k < K; ++k) raw[k] = k % 2 ? 5.f : -5.f;  // outside every range
-  raw[0] = 0.5f * (ng.weightMin[0] + ng.weightMax[0]);        // inside its range
+  raw[0] = 0.5f * (ng.weightMin[0] + ng.weightMax[0]);         // inside its range
   auto guarded = [&](float novelty) {
     std::vector<float> w = raw;
     g.apply(novelty, w);
