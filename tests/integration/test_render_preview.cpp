@@ -247,5 +247,31 @@ TEST_F(PreviewRender, BadBodyIsRejectedWithAReason) {
   }
 }
 
+// The model's covered-triangle list leaves those triangles out of the body the preview draws, keeps the
+// others in order, and is refused for another body (a different triangle count).
+TEST(PreviewBody, HidesTheModelsCoveredTriangles) {
+  render::BodyMesh body;
+  body.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  body.triangles = {0, 1, 2, 1, 3, 2, 0, 2, 3, 0, 1, 3};
+  api::ModelInfo info;
+  EXPECT_EQ(body.hideCovered(info), 0u);  // no list: nothing hidden
+  EXPECT_EQ(body.triangles.size(), 12u);
+  info.coveredBodyOf = 4;
+  info.coveredBodyTriangles = {1, 3};
+  render::BodyMesh other = body;
+  EXPECT_EQ(body.hideCovered(info), 2u);
+  EXPECT_EQ(body.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+  info.coveredBodyOf = 5;
+  try {
+    other.hideCovered(info);
+    FAIL() << "a list for another body was accepted";
+  } catch (const api::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("for a body of 5 triangles, this one has 4"), std::string::npos) << e.what();
+  }
+  info.coveredBodyOf = 4;
+  info.coveredBodyTriangles = {0, 1, 2, 3};
+  EXPECT_THROW(other.hideCovered(info), api::Error);  // nothing left to draw
+}
+
 }  // namespace
 }  // namespace swish

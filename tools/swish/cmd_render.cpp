@@ -30,7 +30,7 @@ struct RenderOptions {
   std::string out = "render.png";
   std::string device;
   uint32_t width = 480, height = 640;
-  bool validation = false;
+  bool validation = false, hideCoveredBody = false;
 };
 
 api::Quat multiply(const api::Quat& a, const api::Quat& b) {
@@ -90,6 +90,14 @@ int run(const RenderOptions& o) {
   std::string why, bodyLabel;
   popts.body = loadBody(o, info, bodyLabel, why);
   if (!popts.body) std::printf("swish render: drawing the jersey only: %s\n", why.c_str());
+  std::string hidden = "body drawn whole";
+  if (popts.body && o.hideCoveredBody) {
+    if (info.coveredBodyTriangles.empty())
+      hidden = "body drawn whole: the model lists no covered triangles (baked before format 1.2, or without a body)";
+    else
+      hidden = "left out " + std::to_string(popts.body->hideCovered(info)) +
+               " body triangles the garment covers in every training pose";
+  }
   if (!info.hasNormalMaps) std::printf("swish render: the model has no normal maps; both halves will look the same\n");
 
   std::vector<api::Quat> rotations = info.restRotations;
@@ -101,9 +109,9 @@ int run(const RenderOptions& o) {
   const render::PreviewImage img = preview.render(pose, {{true, true}, {false, true}});
   for (const auto& w : preview.lastReport().warnings) std::printf("swish render: warning: %s\n", w.c_str());
   render::writePreviewPng(o.out, img, popts.background);
-  std::printf("%s: %ux%u, left: with swish's normal map, right: without (%s, %s), on %s\n", o.out.c_str(), img.width,
-              img.height, info.name.c_str(), popts.body ? ("on " + bodyLabel).c_str() : "garment only",
-              device.deviceName().c_str());
+  std::printf("%s: %ux%u, left: with swish's normal map, right: without (%s, %s; %s), on %s\n", o.out.c_str(),
+              img.width, img.height, info.name.c_str(), popts.body ? ("on " + bodyLabel).c_str() : "garment only",
+              hidden.c_str(), device.deviceName().c_str());
   if (o.validation)
     for (const auto& m : device.validationMessages()) std::fprintf(stderr, "validation: %s\n", m.c_str());
   return o.validation && !device.validationMessages().empty() ? 1 : 0;
@@ -120,6 +128,9 @@ static CommandRegistration registration{
       app.add_option("--character", o->character,
                      "body to draw: 'auto' (the body the model was baked on, from its metadata; an error when that "
                      "file is not at hand), 'default' (the embedded mannequin), a glTF/FBX file, or 'none'");
+      app.add_flag("--hide-covered-body", o->hideCoveredBody,
+                   "leave out the body triangles the garment covers in every training pose (the model's list; as "
+                   "games do under tight clothing). Off by default: the whole body shows where the garment fails");
       app.add_option("--out,-o", o->out, "output PNG");
       app.add_option("--width", o->width, "width of each half, pixels")->check(CLI::Range(16, 4096));
       app.add_option("--height", o->height, "height, pixels")->check(CLI::Range(16, 4096));

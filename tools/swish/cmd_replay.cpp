@@ -36,7 +36,7 @@ struct ReplayCliOptions {
   std::string scene, out, device;
   bool plan = false, quiet = false, validation = false, render = false;
   uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16, penetrationEvery = 30;
-  bool pushOut = false, noGuard = false;
+  bool pushOut = false, noGuard = false, hideCoveredBody = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
 };
@@ -133,6 +133,7 @@ int runReplay(const ReplayCliOptions& o) {
     ro.validation = o.validation;
     ro.truth = jo.engine.truth;
     ro.pushOut = o.pushOut;
+    ro.hideCoveredBody = o.hideCoveredBody;
     const replay::ReplayRenderResult rr = replay::renderReplayFrames(scene, models, dir, ro);
     if (!o.quiet) {
       std::printf("Rendered %zu frames of character %u: %s\n", rr.frames.size(), o.renderCharacter,
@@ -175,6 +176,9 @@ swish::cli::CommandRegistration reg{
       app.add_flag("--push-out", o->pushOut,
                    "push the garment out of the model's body proxy on the GPU (models that carry one; off by default: "
                    "measured to raise the error against the source simulation)");
+      app.add_flag("--hide-covered-body", o->hideCoveredBody,
+                   "with --render: leave out the body triangles the garment covers in every training pose (the "
+                   "model's list, as games do under tight clothing); off by default so that a fault shows");
       app.add_flag("--no-guard", o->noGuard,
                    "measure each character's novelty (how far its pose is from the model's training poses) but do "
                    "not apply the model's novelty guard (clamp of the mesh weights, blend towards the mean shape): "

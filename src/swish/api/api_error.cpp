@@ -67,6 +67,8 @@ ModelInfo describeModel(const swish::Model& m, const std::string& name) {
   info.normalMapDatabaseSize = m.normalMaps.mapCount();
   info.temporalFilterSeconds = m.temporalFilter.timeConstantSeconds;
   info.bodyCapsules = uint32_t(m.bodyProxy.capsules.size());
+  info.coveredBodyOf = m.bodyCoverage.bodyTriangles;
+  info.coveredBodyTriangles = m.bodyCoverage.covered;
   info.hasNoveltyGuard = !m.noveltyGuard.empty();
   if (info.hasNoveltyGuard) {
     info.noveltyFlagAbove = m.noveltyGuard.flagAbove;

@@ -114,6 +114,12 @@ void Model::validate(const std::string& what) const {
         g.blendStart < 0.f || g.flagAbove < 0.f)
       fail("novelty guard", "blend and flag thresholds must be finite and >= 0");
   }
+  for (size_t i = 0; i < bodyCoverage.covered.size(); ++i)
+    if (bodyCoverage.covered[i] >= bodyCoverage.bodyTriangles ||
+        (i > 0 && bodyCoverage.covered[i] <= bodyCoverage.covered[i - 1]))
+      fail("body coverage", "triangle " + n2s(bodyCoverage.covered[i]) + " (entry " + n2s(i) +
+                                ") is not ascending below the body's " + n2s(bodyCoverage.bodyTriangles) +
+                                " triangles");
   if (!(temporalFilter.timeConstantSeconds >= 0.f) || !std::isfinite(temporalFilter.timeConstantSeconds))
     fail("temporal filter", "time constant must be finite and >= 0");
 }

@@ -102,6 +102,15 @@ struct NoveltyGuard {
   bool blends() const { return blendEnd > blendStart; }
 };
 
+// The body triangles the garment covers in every training pose (format 1.2; bake/transfer/body_coverage.hpp):
+// what a renderer may leave out, as games leave out the skin under tight clothing. Indices refer to the
+// triangles of the body the model was baked on, which has bodyTriangles of them (a host checks that its
+// body is that one). Empty: not computed (no body, or a model before 1.2).
+struct BodyCoverage {
+  uint32_t bodyTriangles = 0;
+  std::vector<uint32_t> covered;  // ascending, < bodyTriangles
+};
+
 struct Model {
   Skeleton skeleton;                  // the character's skeleton (for FK and skinning)
   std::vector<uint32_t> inputJoints;  // skeleton joint indices forming Theta, in this order
@@ -114,6 +123,7 @@ struct Model {
   TemporalFilterParams temporalFilter;
   BodyProxy bodyProxy;          // may be empty (models of format 1.0, or baked without a body)
   NoveltyGuard noveltyGuard;    // may be empty (models before format 1.2)
+  BodyCoverage bodyCoverage;    // may be empty (models before format 1.2, or baked without a body)
   std::string metadata = "{}";  // free-form JSON: bake settings, errors measured at bake time
 
   int thetaSize() const { return int(inputJoints.size()) * 6; }

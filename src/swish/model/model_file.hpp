@@ -22,7 +22,7 @@
 //   16  u8[payload size] payload; every payload must be read to its last byte (trailing bytes = error)
 //
 // Sections of version 1.0: each exactly once, all required, any order (the writer uses this one and
-// puts BPRX and NOVG before META).
+// puts BPRX, NOVG and BCOV before META).
 //   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
 //          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
 //          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
@@ -55,6 +55,8 @@
 //          centres (centre after centre), f32 unit, u32 K weight ranges (0 or the mesh components),
 //          f32[K] minimum, f32[K] maximum, f32 blend start, f32 blend end, f32 flag threshold. See
 //          NoveltyGuard.
+//   "BCOV" body coverage: u32 body triangle count B, u32 n, u32[n] covered triangle indices
+//          (ascending, < B). See BodyCoverage.
 // After parsing, Model::validate checks every index and size the run time relies on.
 // =====================================================================================================
 #include <array>

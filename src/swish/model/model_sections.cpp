@@ -310,6 +310,19 @@ void readNoveltyGuard(ByteReader& r, Model& m) {
   g.flagAbove = r.f32("novelty flag threshold");
 }
 
+// ---- BCOV (format 1.2) ------------------------------------------------------------------------
+void writeBodyCoverage(const Model& m, ByteWriter& w) {
+  w.u32(m.bodyCoverage.bodyTriangles);
+  w.u32(count32(m.bodyCoverage.covered.size(), "covered body triangle"));
+  for (uint32_t t : m.bodyCoverage.covered) w.u32(t);
+}
+
+void readBodyCoverage(ByteReader& r, Model& m) {
+  m.bodyCoverage.bodyTriangles = r.u32("body triangle count");
+  m.bodyCoverage.covered.resize(r.checkCount(r.u32("covered body triangle count"), 4, "covered body triangle"));
+  for (uint32_t& t : m.bodyCoverage.covered) t = r.u32("covered body triangle");
+}
+
 // ---- TFLT, META -------------------------------------------------------------------------------
 void writeTemporalFilter(const Model& m, ByteWriter& w) { w.f32(m.temporalFilter.timeConstantSeconds); }
 void readTemporalFilter(ByteReader& r, Model& m) { m.temporalFilter.timeConstantSeconds = r.f32("time constant"); }
@@ -336,6 +349,7 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {"TFLT", writeTemporalFilter, readTemporalFilter},
       {"BPRX", writeBodyProxy, readBodyProxy, 1},
       {"NOVG", writeNoveltyGuard, readNoveltyGuard, 2},
+      {"BCOV", writeBodyCoverage, readBodyCoverage, 2},
       {"META", writeMetadata, readMetadata},
   };
   return codecs;

@@ -140,6 +140,27 @@ void BodyMesh::validate(size_t jointCount) const {
     if (!std::isfinite(v)) bad("non-finite position");
 }
 
+size_t BodyMesh::hideCovered(const api::ModelInfo& model) {
+  const size_t count = triangles.size() / 3;
+  if (model.coveredBodyTriangles.empty()) return 0;
+  if (model.coveredBodyOf != count)
+    throw api::Error(api::ErrorCode::InvalidArgument, "body mesh: the model's covered-triangle list is for a body of " +
+                                                          std::to_string(model.coveredBodyOf) +
+                                                          " triangles, this one has " + std::to_string(count) +
+                                                          " (not the body the model was baked on)");
+  std::vector<uint8_t> hide(count, 0);
+  for (uint32_t t : model.coveredBodyTriangles) hide[t] = 1;
+  std::vector<uint32_t> kept;
+  kept.reserve(triangles.size());
+  for (size_t t = 0; t < count; ++t)
+    if (!hide[t]) kept.insert(kept.end(), triangles.begin() + long(3 * t), triangles.begin() + long(3 * t + 3));
+  if (kept.empty())
+    throw api::Error(api::ErrorCode::InvalidArgument, "body mesh: the garment covers every triangle; nothing to draw");
+  const size_t hidden = count - kept.size() / 3;
+  triangles = std::move(kept);
+  return hidden;
+}
+
 PreviewRenderer::PreviewRenderer(HostDevice& device, api::Runtime runtime, api::Model model, PreviewOptions options) {
   if (options.width == 0 || options.height == 0 || options.width > 8192 || options.height > 8192)
     throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: image size must be 1..8192 a side");

@@ -31,6 +31,10 @@ struct BodyMesh {
   std::vector<float> weights;       // vertexCount * influences
   // Throws api::Error(InvalidArgument) naming the problem (sizes, indices, joints >= jointCount).
   void validate(size_t jointCount) const;
+  // Leaves out the triangles the model says its garment covers (api::ModelInfo::coveredBodyTriangles),
+  // as games do for skin under tight clothing. Returns how many were left out; throws
+  // api::Error(InvalidArgument) when this body is not the one the list refers to (another triangle count).
+  size_t hideCovered(const api::ModelInfo& model);
 };
 
 struct PreviewOptions {

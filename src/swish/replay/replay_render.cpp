@@ -54,6 +54,16 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   std::string why;
   popts.body = render::bodyFromCharacter(bake::makeDefaultCharacter(), model.info(), why);
   if (!popts.body) result.note = "no mannequin drawn: " + why;
+  if (popts.body && o.hideCoveredBody) {
+    try {
+      const size_t hidden = model.info().coveredBodyTriangles.empty() ? 0 : popts.body->hideCovered(model.info());
+      result.note = hidden ? "left out " + std::to_string(hidden) +
+                                 " body triangles the garment covers in every training pose (--hide-covered-body)"
+                           : "body drawn whole: the model lists no covered triangles (baked before format 1.2)";
+    } catch (const api::Error& e) {
+      result.note = std::string("body drawn whole: ") + e.what();
+    }
+  }
   {
     // Frame the garment and the body around it from the hem up (arms, neck), not the legs and feet.
     render::Vec3 lo, hi;

@@ -218,6 +218,8 @@ void expectBitwiseEqual(const Model& a, const Model& b) {
   const float fa[4] = {na.unit, na.blendStart, na.blendEnd, na.flagAbove};
   const float fb[4] = {nb.unit, nb.blendStart, nb.blendEnd, nb.flagAbove};
   EXPECT_EQ(std::memcmp(fa, fb, sizeof fa), 0);
+  EXPECT_EQ(a.bodyCoverage.bodyTriangles, b.bodyCoverage.bodyTriangles);
+  EXPECT_EQ(a.bodyCoverage.covered, b.bodyCoverage.covered);
   EXPECT_EQ(a.metadata, b.metadata);
 }
 
@@ -372,13 +374,13 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
   EXPECT_EQ(u16(8), 1u);
   EXPECT_EQ(u16(10), 2u);
-  EXPECT_EQ(u32(12), 13u);
+  EXPECT_EQ(u32(12), 14u);
   EXPECT_EQ(uint64_t(u32(16)) | uint64_t(u32(20)) << 32, bytes.size());
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
   const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH",
-                                "SKIN", "NMDB", "TFLT", "BPRX", "NOVG", "META"};
+                                "SKIN", "NMDB", "TFLT", "BPRX", "NOVG", "BCOV", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());
@@ -503,7 +505,7 @@ TEST(ModelFile, BodyProxySectionOfVersion11) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
 
   auto without = sections;
-  for (const char* tag : {"BPRX", "NOVG"})  // a 1.0 file has neither
+  for (const char* tag : {"BPRX", "NOVG", "BCOV"})  // a 1.0 file has none of them
     without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
   Model old = m;
   old.bodyProxy = {};
@@ -537,9 +539,11 @@ TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
 
   auto without = sections;
-  without.erase(std::find_if(without.begin(), without.end(), [](const RawSection& s) { return s.tag == "NOVG"; }));
+  for (const char* tag : {"NOVG", "BCOV"})
+    without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
   Model old = m;
   old.noveltyGuard = {};
+  old.bodyCoverage = {};
   expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 1), "old.swish"), old);
   EXPECT_CONTAINS(loadError(assemble(without)), "section 'NOVG' is missing");
   EXPECT_CONTAINS(loadError(assemble(sections, 1, 1)), "a section of format 1.2 in a version 1.1 file");
@@ -558,6 +562,21 @@ TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
   auto hostile = sections;
   putU32(sectionOf(hostile, "NOVG").payload, 0, 0x10000000u);
   EXPECT_CONTAINS(loadError(assemble(hostile)), "novelty centre");
+
+  // Body coverage, also new in 1.2: round trip, then a list that is not ascending below the count.
+  Model covered = m;
+  covered.bodyCoverage = {10, {1, 4, 9}};
+  const auto coveredSections = splitSections(swish::serializeModel(covered));
+  expectBitwiseEqual(swish::deserializeModel(assemble(coveredSections), "covered.swish"), covered);
+  covered.bodyCoverage.covered = {1, 10};
+  EXPECT_THROW(covered.validate(), swish::Error);
+  covered.bodyCoverage.covered = {4, 1};
+  try {
+    covered.validate("m");
+    ADD_FAILURE() << "a descending list was accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "body coverage: triangle 1 (entry 1) is not ascending");
+  }
 }
 
 TEST(ModelFile, HostileCountsFailBeforeAllocating) {

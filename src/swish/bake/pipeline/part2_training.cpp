@@ -8,6 +8,7 @@
 #include "swish/bake/training/body_proxy_fit.hpp"
 #include "swish/bake/training/model_builder.hpp"
 #include "swish/bake/training/novelty_guard_fit.hpp"
+#include "swish/bake/transfer/body_coverage.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/runtime/theta.hpp"
@@ -215,6 +216,20 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
                                   {"dropped", fit.dropped},
                                   {"worst_outside_mm", fit.worstOutsideMm}};
     stage("body proxy");
+  }
+
+  // The body triangles the garment covers in every training pose: what a renderer may leave out.
+  if (ds.character.body.triangleCount() > 0) {
+    report("body coverage", 0.93);
+    std::vector<const DatasetPose*> trained;
+    for (uint32_t i : out.trainingPoses) trained.push_back(&ds.poses[i]);
+    const BodyCoverageResult cov = coveredBodyTriangles(ds.character, trained);
+    out.model.bodyCoverage = {cov.bodyTriangles, cov.covered};
+    out.metadata["body_coverage"] = {{"body_triangles", cov.bodyTriangles},
+                                     {"covered_in_every_training_pose", cov.covered.size()},
+                                     {"covered_in_the_first_pose", cov.coveredAtRest},
+                                     {"poses_tested", cov.poses}};
+    stage("body coverage");
   }
 
   std::vector<const DatasetPose*> held;

@@ -1,0 +1,55 @@
+#include "swish/bake/transfer/body_coverage.hpp"
+
+#include <algorithm>
+
+#include <tbb/parallel_for.h>
+
+#include "swish/bake/transfer/triangle_ray_scene.hpp"
+#include "swish/core/error.hpp"
+#include "swish/runtime/reference_skinning.hpp"
+
+namespace swish::bake {
+
+BodyCoverageResult coveredBodyTriangles(const Character& character, const std::vector<const DatasetPose*>& poses,
+                                        const BodyCoverageOptions& o) {
+  const Mesh& body = character.body;
+  BodyCoverageResult r;
+  r.bodyTriangles = uint32_t(body.triangleCount());
+  if (body.triangleCount() == 0 || poses.empty()) return r;
+  const size_t nt = body.triangleCount();
+  std::vector<uint8_t> covered(nt, 1);
+  const size_t step = std::max<size_t>(1, (poses.size() + o.maxPoses - 1) / std::max<size_t>(1, o.maxPoses));
+  for (size_t k = 0; k < poses.size(); k += step) {
+    const DatasetPose& p = *poses[k];
+    if (size_t(p.gameMeshWorld.rows()) != character.garment.vertexCount())
+      throw Error("body coverage: pose " + std::to_string(p.id) + " has a game mesh of " +
+                  std::to_string(p.gameMeshWorld.rows()) + " vertices, the character's garment " +
+                  std::to_string(character.garment.vertexCount()));
+    const Points3f posed =
+        runtime::referenceSkin(body.positions, body.skin, character.skeleton.skinningMatrices(p.pose));
+    const TriangleRayScene garment(p.gameMeshWorld, character.garment.triangles, "body coverage: garment");
+    std::vector<uint8_t> hit(nt, 0);
+    tbb::parallel_for(size_t(0), nt, [&](size_t t) {
+      if (!covered[t]) return;
+      const Vec3f a = posed.row(body.triangles(Eigen::Index(t), 0)), b = posed.row(body.triangles(Eigen::Index(t), 1)),
+                  c = posed.row(body.triangles(Eigen::Index(t), 2));
+      const Vec3f n = (b - a).cross(c - a);
+      const float len = n.norm();
+      if (!(len > 0.f)) return;  // degenerate: never covered
+      const Vec3f centroid = (a + b + c) / 3.f;
+      hit[t] = garment.intersect(centroid, n / len, 0.f, o.maxGap).found;
+    });
+    size_t count = 0;
+    for (size_t t = 0; t < nt; ++t) {
+      covered[t] = covered[t] && hit[t];
+      count += covered[t];
+    }
+    if (r.poses == 0) r.coveredAtRest = count;
+    ++r.poses;
+  }
+  for (size_t t = 0; t < nt; ++t)
+    if (covered[t]) r.covered.push_back(uint32_t(t));
+  return r;
+}
+
+}  // namespace swish::bake
