@@ -66,7 +66,7 @@ struct ModelInfo {
   // character above noveltyFlagAbove is in FrameReport::novelCharacters. Novelty 1 is the sparse edge
   // of the poses the model was trained on.
   bool hasNoveltyGuard = false;
-  // The triangles of the body the model was baked on that the garment covers in every training pose
+  // The triangles of the body the model was baked on that the garment covers in (nearly) every training pose
   // (ascending): a host drawing that body (coveredBodyOf triangles) may leave them out, as games do
   // under tight clothing, so the body can never show through. Empty: not computed.
   uint32_t coveredBodyOf = 0;

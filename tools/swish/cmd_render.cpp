@@ -96,7 +96,7 @@ int run(const RenderOptions& o) {
       hidden = "body drawn whole: the model lists no covered triangles (baked before format 1.2, or without a body)";
     else
       hidden = "left out " + std::to_string(popts.body->hideCovered(info)) +
-               " body triangles the garment covers in every training pose";
+               " body triangles the garment covers in (nearly) every training pose";
   }
   if (!info.hasNormalMaps) std::printf("swish render: the model has no normal maps; both halves will look the same\n");
 
@@ -128,9 +128,10 @@ static CommandRegistration registration{
       app.add_option("--character", o->character,
                      "body to draw: 'auto' (the body the model was baked on, from its metadata; an error when that "
                      "file is not at hand), 'default' (the embedded mannequin), a glTF/FBX file, or 'none'");
-      app.add_flag("--hide-covered-body", o->hideCoveredBody,
-                   "leave out the body triangles the garment covers in every training pose (the model's list; as "
-                   "games do under tight clothing). Off by default: the whole body shows where the garment fails");
+      app.add_flag(
+          "--hide-covered-body", o->hideCoveredBody,
+          "leave out the body triangles the garment covers in (nearly) every training pose (the model's list; as "
+          "games do under tight clothing). Off by default: the whole body shows where the garment fails");
       app.add_option("--out,-o", o->out, "output PNG");
       app.add_option("--width", o->width, "width of each half, pixels")->check(CLI::Range(16, 4096));
       app.add_option("--height", o->height, "height, pixels")->check(CLI::Range(16, 4096));

@@ -176,9 +176,10 @@ swish::cli::CommandRegistration reg{
       app.add_flag("--push-out", o->pushOut,
                    "push the garment out of the model's body proxy on the GPU (models that carry one; off by default: "
                    "measured to raise the error against the source simulation)");
-      app.add_flag("--hide-covered-body", o->hideCoveredBody,
-                   "with --render: leave out the body triangles the garment covers in every training pose (the "
-                   "model's list, as games do under tight clothing); off by default so that a fault shows");
+      app.add_flag(
+          "--hide-covered-body", o->hideCoveredBody,
+          "with --render: leave out the body triangles the garment covers in (nearly) every training pose (the "
+          "model's list, as games do under tight clothing); off by default so that a fault shows");
       app.add_flag("--no-guard", o->noGuard,
                    "measure each character's novelty (how far its pose is from the model's training poses) but do "
                    "not apply the model's novelty guard (clamp of the mesh weights, blend towards the mean shape): "

@@ -102,7 +102,7 @@ struct NoveltyGuard {
   bool blends() const { return blendEnd > blendStart; }
 };
 
-// The body triangles the garment covers in every training pose (format 1.2; bake/transfer/body_coverage.hpp):
+// The body triangles the garment covers in (nearly) every training pose (format 1.2; bake/transfer/body_coverage.hpp):
 // what a renderer may leave out, as games leave out the skin under tight clothing. Indices refer to the
 // triangles of the body the model was baked on, which has bodyTriangles of them (a host checks that its
 // body is that one). Empty: not computed (no body, or a model before 1.2).

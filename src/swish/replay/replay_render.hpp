@@ -26,7 +26,7 @@ struct ReplayRenderOptions {
   // io/error_heat_map.hpp) and heat_sheet.png; the truth is simulated again here (as the replay's).
   TruthOptions truth;
   bool pushOut = false;  // as the replay's --push-out
-  // Leave out the body triangles the garment covers in every training pose (the model's list: games
+  // Leave out the body triangles the garment covers in (nearly) every training pose (the model's list: games
   // do not draw the skin under tight clothing). Off by default: a body showing through is a fault the
   // user should see; the result's note says which was drawn.
   bool hideCoveredBody = false;

@@ -218,7 +218,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     stage("body proxy");
   }
 
-  // The body triangles the garment covers in every training pose: what a renderer may leave out.
+  // The body triangles the garment covers in (nearly) every training pose: what a renderer may leave out.
   if (ds.character.body.triangleCount() > 0) {
     report("body coverage", 0.93);
     std::vector<const DatasetPose*> trained;
@@ -226,8 +226,11 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     const BodyCoverageResult cov = coveredBodyTriangles(ds.character, trained);
     out.model.bodyCoverage = {cov.bodyTriangles, cov.covered};
     out.metadata["body_coverage"] = {{"body_triangles", cov.bodyTriangles},
-                                     {"covered_in_every_training_pose", cov.covered.size()},
+                                     {"covered", cov.covered.size()},
+                                     {"min_share_of_poses", BodyCoverageOptions{}.minShare},
                                      {"covered_in_the_first_pose", cov.coveredAtRest},
+                                     {"covered_per_pose", cov.perPose},
+                                     {"covered_by_share_of_poses", cov.byShare},
                                      {"poses_tested", cov.poses}};
     stage("body coverage");
   }

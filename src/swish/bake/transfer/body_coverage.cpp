@@ -1,6 +1,7 @@
 #include "swish/bake/transfer/body_coverage.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <tbb/parallel_for.h>
 
@@ -17,7 +18,7 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
   r.bodyTriangles = uint32_t(body.triangleCount());
   if (body.triangleCount() == 0 || poses.empty()) return r;
   const size_t nt = body.triangleCount();
-  std::vector<uint8_t> covered(nt, 1);
+  std::vector<uint32_t> hits(nt, 0);
   const size_t step = std::max<size_t>(1, (poses.size() + o.maxPoses - 1) / std::max<size_t>(1, o.maxPoses));
   for (size_t k = 0; k < poses.size(); k += step) {
     const DatasetPose& p = *poses[k];
@@ -30,25 +31,32 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
     const TriangleRayScene garment(p.gameMeshWorld, character.garment.triangles, "body coverage: garment");
     std::vector<uint8_t> hit(nt, 0);
     tbb::parallel_for(size_t(0), nt, [&](size_t t) {
-      if (!covered[t]) return;
       const Vec3f a = posed.row(body.triangles(Eigen::Index(t), 0)), b = posed.row(body.triangles(Eigen::Index(t), 1)),
                   c = posed.row(body.triangles(Eigen::Index(t), 2));
       const Vec3f n = (b - a).cross(c - a);
       const float len = n.norm();
       if (!(len > 0.f)) return;  // degenerate: never covered
       const Vec3f centroid = (a + b + c) / 3.f;
-      hit[t] = garment.intersect(centroid, n / len, 0.f, o.maxGap).found;
+      const Vec3f dir = n / len;
+      hit[t] = garment.intersect(centroid - o.maxInside * dir, dir, 0.f, o.maxInside + o.maxGap).found;
     });
-    size_t count = 0;
+    size_t own = 0;
     for (size_t t = 0; t < nt; ++t) {
-      covered[t] = covered[t] && hit[t];
-      count += covered[t];
+      own += hit[t];
+      hits[t] += hit[t];
     }
-    if (r.poses == 0) r.coveredAtRest = count;
+    if (r.poses == 0) r.coveredAtRest = own;
+    r.perPose.push_back(uint32_t(own));
     ++r.poses;
   }
+  for (double share : {0.5, 0.8, 0.9, 0.95, 0.98, 1.0}) {
+    const uint32_t n = uint32_t(std::max<double>(1.0, std::ceil(share * double(r.poses) - 1e-9)));
+    r.byShare.push_back({share, uint32_t(std::count_if(hits.begin(), hits.end(), [&](uint32_t h) { return h >= n; }))});
+  }
+  // Covered in at least minShare of the poses tested (rounded up; 1: every one).
+  const uint32_t need = uint32_t(std::max<double>(1.0, std::ceil(o.minShare * double(r.poses) - 1e-9)));
   for (size_t t = 0; t < nt; ++t)
-    if (covered[t]) r.covered.push_back(uint32_t(t));
+    if (hits[t] >= need) r.covered.push_back(uint32_t(t));
   return r;
 }
 

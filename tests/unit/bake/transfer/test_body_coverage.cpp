@@ -50,7 +50,9 @@ TEST(BodyCoverage, CoveredInEveryPoseIsWhatTheGarmentHidesInAll) {
   }
   EXPECT_GT(inside, 100u);
 
-  const BodyCoverageResult both = coveredBodyTriangles(ch, {&rest, &raised});
+  BodyCoverageOptions every;
+  every.minShare = 1.0;
+  const BodyCoverageResult both = coveredBodyTriangles(ch, {&rest, &raised}, every);
   EXPECT_EQ(both.poses, 2u);
   EXPECT_EQ(both.coveredAtRest, one.covered.size());
   EXPECT_LT(both.covered.size(), one.covered.size());
@@ -59,6 +61,12 @@ TEST(BodyCoverage, CoveredInEveryPoseIsWhatTheGarmentHidesInAll) {
     EXPECT_TRUE(inOne[t]) << "covered in both poses but not in the first: " << t;
     EXPECT_GT(centroidY(ch.body, t), spec.garmentLow + 0.1f - 0.015f) << t;
   }
+  // With half the poses enough, the union of the two.
+  BodyCoverageOptions half;
+  half.minShare = 0.5;
+  const BodyCoverageResult either = coveredBodyTriangles(ch, {&rest, &raised}, half);
+  EXPECT_GT(either.covered.size(), one.covered.size());
+  for (uint32_t t : one.covered) EXPECT_TRUE(std::binary_search(either.covered.begin(), either.covered.end(), t));
   // A body-less character covers nothing.
   Character bare = ch;
   bare.body = Mesh{};
