@@ -82,6 +82,9 @@ int main(int argc, char** argv) {
     s.bodyCapsules = 3;
     shapes.push_back({"body_proxy", s});
     s = small();
+    s.noveltyCentres = 3;
+    shapes.push_back({"novelty_guard", s});
+    s = small();
     s.vertices = 20;
     s.mapSize = 8;
     s.codebookSize = 5;
@@ -90,7 +93,9 @@ int main(int argc, char** argv) {
     swish::Rng rng(0xF022);
     std::vector<uint8_t> first;
     for (const auto& [name, spec] : shapes) {
-      const auto bytes = swish::serializeModel(swish::test::makeRandomModel(rng, spec));
+      swish::Model m = swish::test::makeRandomModel(rng, spec);
+      if (name == "novelty_guard") m.bodyCoverage = {7, {0, 3, 6}};  // format 1.2's other section filled too
+      const auto bytes = swish::serializeModel(m);
       if (first.empty()) first = bytes;
       swish::writeFileAtomic(dir / ("seed_" + name + ".swish"), bytes);
     }
