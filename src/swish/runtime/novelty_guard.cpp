@@ -21,14 +21,17 @@ NoveltyGuardEvaluator::NoveltyGuardEvaluator(const Model& model) : guard_(model.
 }
 
 void NoveltyGuardEvaluator::measure(std::span<const float> theta, uint32_t n, std::span<float> novelty) const {
+  if (!active()) {  // no guard: nothing to measure against
+    if (novelty.size() != n)
+      throw Error("novelty guard: " + std::to_string(novelty.size()) + " outputs for " + std::to_string(n) +
+                  " characters");
+    std::fill(novelty.begin(), novelty.end(), std::numeric_limits<float>::quiet_NaN());
+    return;
+  }
   const Eigen::Index D = centres_.cols();
   if (novelty.size() != n || theta.size() != size_t(n) * size_t(D))
     throw Error("novelty guard: " + std::to_string(theta.size()) + " inputs and " + std::to_string(novelty.size()) +
                 " outputs for " + std::to_string(n) + " characters of " + std::to_string(D) + " inputs");
-  if (!active()) {
-    std::fill(novelty.begin(), novelty.end(), std::numeric_limits<float>::quiet_NaN());
-    return;
-  }
   const Eigen::Map<const MatXf> t(theta.data(), D, Eigen::Index(n));
   x_.resize(D, Eigen::Index(n));
   x_.noalias() = ((t.colwise() - mean_).array().colwise() * invScale_.array()).matrix();

@@ -153,6 +153,14 @@ TEST(NoveltyGuard, FrameEvaluatorMeasuresAppliesAndFlags) {
   EXPECT_TRUE(std::all_of(c.novelty.begin(), c.novelty.end(), [](float v) { return std::isnan(v); }));
   EXPECT_TRUE(c.novel.empty());
   EXPECT_EQ(c.meshWeights, b.meshWeights);
+  // The evaluator of a guard-less model measures nothing and changes nothing (the bake's evaluation and
+  // the CPU prediction call it on every model).
+  const NoveltyGuardEvaluator absent(plain);
+  const std::vector<float> theta = computeTheta(plain.inputJoints, poses[0].local);
+  EXPECT_TRUE(std::isnan(absent.measureOne(theta)));
+  std::vector<float> w(K, 7.f);
+  absent.apply(absent.measureOne(theta), w);
+  EXPECT_EQ(w, std::vector<float>(K, 7.f));
 }
 
 // The fit: training poses' novelty has its 95th percentile at 1 (the unit's definition), the clamp is
