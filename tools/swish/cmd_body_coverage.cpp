@@ -36,17 +36,11 @@ struct BodyCoverageCliOptions {
 
 int runBodyCoverage(const BodyCoverageCliOptions& o) {
   using namespace swish;
-  replay::ModelEntry entry;
-  entry.key = o.model;
-  entry.file = fs::absolute(o.model);
-  entry.label = o.model;
-  entry.model = loadModel(entry.file);
+  replay::ModelWithBakeBody loaded = replay::loadModelWithBakeBody(o.model, "to test coverage against");
+  replay::ModelEntry& entry = loaded.entry;
+  const Character* character = loaded.character.get();
+  const std::string& how = loaded.how;
   const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
-  std::string note, how;
-  const auto character = replay::rebuildBakeCharacter(entry, note, &how);
-  if (!character) throw Error(o.model + ": no body to test coverage against: " + note);
-  if (character->body.triangleCount() == 0)
-    throw Error(o.model + ": the bake's character '" + character->name + "' has no body mesh");
 
   std::vector<Pose> frames;
   for (const std::string& c : o.clips) {
@@ -95,8 +89,7 @@ int runBodyCoverage(const BodyCoverageCliOptions& o) {
 }
 
 swish::cli::CommandRegistration reg{
-    "body-coverage",
-    "List the body triangles a model's garment covers (for renderers to leave out), without re-baking",
+    "body-coverage", "List the body triangles a model's garment covers (for renderers to leave out), without re-baking",
     [](CLI::App& app) -> swish::cli::RunFn {
       auto o = std::make_shared<BodyCoverageCliOptions>();
       app.add_option("model", o->model, "the .swish model (its bake metadata names the character)")->required();

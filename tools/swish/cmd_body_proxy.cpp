@@ -30,23 +30,19 @@ struct BodyProxyOptions {
 
 int runBodyProxy(const BodyProxyOptions& o) {
   using namespace swish;
-  replay::ModelEntry entry;
-  entry.key = o.model;
-  entry.file = fs::absolute(o.model);
-  entry.label = o.model;
-  entry.model = loadModel(entry.file);
-  const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
   if (o.remove) {
+    replay::ModelEntry entry = replay::loadModelEntry(o.model);
     entry.model.bodyProxy = {};
+    const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
     saveModel(entry.model, out);
     std::printf("Wrote %s without a body proxy (no push-out at run time).\n", out.string().c_str());
     return 0;
   }
-  std::string note, how;
-  const auto character = replay::rebuildBakeCharacter(entry, note, &how);
-  if (!character) throw Error(o.model + ": no body to fit the proxy to: " + note);
-  if (character->body.triangleCount() == 0)
-    throw Error(o.model + ": the bake's character '" + character->name + "' has no body mesh");
+  replay::ModelWithBakeBody loaded = replay::loadModelWithBakeBody(o.model, "to fit the proxy to");
+  replay::ModelEntry& entry = loaded.entry;
+  const Character* character = loaded.character.get();
+  const std::string& how = loaded.how;
+  const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
   bake::BodyProxyFitSettings s;
   s.reach = o.reach;
   const bake::BodyProxyFit fit = bake::fitBodyProxy(character->body, entry.model.skeleton, &entry.model.gameMesh, s);

@@ -14,6 +14,7 @@
 #include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
+#include "swish/model/model_file.hpp"
 
 namespace swish::replay {
 
@@ -266,6 +267,26 @@ TruthSummary TruthPool::summary() const {
     s.meanDeg = a.meanDegrees, s.p95Deg = a.p95Degrees, s.maxDeg = a.maxDegrees;
   }
   return s;
+}
+
+ModelEntry loadModelEntry(const std::string& path) {
+  ModelEntry entry;
+  entry.key = path;
+  entry.file = std::filesystem::absolute(path);
+  entry.label = path;
+  entry.model = loadModel(entry.file);
+  return entry;
+}
+
+ModelWithBakeBody loadModelWithBakeBody(const std::string& path, const std::string& purpose) {
+  ModelWithBakeBody m;
+  m.entry = loadModelEntry(path);
+  std::string note;
+  m.character = rebuildBakeCharacter(m.entry, note, &m.how);
+  if (!m.character) throw Error(path + ": no body " + purpose + ": " + note);
+  if (m.character->body.triangleCount() == 0)
+    throw Error(path + ": the bake's character '" + m.character->name + "' has no body mesh");
+  return m;
 }
 
 }  // namespace swish::replay

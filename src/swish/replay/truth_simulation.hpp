@@ -123,6 +123,17 @@ class ModelTruth {
 // built, in words.
 std::unique_ptr<Character> rebuildBakeCharacter(const ModelEntry& entry, std::string& note, std::string* how = nullptr);
 
+// For the tools that add to a model after its bake (swish body-proxy, swish body-coverage): the model
+// file loaded as an entry, and the body it was baked on. Throws Error naming the file, `purpose` and
+// why when that body cannot be rebuilt or has no mesh.
+struct ModelWithBakeBody {
+  ModelEntry entry;
+  std::unique_ptr<Character> character;
+  std::string how;  // how the character was rebuilt, in words
+};
+ModelEntry loadModelEntry(const std::string& path);
+ModelWithBakeBody loadModelWithBakeBody(const std::string& path, const std::string& purpose);
+
 // Where the rebuilt `character` differs from `model` (skeleton, game mesh, UVs, skin weights), in
 // words; empty when it matches.
 std::string characterDifference(const Model& model, const Character& character);
