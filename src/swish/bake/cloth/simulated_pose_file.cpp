@@ -29,6 +29,7 @@ struct Reader {
   const std::filesystem::path& file;
   size_t at = 0;
   void take(void* dst, size_t n) {
+    if (n == 0) return;  // a failed pose's empty positions: data() may be null, which memcpy must not get
     if (n > bytes.size() - at)
       throw Error(file.string() + ": truncated simulated-pose file (" + std::to_string(bytes.size()) + " bytes)");
     std::memcpy(dst, bytes.data() + at, n);
