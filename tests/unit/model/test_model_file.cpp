@@ -157,8 +157,9 @@ std::vector<uint8_t> toBytes(std::string_view s) { return {s.begin(), s.end()}; 
 template <class A>
 bool sameBits(const A& a, const A& b) {
   if constexpr (requires { a.rows(); }) {
+    // An empty Eigen object's data() is null, which memcmp must not get even for 0 bytes.
     return a.rows() == b.rows() && a.cols() == b.cols() &&
-           std::memcmp(a.data(), b.data(), sizeof(*a.data()) * size_t(a.size())) == 0;
+           (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(*a.data()) * size_t(a.size())) == 0);
   } else {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), sizeof(a[0]) * a.size()) == 0);
   }
