@@ -56,25 +56,29 @@ float NoveltyGuardEvaluator::measureOne(std::span<const float> theta) const {
   return v;
 }
 
-float NoveltyGuardEvaluator::blendOf(float novelty) const {
-  if (!active() || !guard_.blends()) return 0.f;
+float noveltyBlend(const NoveltyGuard& g, float novelty) {
+  if (!g.blends()) return 0.f;
   if (!(novelty == novelty)) return 1.f;  // NaN: as far as it gets
-  return std::clamp((novelty - guard_.blendStart) / (guard_.blendEnd - guard_.blendStart), 0.f, 1.f);
+  return std::clamp((novelty - g.blendStart) / (g.blendEnd - g.blendStart), 0.f, 1.f);
 }
 
-void NoveltyGuardEvaluator::apply(float novelty, std::span<float> w) const {
-  if (!active()) return;
-  if (guard_.weightMin.size() > 0) {
-    if (w.size() != size_t(guard_.weightMin.size()))
+void applyNoveltyGuard(const NoveltyGuard& g, float novelty, std::span<float> w) {
+  if (g.weightMin.size() > 0) {
+    if (w.size() != size_t(g.weightMin.size()))
       throw Error("novelty guard: " + std::to_string(w.size()) + " mesh weights for ranges of " +
-                  std::to_string(guard_.weightMin.size()));
+                  std::to_string(g.weightMin.size()));
     for (size_t k = 0; k < w.size(); ++k)
-      w[k] = std::isnan(w[k]) ? 0.f
-                              : std::clamp(w[k], guard_.weightMin[Eigen::Index(k)], guard_.weightMax[Eigen::Index(k)]);
+      w[k] = std::isnan(w[k]) ? 0.f : std::clamp(w[k], g.weightMin[Eigen::Index(k)], g.weightMax[Eigen::Index(k)]);
   }
-  const float keep = 1.f - blendOf(novelty);
+  const float keep = 1.f - noveltyBlend(g, novelty);
   if (keep < 1.f)
     for (float& v : w) v *= keep;
+}
+
+float NoveltyGuardEvaluator::blendOf(float novelty) const { return active() ? noveltyBlend(guard_, novelty) : 0.f; }
+
+void NoveltyGuardEvaluator::apply(float novelty, std::span<float> w) const {
+  if (active()) applyNoveltyGuard(guard_, novelty, w);
 }
 
 }  // namespace swish::runtime

@@ -19,6 +19,13 @@
 
 namespace swish::runtime {
 
+// The guard's clamp and blend of one character's K mesh weights for its novelty, with the thresholds and
+// ranges of `guard` (its centres are not used): the run time applies the model's guard with it, the
+// bake's study (bake/report/subject_evaluation.cpp) the settings it compares. Empty weight ranges: no
+// clamp; blendEnd <= blendStart: no blend; NaN novelty blends fully.
+void applyNoveltyGuard(const NoveltyGuard& guard, float novelty, std::span<float> meshWeights);
+float noveltyBlend(const NoveltyGuard& guard, float novelty);
+
 class NoveltyGuardEvaluator {
  public:
   // The model's guard may be empty (a model before format 1.2): then active() is false, novelty() is

@@ -138,17 +138,14 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
   auto errors = [&](const std::vector<Prepared>& set, const GuardSetting& s, std::vector<double>* perPose) {
     std::vector<double> all;
     all.reserve(set.size() * n);
+    // The setting as a guard: the model's ranges when it clamps, its thresholds when it blends.
+    NoveltyGuard g;
+    if (s.clamp) g.weightMin = guard.weightMin, g.weightMax = guard.weightMax;
+    if (s.clamp && s.end > s.start) g.blendStart = float(s.start), g.blendEnd = float(s.end);
     std::vector<float> w(static_cast<size_t>(K));
     for (const Prepared& p : set) {
-      for (int k = 0; k < K; ++k) {
-        float v = p.lambda[size_t(k)];
-        if (s.clamp) v = std::clamp(v, guard.weightMin[k], guard.weightMax[k]);
-        w[size_t(k)] = v;
-      }
-      if (s.clamp && s.end > s.start) {
-        const float b = float(std::clamp((p.novelty - s.start) / (s.end - s.start), 0.0, 1.0));
-        for (float& v : w) v *= 1.f - b;
-      }
+      w.assign(p.lambda.begin(), p.lambda.begin() + K);
+      runtime::applyNoveltyGuard(g, float(p.novelty), w);
       const Points3f shape =
           runtime::referenceSkin(runtime::referencePcaReconstruct(model.meshPca, w), model.gameMesh.skin, p.mats);
       double sum = 0.0;
