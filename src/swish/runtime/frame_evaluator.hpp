@@ -20,12 +20,12 @@
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/nearest_code.hpp"
 #include "swish/runtime/novelty_guard.hpp"
+#include "swish/runtime/quality_levels.hpp"
+#include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/temporal_filter.hpp"
 #include "swish/runtime/theta.hpp"
 
 namespace swish::runtime {
-
-inline constexpr uint32_t kNoMap = 0xFFFFFFFFu;  // mapIndex of a model without a normal-map database
 
 struct FrameTimings {  // seconds of wall clock spent in each stage of the last evaluate()
   double theta = 0, mlp = 0, novelty = 0, lookup = 0, filter = 0, total = 0;
@@ -41,7 +41,8 @@ struct FrameOutput {
   // characters x K, character c's weights at [c*K, c*K + K): the deform pass's K x N column-major array.
   std::vector<float> meshWeights;
   std::vector<float> normalCodes;  // characters x C, same layout
-  std::vector<uint32_t> mapIndex;  // per character: the map to blend in (kNoMap without a database)
+  // per character: the map to blend in (kNoMap without a database, or at a level without normal maps)
+  std::vector<uint32_t> mapIndex;
   std::vector<float> blendAlpha;   // per character: its blend factor (1 on a first frame; 0 without a database)
   std::vector<BlendStep> blend;    // per character: the full filter step (empty without a database)
   // Per character: the novelty guard's measure (NaN for a model without a guard) and the blend towards
@@ -85,6 +86,15 @@ class FrameEvaluator {
 
   // The character's next frame starts without history (alpha 1): after a teleport or a respawn.
   void resetCharacter(uint32_t character);
+  // The character's quality level (quality_levels.hpp) from the next evaluate() on; every character
+  // starts at full quality. Its mesh weights beyond level.meshComponents come out as 0; without normal
+  // maps it gets no lookup and no filter step (mapIndex kNoMap, blendAlpha 0), and its filter starts
+  // again without history when maps return; a level that needs no network (the mean shape skinned)
+  // leaves the character out of the network's batch (weights and code 0; novelty is still measured).
+  // Throws Error for a character out of range or more components than the model has.
+  void setLevel(uint32_t character, const QualityLevel& level);
+  uint32_t levelComponents(uint32_t character) const { return levels_.at(character).components; }
+  bool levelNormalMaps(uint32_t character) const { return levels_.at(character).normalMaps; }
   const FrameOutput& output() const { return out_; }
 
  private:
@@ -100,6 +110,13 @@ class FrameEvaluator {
   std::optional<NearestCodeSearch> search_;
   std::vector<TemporalFilter> filters_;
   std::vector<float> theta_;  // characters x thetaSize
+  struct LevelUse {
+    uint32_t components = 0;
+    bool normalMaps = true;
+  };
+  std::vector<LevelUse> levels_;            // per character
+  std::vector<uint32_t> networkRows_;       // characters the network runs for this frame
+  std::vector<float> thetaNet_, weightsNet_, codesNet_;  // their compacted rows
   std::vector<ThetaJointIssue> issueScratch_;
   FrameOutput out_;
 };

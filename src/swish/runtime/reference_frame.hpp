@@ -12,6 +12,11 @@
 
 namespace swish::runtime {
 
+// "No map": FrameEvaluator's mapIndex for a model without a normal-map database or a character at a
+// quality level without normal maps; in FrameKernelInputs::selectedMaps, an instance that gets no decode
+// and no blend this frame (its normal map stays as it was).
+inline constexpr uint32_t kNoMap = 0xFFFFFFFFu;
+
 struct FrameKernelInputs {
   uint32_t instanceCount = 0;
   std::vector<float> meshWeights;      // instanceCount x K, instance-major (the MLP's mesh weights)
