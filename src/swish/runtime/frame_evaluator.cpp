@@ -1,5 +1,6 @@
 #include "swish/runtime/frame_evaluator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <string>
@@ -40,6 +41,21 @@ FrameEvaluator::FrameEvaluator(const Model& model, uint32_t characters, const Fr
   if (search_) out_.blend.resize(characters);
   out_.novelty.assign(characters, std::numeric_limits<float>::quiet_NaN());
   out_.guardBlend.assign(characters, 0.f);
+  levels_.assign(characters, LevelUse{out_.meshComponents, true});
+}
+
+void FrameEvaluator::setLevel(uint32_t character, const QualityLevel& level) {
+  if (character >= characters_)
+    throw Error("frame evaluator: level for character " + std::to_string(character) + " of " +
+                std::to_string(characters_));
+  if (level.meshComponents > out_.meshComponents)
+    throw Error("frame evaluator: level " + level.name + " reads " + std::to_string(level.meshComponents) +
+                " mesh components, the model has " + std::to_string(out_.meshComponents));
+  LevelUse& use = levels_[character];
+  // A map that comes back after frames without one starts from the new selection, not from a map
+  // the character stopped showing.
+  if (level.normalMaps && !use.normalMaps) filters_[character].reset();
+  use = {level.meshComponents, level.normalMaps};
 }
 
 void FrameEvaluator::resetCharacter(uint32_t character) {
@@ -97,11 +113,30 @@ const FrameOutput& FrameEvaluator::finishFrame(std::span<const float> dt, double
     throw Error("frame evaluator: " + std::to_string(dt.size()) + " dt values for " + std::to_string(characters_) +
                 " characters (give one, or one per character)");
   const double t1 = now();
-  mlp_.evaluateBatchSplit(theta_, out_.meshWeights, out_.normalCodes, characters_);
+  const size_t k = out_.meshComponents, cd = out_.codeDims;
+  networkRows_.clear();
+  for (uint32_t c = 0; c < characters_; ++c)
+    if (levels_[c].components > 0 || levels_[c].normalMaps) networkRows_.push_back(c);
+  if (networkRows_.size() == characters_) {
+    mlp_.evaluateBatchSplit(theta_, out_.meshWeights, out_.normalCodes, characters_);
+  } else {
+    // Only the characters whose level needs the network run it: compact their rows, then scatter.
+    const size_t ts = theta_.size() / std::max<size_t>(characters_, 1), n = networkRows_.size();
+    thetaNet_.resize(n * ts);
+    weightsNet_.resize(n * k);
+    codesNet_.resize(n * cd);
+    for (size_t r = 0; r < n; ++r) std::copy_n(theta_.begin() + networkRows_[r] * ts, ts, thetaNet_.begin() + r * ts);
+    if (n > 0) mlp_.evaluateBatchSplit(thetaNet_, weightsNet_, codesNet_, uint32_t(n));
+    std::fill(out_.meshWeights.begin(), out_.meshWeights.end(), 0.f);
+    std::fill(out_.normalCodes.begin(), out_.normalCodes.end(), 0.f);
+    for (size_t r = 0; r < n; ++r) {
+      std::copy_n(weightsNet_.begin() + r * k, k, out_.meshWeights.begin() + networkRows_[r] * k);
+      std::copy_n(codesNet_.begin() + r * cd, cd, out_.normalCodes.begin() + networkRows_[r] * cd);
+    }
+  }
   const double tm = now();
   if (guard_.active()) {
     guard_.measure(theta_, characters_, out_.novelty);
-    const size_t k = out_.meshComponents;
     const bool on = guardOn();
     for (uint32_t c = 0; c < characters_; ++c) {
       if (!(out_.novelty[c] <= guard_.guard().flagAbove)) out_.novel.push_back(c);
@@ -109,11 +144,18 @@ const FrameOutput& FrameEvaluator::finishFrame(std::span<const float> dt, double
       if (on) guard_.apply(out_.novelty[c], std::span<float>(out_.meshWeights.data() + c * k, k));
     }
   }
+  // A level reads the leading components only: the rest are 0 for every consumer (the GPU, the CPU
+  // reference, a host), not only for the deform.
+  for (uint32_t c = 0; c < characters_; ++c)
+    std::fill(out_.meshWeights.begin() + c * k + levels_[c].components, out_.meshWeights.begin() + (c + 1) * k, 0.f);
   const double t2 = now();
   double t3 = t2;
   if (search_) {
-    const size_t cd = out_.codeDims;
     for (uint32_t c = 0; c < characters_; ++c) {
+      if (!levels_[c].normalMaps) {
+        out_.mapIndex[c] = kNoMap;
+        continue;
+      }
       // Fallback for a non-finite code: the map this character shows now (0 before its first frame).
       const uint32_t previous = filters_[c].hasHistory() ? out_.mapIndex[c] : 0u;
       const NearestCode r = search_->find(std::span<const float>(out_.normalCodes.data() + c * cd, cd), previous);
@@ -122,7 +164,14 @@ const FrameOutput& FrameEvaluator::finishFrame(std::span<const float> dt, double
     }
     t3 = now();
     for (uint32_t c = 0; c < characters_; ++c) {
-      const BlendStep s = filters_[c].step(dt.size() == 1 ? dt[0] : dt[c], out_.mapIndex[c]);
+      const float d = dt.size() == 1 ? dt[0] : dt[c];
+      if (!levels_[c].normalMaps) {
+        if (!(d >= 0.f)) out_.invalidDt.push_back(c);
+        out_.blend[c] = BlendStep{kNoMap, 0.f, false, !(d >= 0.f)};
+        out_.blendAlpha[c] = 0.f;
+        continue;
+      }
+      const BlendStep s = filters_[c].step(d, out_.mapIndex[c]);
       if (s.invalidDt) out_.invalidDt.push_back(c);
       out_.blend[c] = s;
       out_.blendAlpha[c] = s.alpha;

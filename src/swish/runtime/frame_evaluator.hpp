@@ -43,8 +43,8 @@ struct FrameOutput {
   std::vector<float> normalCodes;  // characters x C, same layout
   // per character: the map to blend in (kNoMap without a database, or at a level without normal maps)
   std::vector<uint32_t> mapIndex;
-  std::vector<float> blendAlpha;   // per character: its blend factor (1 on a first frame; 0 without a database)
-  std::vector<BlendStep> blend;    // per character: the full filter step (empty without a database)
+  std::vector<float> blendAlpha;  // per character: its blend factor (1 on a first frame; 0 without a database)
+  std::vector<BlendStep> blend;   // per character: the full filter step (empty without a database)
   // Per character: the novelty guard's measure (NaN for a model without a guard) and the blend towards
   // the mean shape it applied (0 with the guard off); the characters above the model's flag threshold.
   std::vector<float> novelty, guardBlend;
@@ -114,8 +114,8 @@ class FrameEvaluator {
     uint32_t components = 0;
     bool normalMaps = true;
   };
-  std::vector<LevelUse> levels_;            // per character
-  std::vector<uint32_t> networkRows_;       // characters the network runs for this frame
+  std::vector<LevelUse> levels_;                         // per character
+  std::vector<uint32_t> networkRows_;                    // characters the network runs for this frame
   std::vector<float> thetaNet_, weightsNet_, codesNet_;  // their compacted rows
   std::vector<ThetaJointIssue> issueScratch_;
   FrameOutput out_;

@@ -17,12 +17,11 @@ double numberOrNaN(const json& j, const char* key, const std::string& where) {
   return j.at(key).get<double>();
 }
 
-std::string levelName(uint32_t k, bool maps, uint32_t fullK) {
-  if (k == 0 && !maps) return "skinned";
-  std::string name = k == fullK && maps ? "full" : "k" + std::to_string(k);
-  if (!maps && k != fullK) name += "-flat";
-  if (!maps && k == fullK) name = "full-flat";
-  return name;
+// "full", "k64" (with the model's maps), "k32-flat" (without), "skinned" (the mean shape, no network).
+std::string levelName(uint32_t k, bool withMaps, uint32_t fullK, bool modelHasMaps) {
+  if (k == 0 && !withMaps) return "skinned";
+  const std::string base = k == fullK ? "full" : "k" + std::to_string(k);
+  return base + (modelHasMaps && !withMaps ? "-flat" : "");
 }
 
 }  // namespace
@@ -39,7 +38,7 @@ QualityLadder defaultLadder(const Model& model) {
       if (components > prev.meshComponents || (withMaps && !prev.normalMaps)) return;
     }
     QualityLevel l;
-    l.name = levelName(components, withMaps, k);
+    l.name = levelName(components, withMaps, k, maps);
     l.meshComponents = components;
     l.normalMaps = withMaps;
     ladder.levels.push_back(l);
@@ -75,7 +74,8 @@ json toJson(const QualityLadder& ladder) {
                       {"normal_mean_deg", numberOrNull(l.normalMeanDeg)},
                       {"cpu_us_per_character", numberOrNull(l.cpuUsPerCharacter)},
                       {"gpu_us_per_character", numberOrNull(l.gpuUsPerCharacter)}});
-  return {{"levels", levels}, {"measured_on", ladder.measuredOn}, {"poses", ladder.poses}, {"timed_on", ladder.timedOn}};
+  return {
+      {"levels", levels}, {"measured_on", ladder.measuredOn}, {"poses", ladder.poses}, {"timed_on", ladder.timedOn}};
 }
 
 QualityLadder ladderFromJson(const json& j, const Model& model, const std::string& what) {

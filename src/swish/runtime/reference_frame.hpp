@@ -19,7 +19,10 @@ inline constexpr uint32_t kNoMap = 0xFFFFFFFFu;
 
 struct FrameKernelInputs {
   uint32_t instanceCount = 0;
-  std::vector<float> meshWeights;      // instanceCount x K, instance-major (the MLP's mesh weights)
+  std::vector<float> meshWeights;  // instanceCount x K, instance-major (the MLP's mesh weights)
+  // Per instance: the leading mesh components its deform reads (its quality level's k, 0..K; the weights
+  // beyond it count as 0 whatever meshWeights holds). Empty: K for every instance.
+  std::vector<uint32_t> meshComponents;
   std::vector<Mat4f> skinMatrices;     // instanceCount x jointCount (Skeleton::skinningMatrices per instance)
   std::vector<uint32_t> selectedMaps;  // instanceCount database maps, or empty: no normal-map work this frame
   std::vector<float> blendAlpha;       // instanceCount weights of the new map (the temporal filter's alpha)

@@ -1,5 +1,6 @@
 #include "swish/runtime/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -20,6 +21,21 @@ bool Scene::onScreen(size_t c) const {
   return true;
 }
 
+LevelCamera Scene::levelCamera() const {
+  LevelCamera c;
+  c.position = camera;
+  c.verticalFovDegrees = cameraFovDegrees;
+  c.imageHeightPixels = imageHeightPixels;
+  if (cameraTarget) {
+    c.target = *cameraTarget;
+  } else {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const SceneCharacter& ch : characters) mean += ch.placement.translation;
+    c.target = mean / double(std::max<size_t>(characters.size(), 1)) + Eigen::Vector3d(0, 1, 0);
+  }
+  return c;
+}
+
 void Scene::validate() const {
   const std::string where = source.empty() ? std::string("scene") : source.string();
   auto fail = [&](const std::string& path, const std::string& problem) {
@@ -30,6 +46,17 @@ void Scene::validate() const {
   if (!(framesPerSecond > 0.0 && framesPerSecond <= 1000.0))
     fail("frames.rate", "must be in (0, 1000] frames per second");
   if (!camera.allFinite()) fail("camera.position", "must be finite");
+  if (cameraTarget && !cameraTarget->allFinite()) fail("camera.target", "must be finite");
+  if (cameraTarget && (*cameraTarget - camera).norm() < 1e-6) fail("camera.target", "must differ from the position");
+  if (!(cameraFovDegrees >= 1.0 && cameraFovDegrees <= 170.0)) fail("camera.fovDegrees", "must be in [1, 170]");
+  if (!(imageHeightPixels >= 16.0 && imageHeightPixels <= 65536.0))
+    fail("camera.imageHeight", "must be 16 to 65536 pixels");
+  if (levels.frameBudgetMs && !(*levels.frameBudgetMs > 0.0 && *levels.frameBudgetMs < 1e6))
+    fail("levels.frameBudgetMs", "must be a positive number of milliseconds");
+  if (levels.tolerancePixels && !(*levels.tolerancePixels > 0.0 && *levels.tolerancePixels < 1e6))
+    fail("levels.tolerancePixels", "must be a positive number of pixels");
+  if (!(levels.holdSeconds >= 0.0 && levels.holdSeconds <= 3600.0))
+    fail("levels.holdSeconds", "must be 0 to 3600 seconds");
   if (cullDistance && !(*cullDistance > 0.0 && std::isfinite(*cullDistance)))
     fail("cullDistance", "must be a positive number of metres");
   if (outputs.gpuCheckEvery < 1) fail("outputs.gpuCheckEvery", "must be at least 1");

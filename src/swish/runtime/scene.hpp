@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "swish/core/types.hpp"
+#include "swish/runtime/level_planner.hpp"
 
 namespace swish::runtime {
 
@@ -50,6 +51,16 @@ struct SceneCharacter {
   std::optional<std::filesystem::path> poseStream;  // a recorded pose stream (pose_stream format)
   ScenePlacement placement;
   bool visible = true;  // false: off screen, skips mesh and normal-map work
+  // A quality level the scene fixes for this character (a name of its model's ladder, or an index), as a
+  // host with its own LOD system would; empty: the level planner chooses (level_planner.hpp).
+  std::string level;
+};
+
+// How the level planner (level_planner.hpp) spends the frame: all optional.
+struct SceneLevels {
+  std::optional<double> frameBudgetMs;    // GPU milliseconds per frame for all characters
+  std::optional<double> tolerancePixels;  // cheapest level whose mean error on screen is within this
+  double holdSeconds = 1.0;               // a character keeps a level at least this long after a change
 };
 
 // Outputs a scene asks for. What they need decides the work (planner.hpp):
@@ -72,7 +83,11 @@ struct Scene {
   uint32_t firstFrame = 0;       // scene frames [firstFrame, firstFrame + frameCount)
   uint32_t frameCount = 1;
   double framesPerSecond = 30.0;
-  Eigen::Vector3d camera = Eigen::Vector3d::Zero();
+  Eigen::Vector3d camera = Eigen::Vector3d::Zero();  // the camera's position
+  std::optional<Eigen::Vector3d> cameraTarget;       // where it looks; default: the characters' mean, 1 m up
+  double cameraFovDegrees = 50.0;                    // vertical field of view
+  double imageHeightPixels = 1080.0;                 // of the image the characters are drawn into
+  SceneLevels levels;
   std::optional<double> cullDistance;  // metres from the camera; beyond it a character is off screen
   SceneOutputs outputs;
   std::vector<SceneCharacter> characters;
@@ -82,6 +97,8 @@ struct Scene {
   // further than cullDistance from the camera. Culling looks at the placement, not the per-frame root
   // motion, so that the plan stays the same for every frame.
   bool onScreen(size_t c) const;
+  // The camera as the level planner sees it (cameraTarget or its default filled in).
+  LevelCamera levelCamera() const;
   // Checks values (counts, ranges, names) and throws Error naming the scene and the field. Does not
   // touch files: scene_file.cpp checks those.
   void validate() const;

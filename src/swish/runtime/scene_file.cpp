@@ -95,7 +95,7 @@ void requireFile(const Reader& r, const std::filesystem::path& file) {
 }
 
 SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base, bool checkFiles) {
-  r.requireObject({"name", "model", "animation", "poseStream", "placement", "visible"});
+  r.requireObject({"name", "model", "animation", "poseStream", "placement", "visible", "level"});
   SceneCharacter c;
   c.name = r.required("name").string();
   const Reader model = r.required("model");
@@ -150,6 +150,14 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
     if (p.has("yawDegrees")) c.placement.yawDegrees = p.child("yawDegrees").number();
   }
   if (r.has("visible")) c.visible = r.child("visible").boolean();
+  if (r.has("level")) {
+    const Reader l = r.child("level");
+    if (l.value().is_number_integer())
+      c.level = std::to_string(l.integer(0, 255));
+    else
+      c.level = l.string();
+    if (c.level.empty()) l.fail("must name a level of the model's ladder, or its index");
+  }
   return c;
 }
 
@@ -157,7 +165,7 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
 
 Scene parseScene(const json& j, const std::filesystem::path& source, bool checkFiles) {
   const Reader root(j, source.string(), "");
-  root.requireObject({"name", "frames", "camera", "cullDistance", "outputs", "characters"});
+  root.requireObject({"name", "frames", "camera", "cullDistance", "levels", "outputs", "characters"});
   const std::filesystem::path base = source.has_parent_path() ? source.parent_path() : std::filesystem::path(".");
   Scene s;
   s.source = source;
@@ -174,8 +182,18 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
 
   if (root.has("camera")) {
     const Reader cam = root.child("camera");
-    cam.requireObject({"position"});
+    cam.requireObject({"position", "target", "fovDegrees", "imageHeight"});
     s.camera = cam.required("position").vec3();
+    if (cam.has("target")) s.cameraTarget = cam.child("target").vec3();
+    if (cam.has("fovDegrees")) s.cameraFovDegrees = cam.child("fovDegrees").number();
+    if (cam.has("imageHeight")) s.imageHeightPixels = cam.child("imageHeight").integer(16, 65536);
+  }
+  if (root.has("levels")) {
+    const Reader lv = root.child("levels");
+    lv.requireObject({"frameBudgetMs", "tolerancePixels", "holdSeconds"});
+    if (lv.has("frameBudgetMs")) s.levels.frameBudgetMs = lv.child("frameBudgetMs").number();
+    if (lv.has("tolerancePixels")) s.levels.tolerancePixels = lv.child("tolerancePixels").number();
+    if (lv.has("holdSeconds")) s.levels.holdSeconds = lv.child("holdSeconds").number();
   }
   if (root.has("cullDistance")) {
     const double d = root.child("cullDistance").number();
@@ -222,7 +240,13 @@ json sceneToJson(const Scene& s) {
   json j;
   j["name"] = s.name;
   j["frames"] = {{"start", s.firstFrame}, {"count", s.frameCount}, {"rate", s.framesPerSecond}};
-  j["camera"] = {{"position", {s.camera.x(), s.camera.y(), s.camera.z()}}};
+  j["camera"] = {{"position", {s.camera.x(), s.camera.y(), s.camera.z()}},
+                 {"fovDegrees", s.cameraFovDegrees},
+                 {"imageHeight", s.imageHeightPixels}};
+  if (s.cameraTarget) j["camera"]["target"] = {s.cameraTarget->x(), s.cameraTarget->y(), s.cameraTarget->z()};
+  j["levels"] = {{"holdSeconds", s.levels.holdSeconds}};
+  if (s.levels.frameBudgetMs) j["levels"]["frameBudgetMs"] = *s.levels.frameBudgetMs;
+  if (s.levels.tolerancePixels) j["levels"]["tolerancePixels"] = *s.levels.tolerancePixels;
   if (s.cullDistance) j["cullDistance"] = *s.cullDistance;
   j["outputs"] = {{"directory", s.outputs.directory.string()},
                   {"report", s.outputs.report},
@@ -243,6 +267,7 @@ json sceneToJson(const Scene& s) {
     else if (c.clip && !c.clip->jointMap.is_null())
       cj["animation"]["jointMap"] = c.clip->jointMap;
     if (c.poseStream) cj["poseStream"] = c.poseStream->string();
+    if (!c.level.empty()) cj["level"] = c.level;
     const auto& t = c.placement.translation;
     cj["placement"] = {{"translation", {t.x(), t.y(), t.z()}}, {"yawDegrees", c.placement.yawDegrees}};
     j["characters"].push_back(cj);
