@@ -142,6 +142,14 @@ class CharacterBatch {
   // The character's next frame starts without history (teleport, respawn): no temporal blend.
   void resetCharacter(uint32_t character);
 
+  // Quality levels (ModelInfo::qualityLevels; every character starts at level 0, full quality). A host
+  // with its own LOD system sets each character's level; from then on that character stays at it.
+  // InvalidArgument for a character or level out of range.
+  void setQualityLevel(uint32_t character, uint32_t level);
+  uint32_t qualityLevel(uint32_t character) const;
+  // Or swish chooses, every frame, the level of each character the host has not set (LevelPlanning).
+  void planQualityLevels(const LevelPlanning& planning);
+
   explicit CharacterBatch(std::unique_ptr<BatchImpl> impl);
 
  private:

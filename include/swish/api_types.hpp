@@ -5,6 +5,7 @@
 #include <vulkan/vulkan.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -45,6 +46,29 @@ struct CharacterPose {
   float dtSeconds = 1.f / 60.f;
 };
 
+// One quality level of a model (its ladder, full quality first): the leading PCA components its deform
+// reads, whether it gets normal maps, and what the bake measured (NaN: not measured).
+struct QualityLevelInfo {
+  std::string name;
+  uint32_t meshComponents = 0;  // 0: the mean shape skinned, no network
+  bool normalMaps = false;
+  float vertexMeanMm = NAN, vertexP95Mm = NAN, normalMeanDeg = NAN;
+  float cpuMicrosecondsPerCharacter = NAN, gpuMicrosecondsPerCharacter = NAN;
+};
+
+// Let swish choose each character's level every frame from its size on screen
+// (CharacterBatch::planQualityLevels): the cheapest level whose mean error on screen is within
+// tolerancePixels, keeping a level at least holdFrames frames. The character's position is the
+// translation of its CharacterPose::characterToWorld.
+struct LevelPlanning {
+  std::array<float, 3> cameraPosition{0, 1.7f, -5};
+  std::array<float, 3> cameraTarget{0, 1, 0};
+  float verticalFovDegrees = 50;
+  float imageHeightPixels = 1080;
+  float tolerancePixels = 0.5f;
+  uint32_t holdFrames = 30;
+};
+
 // What a loaded model is: its skeleton (the order poses use), its mesh topology and its normal maps.
 struct ModelInfo {
   std::string name;
@@ -72,6 +96,8 @@ struct ModelInfo {
   uint32_t coveredBodyOf = 0;
   std::vector<uint32_t> coveredBodyTriangles;
   float noveltyFlagAbove = 0, noveltyBlendStart = 0, noveltyBlendEnd = 0;
+  // Quality levels, level 0 full quality (CharacterBatch::setQualityLevel, planQualityLevels).
+  std::vector<QualityLevelInfo> qualityLevels;
 };
 
 // One vertex attribute of the deformed mesh. Character c's vertices start at
@@ -141,6 +167,7 @@ struct FrameReport {
   // guard), and how far the guard blended its shape towards the mean shape (0: not at all, 1: fully).
   std::vector<float> novelty, guardBlend;
   std::vector<uint32_t> novelCharacters;  // novelty above ModelInfo::noveltyFlagAbove
+  std::vector<uint32_t> qualityLevels;    // per character: the level it was recorded at (ModelInfo::qualityLevels)
 };
 
 // GPU time of each pass of a retired frame in milliseconds (NaN: not run or no timestamps).

@@ -11,6 +11,7 @@
 
 #include "swish/command.hpp"
 #include "swish/model/model_file.hpp"
+#include "swish/runtime/quality_levels.hpp"
 
 namespace swish::cli {
 
@@ -86,6 +87,7 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
                        {"blockIndices", db.indices.size()}};
   }
   j["temporalFilter"] = {{"timeConstantSeconds", m.temporalFilter.timeConstantSeconds}};
+  j["qualityLevels"] = swish::runtime::toJson(swish::runtime::ladderOf(m));
   json capsules = json::array();
   for (const BodyCapsule& c : m.bodyProxy.capsules)
     capsules.push_back(
@@ -125,6 +127,19 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
       << db.indices.size() << " block indices\n";
   }
   o << "  temporal      time constant " << m.temporalFilter.timeConstantSeconds << " s\n";
+  {
+    const swish::runtime::QualityLadder ladder = swish::runtime::ladderOf(m);
+    o << "  levels        " << ladder.size() << " quality levels"
+      << (ladder.measured() ? " measured on " + ladder.measuredOn : std::string(" (not measured: the default ladder)"))
+      << "\n";
+    for (size_t l = 0; l < ladder.size(); ++l) {
+      char line[200];
+      std::snprintf(line, sizeof line, "    %zu %-10s k %3u%s  vertex mean %.2f mm, p95 %.2f mm; CPU %.1f us\n", l,
+                    ladder[l].name.c_str(), ladder[l].meshComponents, ladder[l].normalMaps ? " + maps" : "        ",
+                    ladder[l].vertexMeanMm, ladder[l].vertexP95Mm, ladder[l].cpuUsPerCharacter);
+      o << line;
+    }
+  }
   o << "  body proxy    " << m.bodyProxy.capsules.size() << " capsules"
     << (m.bodyProxy.empty() ? " (no push-out at run time)" : " (the run-time push-out keeps the garment off them)")
     << "\n";

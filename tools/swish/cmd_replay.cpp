@@ -15,17 +15,21 @@
 // Exit codes: 0 all frames replayed and every check within tolerance; 3 replayed, but bad poses were
 // met or a GPU output differed from the CPU reference beyond tolerance (see the report); 1 an error
 // (bad scene, missing file, no device): nothing was written.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/replay/replay_job.hpp"
 #include "swish/replay/replay_render.hpp"
+#include "swish/runtime/level_planner.hpp"
 #include "swish/runtime/planner.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
 
 namespace {
@@ -39,7 +43,73 @@ struct ReplayCliOptions {
   bool pushOut = false, noGuard = false, hideCoveredBody = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
+  std::optional<double> frameBudgetMs, tolerancePixels;
+  std::string level;
 };
+
+// `--plan`'s quality levels: the planner on the first frame, each character at its placement (the clips'
+// root motion is not read without a replay); the budget needs costs, which only a replay calibrates, or
+// a ladder whose GPU times were measured.
+void printPlannedLevels(const swish::runtime::Scene& scene, swish::replay::ModelLibrary& models,
+                        const swish::runtime::ReplayPlan& plan, const ReplayCliOptions& o) {
+  using namespace swish;
+  std::vector<runtime::QualityLadder> ladders;
+  std::vector<const runtime::QualityLadder*> per;
+  std::vector<std::optional<uint32_t>> fixed;
+  std::vector<Eigen::Vector3d> roots;
+  std::vector<uint32_t> characters;
+  ladders.reserve(plan.batches.size());
+  for (const runtime::PlannedBatch& b : plan.batches) {
+    ladders.push_back(runtime::ladderOf(models.at(b.model).model));
+    if (!b.normalMaps)
+      for (runtime::QualityLevel& l : ladders.back().levels) l.normalMaps = false;
+  }
+  runtime::LevelCosts costs;
+  bool timed = true;
+  for (size_t b = 0; b < plan.batches.size(); ++b)
+    for (uint32_t c : plan.batches[b].characters) {
+      const runtime::SceneCharacter& ch = scene.characters[c];
+      per.push_back(&ladders[b]);
+      const std::string& name = o.level.empty() ? ch.level : o.level;
+      fixed.push_back(name.empty()
+                          ? std::nullopt
+                          : std::optional<uint32_t>(runtime::levelIndex(ladders[b], name, ch.name + " level")));
+      roots.push_back(ch.placement.translation + Eigen::Vector3d(0, 1, 0));
+      characters.push_back(c);
+      std::vector<double> ms;
+      for (const runtime::QualityLevel& l : ladders[b].levels) ms.push_back(l.gpuUsPerCharacter / 1000.0);
+      for (double v : ms) timed &= std::isfinite(v);
+      costs.msPerCharacter.push_back(ms);
+    }
+  if (per.empty()) return;
+  runtime::LevelPlannerSettings ls;
+  ls.camera = scene.levelCamera();
+  ls.frameBudgetMs = o.frameBudgetMs ? o.frameBudgetMs : scene.levels.frameBudgetMs;
+  ls.tolerancePixels = o.tolerancePixels ? o.tolerancePixels : scene.levels.tolerancePixels;
+  ls.holdFrames = uint32_t(std::lround(scene.levels.holdSeconds * scene.framesPerSecond));
+  runtime::LevelPlanner planner(per, fixed, ls);
+  if (timed) planner.setCosts(costs);
+  const runtime::PlannedLevels& p = planner.plan(scene.firstFrame, roots);
+  std::printf("\nQuality levels (first frame, characters at their placements):\n");
+  for (size_t b = 0; b < plan.batches.size(); ++b) {
+    std::printf("  model '%s' ladder:", plan.batches[b].model.c_str());
+    for (size_t l = 0; l < ladders[b].size(); ++l)
+      std::printf(" %zu %s (k %u%s)%s", l, ladders[b][l].name.c_str(), ladders[b][l].meshComponents,
+                  ladders[b][l].normalMaps ? ", maps" : "", l + 1 < ladders[b].size() ? "," : "\n");
+  }
+  if (ls.frameBudgetMs)
+    std::printf("  frame budget %.2f ms: %s\n", *ls.frameBudgetMs,
+                timed
+                    ? "costs from the ladder's measured GPU times"
+                    : "not applied here: the replay calibrates the costs on its device (the ladder has no GPU times)");
+  for (size_t s = 0; s < p.characters.size(); ++s) {
+    const runtime::LevelChoice& c = p.characters[s];
+    std::printf("  %-12s level %u %-10s %6.1f px tall at %5.1f m: %s\n", scene.characters[characters[s]].name.c_str(),
+                c.level, (*per[s])[c.level].name.c_str(), c.view.heightPixels, c.view.distance, c.reason.c_str());
+  }
+  if (std::isfinite(p.weightedErrorMm))
+    std::printf("  screen-weighted ladder error %.2f mm (full quality %.2f mm)\n", p.weightedErrorMm, p.fullErrorMm);
+}
 
 fs::path defaultScenePath() {
   std::error_code ec;
@@ -68,6 +138,7 @@ int runReplay(const ReplayCliOptions& o) {
                 scene.firstFrame + scene.frameCount - 1, scene.framesPerSecond);
     for (const auto& e : models.entries()) std::printf("Model '%s': %s\n", e->key.c_str(), e->label.c_str());
     std::printf("%s", plan.describe().c_str());
+    printPlannedLevels(scene, models, plan, o);
     return 0;
   }
   replay::ReplayJobOptions jo;
@@ -81,6 +152,9 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.penetrationEvery = o.penetrationEvery;
   jo.engine.pushOut = o.pushOut;
   jo.engine.noveltyGuard = !o.noGuard;
+  jo.engine.frameBudgetMs = o.frameBudgetMs;
+  jo.engine.tolerancePixels = o.tolerancePixels;
+  jo.engine.fixedLevel = o.level;
   const replay::ReplayJobResult r = replay::runReplayJob(scene, jo);
   if (!o.quiet) {
     std::printf("Replayed %zu frames of '%s' on %s.\n", r.result.frames.size(), scene.name.c_str(),
@@ -122,6 +196,25 @@ int runReplay(const ReplayCliOptions& o) {
                   measured, double(worst), o.noGuard ? "off (--no-guard)" : "on");
     else
       std::printf("Novelty: not measured (no model in the scene carries a novelty guard).\n");
+    const replay::ReplayResult& rr = r.result;
+    if (!rr.levels.empty() && !rr.frames.empty()) {
+      double gpu = 0, predicted = 0, weighted = 0, full = 0;
+      size_t nGpu = 0, nPred = 0, nErr = 0, changes = 0;
+      for (const auto& f : rr.frames) {
+        if (std::isfinite(f.times.gpuTotal)) gpu += f.times.gpuTotal, ++nGpu;
+        if (std::isfinite(f.predictedGpuMs)) predicted += f.predictedGpuMs, ++nPred;
+        if (std::isfinite(f.weightedErrorMm)) weighted += f.weightedErrorMm, full += f.fullErrorMm, ++nErr;
+        changes += f.levelChanges;
+      }
+      std::printf("Quality levels: %zu level changes", changes);
+      if (rr.frameBudgetMs) std::printf("; budget %.2f ms", *rr.frameBudgetMs);
+      if (nPred > 0) std::printf(", predicted %.2f ms", predicted / double(nPred));
+      if (nGpu > 0) std::printf(", measured GPU %.2f ms mean per frame", gpu / double(nGpu));
+      if (nErr > 0)
+        std::printf("; screen-weighted ladder error %.2f mm (full quality %.2f mm)", weighted / double(nErr),
+                    full / double(nErr));
+      std::printf(".\n");
+    }
   }
   if (o.render) {
     // After the replay's outputs are in place, so that a render failure never loses the report.
@@ -184,6 +277,16 @@ swish::cli::CommandRegistration reg{
                    "measure each character's novelty (how far its pose is from the model's training poses) but do "
                    "not apply the model's novelty guard (clamp of the mesh weights, blend towards the mean shape): "
                    "with --truth-every, shows what the guard does to the error");
+      app.add_option("--frame-budget-ms", o->frameBudgetMs,
+                     "GPU milliseconds per frame for all characters: the level planner steps characters down "
+                     "(small and far first) until its calibrated prediction fits (overrides the scene's "
+                     "levels.frameBudgetMs)");
+      app.add_option("--level-tolerance-px", o->tolerancePixels,
+                     "each character runs at the cheapest quality level whose mean error on screen is within "
+                     "this many pixels (overrides the scene's levels.tolerancePixels)");
+      app.add_option("--level", o->level,
+                     "every character at this quality level of its model's ladder (a name such as k64 or "
+                     "skinned, or an index; `swish inspect MODEL` lists them)");
       app.add_option("--frames", o->frames, "replay only this many frames");
       app.add_flag("--quiet", o->quiet, "no progress bar or summary");
       app.add_flag("--validation", o->validation, "enable the Vulkan validation layers");

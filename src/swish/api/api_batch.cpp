@@ -31,6 +31,15 @@ uint32_t retiredSlot(const BatchImpl& b, uint64_t frameIndex, uint32_t character
   return slot;
 }
 
+void ensureLadder(BatchImpl& b) {
+  if (!b.levels.empty()) return;
+  b.ladder = runtime::ladderOf(b.model->model);
+  if (!b.normalMaps)
+    for (runtime::QualityLevel& l : b.ladder.levels) l.normalMaps = false;
+  b.levels.assign(b.characters, 0);
+  b.hostLevel.assign(b.characters, false);
+}
+
 }  // namespace
 
 CharacterBatch::CharacterBatch(std::unique_ptr<BatchImpl> impl) : impl_(std::move(impl)) {}
@@ -77,6 +86,20 @@ FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex
       for (const Mat4f& m : model.skeleton.skinningMatrices(p)) b.inputs.skinMatrices.push_back(world * m);
     }
 
+    ensureLadder(b);
+    if (b.planner) {
+      b.roots.clear();
+      for (uint32_t c = 0; c < b.characters; ++c) {
+        const Mat4f world = toMat4f(poses[c].characterToWorld);
+        b.roots.push_back(world.block<3, 1>(0, 3).cast<double>());
+      }
+      const runtime::PlannedLevels& planned = b.planner->plan(frameIndex, b.roots);
+      for (uint32_t c = 0; c < b.characters; ++c)
+        if (!b.hostLevel[c] && planned.characters[c].level != b.levels[c]) {
+          b.levels[c] = planned.characters[c].level;
+          b.evaluator->setLevel(c, b.ladder[b.levels[c]]);
+        }
+    }
     const runtime::FrameOutput& out = b.evaluator->evaluate(b.rotations, b.dt);
     for (uint32_t c : out.invalidDt)
       report.warnings.push_back("character " + std::to_string(c) + ": negative or NaN dtSeconds treated as 0");
@@ -87,6 +110,9 @@ FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex
     report.guardBlend = out.guardBlend;
     report.novelCharacters = out.novel;
     b.inputs.meshWeights = out.meshWeights;
+    b.inputs.meshComponents.resize(b.characters);
+    for (uint32_t c = 0; c < b.characters; ++c) b.inputs.meshComponents[c] = b.ladder[b.levels[c]].meshComponents;
+    report.qualityLevels = b.levels;
     b.inputs.selectedMaps.clear();
     b.inputs.blendAlpha.clear();
     if (b.normalMaps) {
@@ -99,6 +125,47 @@ FrameReport CharacterBatch::recordFrame(VkCommandBuffer cmd, uint64_t frameIndex
     report.cpuMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return report;
+  });
+}
+
+void CharacterBatch::setQualityLevel(uint32_t character, uint32_t level) {
+  translateErrors(ErrorCode::InvalidArgument, [&] {
+    BatchImpl& b = *impl_;
+    ensureLadder(b);
+    if (character >= b.characters)
+      throw Error(ErrorCode::InvalidArgument,
+                  "setQualityLevel: character " + std::to_string(character) + " of " + std::to_string(b.characters));
+    if (level >= b.ladder.size())
+      throw Error(ErrorCode::InvalidArgument, "setQualityLevel: level " + std::to_string(level) + " of a ladder of " +
+                                                  std::to_string(b.ladder.size()) + " levels");
+    b.levels[character] = level;
+    b.hostLevel[character] = true;
+    b.evaluator->setLevel(character, b.ladder[level]);
+  });
+}
+
+uint32_t CharacterBatch::qualityLevel(uint32_t character) const {
+  if (character >= impl_->characters)
+    throw Error(ErrorCode::InvalidArgument,
+                "qualityLevel: character " + std::to_string(character) + " of " + std::to_string(impl_->characters));
+  return impl_->levels.empty() ? 0u : impl_->levels[character];
+}
+
+void CharacterBatch::planQualityLevels(const LevelPlanning& p) {
+  translateErrors(ErrorCode::InvalidArgument, [&] {
+    BatchImpl& b = *impl_;
+    ensureLadder(b);
+    runtime::LevelPlannerSettings s;
+    s.camera.position = Eigen::Vector3d(p.cameraPosition[0], p.cameraPosition[1], p.cameraPosition[2]);
+    s.camera.target = Eigen::Vector3d(p.cameraTarget[0], p.cameraTarget[1], p.cameraTarget[2]);
+    s.camera.verticalFovDegrees = p.verticalFovDegrees;
+    s.camera.imageHeightPixels = p.imageHeightPixels;
+    s.tolerancePixels = double(p.tolerancePixels);
+    s.holdFrames = p.holdFrames;
+    if (!(p.verticalFovDegrees >= 1.f && p.verticalFovDegrees <= 170.f) || !(p.imageHeightPixels >= 16.f))
+      throw Error(ErrorCode::InvalidArgument, "planQualityLevels: field of view 1..170 degrees, image >= 16 px");
+    b.planner.emplace(std::vector<const runtime::QualityLadder*>(b.characters, &b.ladder),
+                      std::vector<std::optional<uint32_t>>(b.characters), s);
   });
 }
 

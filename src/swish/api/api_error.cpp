@@ -3,6 +3,7 @@
 
 #include "swish/api/api_impl.hpp"
 #include "swish/core/skeleton.hpp"
+#include "swish/runtime/quality_levels.hpp"
 
 namespace swish::api {
 
@@ -75,6 +76,9 @@ ModelInfo describeModel(const swish::Model& m, const std::string& name) {
     info.noveltyBlendStart = m.noveltyGuard.blendStart;
     info.noveltyBlendEnd = m.noveltyGuard.blendEnd;
   }
+  for (const runtime::QualityLevel& l : runtime::ladderOf(m).levels)
+    info.qualityLevels.push_back({l.name, l.meshComponents, l.normalMaps, float(l.vertexMeanMm), float(l.vertexP95Mm),
+                                  float(l.normalMeanDeg), float(l.cpuUsPerCharacter), float(l.gpuUsPerCharacter)});
   return info;
 }
 

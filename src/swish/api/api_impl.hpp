@@ -13,6 +13,8 @@
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/model/model.hpp"
 #include "swish/runtime/frame_evaluator.hpp"
+#include "swish/runtime/level_planner.hpp"
+#include "swish/runtime/quality_levels.hpp"
 
 namespace swish::api {
 
@@ -45,6 +47,13 @@ struct BatchImpl {
   std::vector<Quatf> rotations;
   std::vector<float> dt;
   runtime::FrameKernelInputs inputs;
+  // Quality levels: the model's ladder, each character's level and whether the host set it, and the
+  // planner when swish chooses.
+  runtime::QualityLadder ladder;
+  std::vector<uint32_t> levels;
+  std::vector<bool> hostLevel;
+  std::optional<runtime::LevelPlanner> planner;
+  std::vector<Eigen::Vector3d> roots;
 };
 
 // Which public code an internal error maps to, given where it happened.

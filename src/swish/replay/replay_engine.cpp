@@ -65,10 +65,33 @@ struct Batch {
   std::unique_ptr<Character> bodyCharacter;
   std::string bodyNote;
   std::vector<bake::BodyCollider> colliders;
+  // Quality levels: the model's ladder, each instance's level this frame, and a one-character evaluator
+  // at full quality that gives truth frames the network's whole output (every level is measured from it).
+  runtime::QualityLadder ladder;
+  std::vector<uint32_t> levelOf;
+  std::optional<runtime::FrameEvaluator> probe;
   // Per frame scratch.
   std::vector<Pose> poses;
   runtime::FrameKernelInputs inputs;
 };
+
+// Instance i of the batch at every level of its ladder (the CPU reference), from the network's whole
+// output for its pose: what each level would have shown on this frame.
+std::vector<Points3f> levelPositions(Batch& B, uint32_t i) {
+  const runtime::FrameOutput& o = B.probe->evaluate(std::span<const Pose>(&B.poses[i], 1), 0.f);
+  const size_t jc = B.model->skeleton.size(), k = size_t(B.model->meshComponents());
+  runtime::FrameKernelInputs in;
+  in.instanceCount = 1;
+  in.pushOut = B.inputs.pushOut;
+  in.skinMatrices.assign(B.inputs.skinMatrices.begin() + i * jc, B.inputs.skinMatrices.begin() + (i + 1) * jc);
+  std::vector<Points3f> out;
+  for (const runtime::QualityLevel& l : B.ladder.levels) {
+    in.meshWeights.assign(o.meshWeights.begin(), o.meshWeights.begin() + k);
+    std::fill(in.meshWeights.begin() + l.meshComponents, in.meshWeights.end(), 0.f);
+    out.push_back(runtime::referencePositions(B.uploaded(), in, 0, in.pushOut));
+  }
+  return out;
+}
 
 // One character's truth simulation, waiting for a batch of them to run in parallel.
 struct TruthJob {
@@ -80,6 +103,8 @@ struct TruthJob {
   Points3f positions;
   std::optional<Points3f> withoutPushOut;  // the CPU reference's positions without the push-out (models with a proxy)
   std::optional<runtime::BlendedNormalMap> normalMap;
+  size_t batch = 0;
+  std::vector<Points3f> levelPositions;  // per level of the batch's ladder: the CPU reference's positions
 };
 
 struct ReplayEngine::Impl {
@@ -95,6 +120,12 @@ struct ReplayEngine::Impl {
   std::vector<TruthPool> truthPools;  // per scene character
   TruthPool truthOverall;
   uint32_t truthDone = 0, truthTotal = 0;
+  // Quality levels: the planner over every on-screen character, in plan order (batch, instance).
+  std::optional<runtime::LevelPlanner> levelPlanner;
+  std::vector<std::pair<size_t, uint32_t>> levelSlots;
+  std::vector<std::vector<std::vector<double>>> levelTruthMm;  // [batch][level]: every vertex distance
+  std::string levelCostsSource;
+  std::vector<std::string> firstReasons;
   // Penetration.
   std::vector<PenetrationSummary> penetrationPools;  // per scene character
   PenetrationSummary penetrationOverall;
@@ -102,6 +133,9 @@ struct ReplayEngine::Impl {
 
   Impl(const runtime::Scene& s, ModelLibrary& m, const ReplayOptions& o) : scene(s), models(m), options(o) {}
   void setUp();
+  void setUpLevels();
+  void calibrateLevels();
+  void applyLevels(uint64_t frame, const std::vector<std::vector<Pose>>& poses, FrameRecord& rec);
   bool truthFrame(uint32_t index) const;
   FrameRecord runFrame(uint32_t index, ReplayResult& result);
   void measurePenetration(FrameRecord& rec);
@@ -151,6 +185,7 @@ void ReplayEngine::Impl::setUp() {
       }
     }
   }
+  setUpLevels();
   if (!plan.gpuWork) return;
   if (options.context) {
     ctx = options.context;
@@ -183,6 +218,144 @@ void ReplayEngine::Impl::setUp() {
   }
 }
 
+void ReplayEngine::Impl::setUpLevels() {
+  const std::string where = scene.source.empty() ? std::string("scene") : scene.source.string();
+  std::vector<const runtime::QualityLadder*> ladders;
+  std::vector<std::optional<uint32_t>> fixed;
+  for (size_t b = 0; b < batches.size(); ++b) {
+    Batch& B = batches[b];
+    B.ladder = runtime::ladderOf(*B.model);
+    if (!B.planned->normalMaps)  // the plan uploads no maps: levels keep their components, without maps
+      for (runtime::QualityLevel& l : B.ladder.levels) l.normalMaps = false;
+    B.levelOf.assign(B.planned->characters.size(), 0);
+    if (options.truth.every > 0) {
+      runtime::FrameEvaluatorOptions eo;
+      eo.normalMaps = false;
+      eo.guard = options.noveltyGuard;
+      B.probe.emplace(*B.model, 1u, eo);
+    }
+    for (uint32_t i = 0; i < B.planned->characters.size(); ++i) {
+      const runtime::SceneCharacter& ch = scene.characters[B.planned->characters[i]];
+      const std::string& name = options.fixedLevel.empty() ? ch.level : options.fixedLevel;
+      fixed.push_back(name.empty() ? std::nullopt
+                                   : std::optional<uint32_t>(runtime::levelIndex(
+                                         B.ladder, name,
+                                         where + ": characters[" + std::to_string(B.planned->characters[i]) + "] ('" +
+                                             ch.name + "') level")));
+      levelSlots.emplace_back(b, i);
+    }
+  }
+  for (Batch& B : batches)
+    for (size_t i = 0; i < B.planned->characters.size(); ++i) ladders.push_back(&B.ladder);
+  runtime::LevelPlannerSettings ls;
+  ls.camera = scene.levelCamera();
+  ls.frameBudgetMs = options.frameBudgetMs ? options.frameBudgetMs : scene.levels.frameBudgetMs;
+  ls.tolerancePixels = options.tolerancePixels ? options.tolerancePixels : scene.levels.tolerancePixels;
+  ls.holdFrames = uint32_t(std::lround(scene.levels.holdSeconds * scene.framesPerSecond));
+  levelPlanner.emplace(std::move(ladders), std::move(fixed), ls);
+  levelTruthMm.resize(batches.size());
+  for (size_t b = 0; b < batches.size(); ++b) levelTruthMm[b].resize(batches[b].ladder.size());
+  levelCostsSource = ls.frameBudgetMs ? "not calibrated" : "no frame budget: the costs were not needed";
+}
+
+// The planner's costs: per batch and level, the GPU time of a frame with every character of the batch at
+// that level (median of a few frames of the scene's first poses) shared out per character. The
+// calibration's frames are thrown away: filters start again and decoded maps are forgotten.
+void ReplayEngine::Impl::calibrateLevels() {
+  if (!plan.gpuWork || !levelPlanner || !levelPlanner->settings().frameBudgetMs) return;
+  constexpr int kRepeats = 5;
+  std::vector<PoseIssue> ignored;
+  std::vector<std::vector<double>> perBatch(batches.size());
+  for (size_t b = 0; b < batches.size(); ++b) {
+    Batch& B = batches[b];
+    const uint32_t n = uint32_t(B.planned->characters.size());
+    const size_t jc = B.model->skeleton.size();
+    std::vector<Pose> poses;
+    B.inputs.instanceCount = n;
+    B.inputs.pushOut = options.pushOut;
+    B.inputs.skinMatrices.resize(n * jc);
+    for (uint32_t i = 0; i < n; ++i) {
+      poses.push_back(B.motions[i].poseAt(scene.timeOfFrame(scene.firstFrame), scene.firstFrame, ignored));
+      const auto mats = B.model->skeleton.skinningMatrices(poses.back());
+      std::copy(mats.begin(), mats.end(), B.inputs.skinMatrices.begin() + i * jc);
+    }
+    for (uint32_t l = 0; l < B.ladder.size(); ++l) {
+      std::vector<double> ms;
+      for (int r = 0; r < kRepeats + 1; ++r) {
+        for (uint32_t i = 0; i < n; ++i) {
+          B.frames->resetCharacter(i);
+          B.frames->setLevel(i, B.ladder[l]);
+        }
+        const runtime::FrameOutput& o = B.frames->evaluate(std::span<const Pose>(poses), 0.f);
+        B.inputs.meshWeights = o.meshWeights;
+        B.inputs.meshComponents.assign(n, B.ladder[l].meshComponents);
+        B.inputs.selectedMaps.clear();
+        B.inputs.blendAlpha.clear();
+        if (B.frames->hasNormalMaps())
+          for (uint32_t i = 0; i < n; ++i) {
+            B.inputs.selectedMaps.push_back(o.blend[i].selectedMap);
+            B.inputs.blendAlpha.push_back(o.blend[i].alpha);
+          }
+        VkCommandBuffer cmd = ctx->beginOneTime();
+        try {
+          B.recorder->forgetDecodedMaps();  // every repeat decodes its maps, as a first frame does
+          B.recorder->record(cmd, 0, B.inputs);
+        } catch (...) {
+          ctx->abandonOneTime(cmd);
+          throw;
+        }
+        ctx->endOneTimeAndWait(cmd);
+        if (r > 0) ms.push_back(B.recorder->stageTimes(0).totalMs);  // the first warms caches up
+      }
+      std::sort(ms.begin(), ms.end());
+      perBatch[b].push_back(ms[ms.size() / 2] / double(std::max(n, 1u)));
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+      B.frames->resetCharacter(i);
+      B.frames->setLevel(i, B.ladder[0]);
+    }
+    B.recorder->forgetDecodedMaps();
+  }
+  runtime::LevelCosts costs;
+  for (const auto& [b, i] : levelSlots) costs.msPerCharacter.push_back(perBatch[b]);
+  for (double v : costs.msPerCharacter.empty() ? std::vector<double>{} : costs.msPerCharacter[0])
+    if (!std::isfinite(v)) {
+      levelCostsSource = "not calibrated: the device has no timestamps";
+      return;
+    }
+  costs.source = "calibrated on " + ctx->deviceName() + ": the median of " + std::to_string(kRepeats) +
+                 " frames per level with every character at that level";
+  levelCostsSource = costs.source;
+  levelPlanner->setCosts(std::move(costs));
+}
+
+// Plans this frame's levels from each on-screen character's root in the world and hands them to the
+// evaluators and the GPU inputs.
+void ReplayEngine::Impl::applyLevels(uint64_t frame, const std::vector<std::vector<Pose>>& poses, FrameRecord& rec) {
+  std::vector<Eigen::Vector3d> roots;
+  roots.reserve(levelSlots.size());
+  for (const auto& [b, i] : levelSlots) {
+    const runtime::SceneCharacter& ch = scene.characters[batches[b].planned->characters[i]];
+    const Pose& p = poses[b][i];
+    roots.push_back(ch.placement.apply(p.rootTranslation));
+  }
+  const runtime::PlannedLevels& planned = levelPlanner->plan(frame, roots);
+  for (size_t s = 0; s < levelSlots.size(); ++s) {
+    const auto& [b, i] = levelSlots[s];
+    Batch& B = batches[b];
+    const uint32_t level = planned.characters[s].level;
+    if (level != B.levelOf[i] || frame == scene.firstFrame) B.frames->setLevel(i, B.ladder[level]);
+    B.levelOf[i] = level;
+    rec.levels.push_back(uint8_t(level));
+    rec.levelChanges += planned.characters[s].changed ? 1u : 0u;
+  }
+  if (firstReasons.empty())
+    for (const runtime::LevelChoice& c : planned.characters) firstReasons.push_back(c.reason);
+  rec.predictedGpuMs = planned.predictedMs;
+  rec.weightedErrorMm = planned.weightedErrorMm;
+  rec.fullErrorMm = planned.fullErrorMm;
+}
+
 bool ReplayEngine::Impl::truthFrame(uint32_t index) const {
   if (options.truth.every == 0 || index % options.truth.every != 0) return false;
   for (const Batch& B : batches)
@@ -202,7 +375,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
   for (Batch& B : batches) {
     const Model& m = *B.model;
     const uint32_t n = uint32_t(B.planned->characters.size());
-    const size_t jc = m.skeleton.size(), ts = size_t(m.thetaSize()), k = size_t(m.meshComponents());
+    const size_t jc = m.skeleton.size();
     auto t0 = Clock::now();
     std::vector<Pose>& poses = B.poses;
     poses.clear();
@@ -217,7 +390,19 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
       std::copy(mats.begin(), mats.end(), B.inputs.skinMatrices.begin() + i * jc);
     }
     t.pose += msSince(t0);
+  }
+  {
+    auto t0 = Clock::now();
+    std::vector<std::vector<Pose>> poses;
+    for (const Batch& B : batches) poses.push_back(B.poses);
+    applyLevels(rec.frame, poses, rec);
+    t.pose += msSince(t0);
+  }
 
+  for (Batch& B : batches) {
+    const Model& m = *B.model;
+    const uint32_t n = uint32_t(B.planned->characters.size());
+    std::vector<Pose>& poses = B.poses;
     const runtime::FrameOutput& o = B.frames->evaluate(std::span<const Pose>(poses), dt);
     t.theta += 1000.0 * o.timings.theta;
     t.mlp += 1000.0 * o.timings.mlp;
@@ -231,6 +416,8 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
         rec.novelty.push_back(
             {B.planned->characters[i], o.novelty[i], o.guardBlend[i], !(o.novelty[i] <= m.noveltyGuard.flagAbove)});
     B.inputs.meshWeights = o.meshWeights;
+    B.inputs.meshComponents.resize(n);
+    for (uint32_t i = 0; i < n; ++i) B.inputs.meshComponents[i] = B.ladder[B.levelOf[i]].meshComponents;
     B.inputs.selectedMaps.clear();
     B.inputs.blendAlpha.clear();
     if (B.frames->hasNormalMaps())
@@ -305,7 +492,11 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
             job.positions = gpuOut.positions[i];
             if (B.inputs.pushOut && !B.uploaded().bodyProxy.empty())
               job.withoutPushOut = runtime::referencePositions(B.uploaded(), B.inputs, i, false);
-            if (B.truth->normalMaps() && i < gpuOut.normalMaps.size()) job.normalMap = gpuOut.normalMaps[i];
+            if (B.truth->normalMaps() && i < gpuOut.normalMaps.size() && B.inputs.selectedMaps.size() > i &&
+                B.inputs.selectedMaps[i] != runtime::kNoMap)
+              job.normalMap = gpuOut.normalMaps[i];
+            job.batch = b;
+            job.levelPositions = levelPositions(B, i);
             rec.truth.push_back({});
             rec.truth.back().character = job.character;
             rec.truth.back().failure = "not simulated yet";
@@ -385,6 +576,11 @@ void ReplayEngine::Impl::runTruth(ReplayResult& result) {
   for (size_t k = 0; k < truthJobs.size(); ++k) {
     const TruthJob& j = truthJobs[k];
     out[k].summary.character = j.character;
+    if (out[k].summary.ok)
+      for (size_t l = 0; l < j.levelPositions.size(); ++l)
+        for (Eigen::Index v = 0; v < j.levelPositions[l].rows(); ++v)
+          levelTruthMm[j.batch][l].push_back(
+              1000.0 * double((j.levelPositions[l].row(v) - out[k].truthPositions.row(v)).norm()));
     result.frames[j.frame].truth[j.slot] = out[k].summary;
     truthPools[j.character].add(out[k]);
     truthOverall.add(out[k]);
@@ -452,6 +648,7 @@ ReplayResult ReplayEngine::run() {
   // Truth simulations wait until a few frames' worth can run in parallel (bounded memory: a job holds
   // one character's output and normal map).
   const size_t truthBatch = size_t(std::max(16, 4 * tbb::this_task_arena::max_concurrency()));
+  I.calibrateLevels();
   for (uint32_t f = 0; f < I.scene.frameCount; ++f) {
     r.frames.push_back(I.runFrame(f, r));
     if (r.frames.back().truthFrame) ++r.truthFrames;
@@ -471,6 +668,40 @@ ReplayResult ReplayEngine::run() {
     r.penetrationOverall = I.penetrationOverall;
   }
   r.penetrationSeconds = I.penetrationSeconds;
+  // Quality levels.
+  if (I.levelPlanner) {
+    const runtime::LevelPlannerSettings& ls = I.levelPlanner->settings();
+    r.frameBudgetMs = ls.frameBudgetMs;
+    r.tolerancePixels = ls.tolerancePixels;
+    r.levelHoldFrames = ls.holdFrames;
+    r.levelCostsSource = I.levelCostsSource;
+    r.levelReasons = I.firstReasons;
+    for (const auto& [b, i] : I.levelSlots) r.levelCharacters.push_back(I.batches[b].planned->characters[i]);
+    for (size_t b = 0; b < I.batches.size(); ++b) {
+      ModelLevels ml;
+      ml.model = I.batches[b].planned->model;
+      ml.ladder = I.batches[b].ladder;
+      const runtime::LevelCosts& costs = I.levelPlanner->costs();
+      for (size_t s = 0; s < I.levelSlots.size() && !costs.empty(); ++s)
+        if (I.levelSlots[s].first == b) {
+          ml.calibratedMsPerCharacter = costs.msPerCharacter[s];
+          break;
+        }
+      for (std::vector<double>& mm : I.levelTruthMm[b]) {
+        if (mm.empty()) continue;
+        LevelTruth t;
+        t.samples = uint32_t(mm.size());
+        double sum = 0;
+        for (double v : mm) sum += v;
+        t.meanMm = sum / double(mm.size());
+        std::sort(mm.begin(), mm.end());
+        t.p95Mm = mm[std::min(mm.size() - 1, size_t(0.95 * double(mm.size())))];
+        t.maxMm = mm.back();
+        ml.truth.push_back(t);
+      }
+      r.levels.push_back(std::move(ml));
+    }
+  }
   // With validation on, a validation message is a failure of the run like a wrong output.
   if (I.ctx && I.ctx->validationEnabled())
     for (const std::string& m : I.ctx->validationMessages()) r.failures.push_back("Vulkan validation: " + m);

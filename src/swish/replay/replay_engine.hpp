@@ -24,6 +24,7 @@
 // truth; ReplayResult::truthNote says why.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,9 @@
 #include "swish/replay/character_motion.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/replay/truth_simulation.hpp"
+#include "swish/runtime/level_planner.hpp"
 #include "swish/runtime/planner.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/scene.hpp"
 
@@ -48,6 +51,10 @@ struct ReplayOptions {
   // without the push-out) on every Nth frame; 0: not measured.
   uint32_t penetrationEvery =
       30;  // the CPU measure poses a body collider per character: every frame would dwarf the replay
+  // Quality levels (runtime/level_planner.hpp): overrides of the scene's "levels" (nullopt: the scene's).
+  std::optional<double> frameBudgetMs;
+  std::optional<double> tolerancePixels;
+  std::string fixedLevel;  // every character at this level of its model's ladder (name or index); empty: planned
   std::function<void(uint32_t framesDone, uint32_t framesTotal)> progress;
   // Truth simulations done of those planned (called from worker threads, one call at a time).
   std::function<void(uint32_t posesDone, uint32_t posesTotal)> truthProgress;
@@ -92,6 +99,19 @@ struct CharacterNovelty {
   bool flagged = false;
 };
 
+// One model's quality ladder in the replay, and the error of every level against the ground truth of
+// the frames with truth (every level reconstructed on the CPU from the same network output).
+struct LevelTruth {
+  uint32_t samples = 0;  // vertex distances pooled (vertices x measured character frames)
+  double meanMm = 0, p95Mm = 0, maxMm = 0;
+};
+struct ModelLevels {
+  std::string model;
+  runtime::QualityLadder ladder;
+  std::vector<double> calibratedMsPerCharacter;  // per level: the GPU ms one character adds (empty: not calibrated)
+  std::vector<LevelTruth> truth;                 // per level (empty without truth)
+};
+
 struct PenetrationSummary {
   bake::PenetrationPool model, pushed;
   bool pushedMeasured = false;
@@ -108,6 +128,11 @@ struct FrameRecord {
   std::vector<CharacterTruth> truth;              // when truthFrame: per on-screen character with truth, plan order
   std::vector<CharacterPenetration> penetration;  // per on-screen character with a body, plan order (measured frames)
   std::vector<CharacterNovelty> novelty;          // per on-screen character of a model with a guard, plan order
+  std::vector<uint8_t> levels;                    // per on-screen character, plan order: its quality level
+  uint32_t levelChanges = 0;                      // characters whose level changed this frame
+  double predictedGpuMs = 0;                      // the level planner's prediction (NaN: no costs)
+  double weightedErrorMm = 0;                     // screen-weighted ladder error of the chosen levels (NaN: unmeasured)
+  double fullErrorMm = 0;                         // the same at full quality
   double maxPositionErrorMm() const;
   double maxNormalErrorDeg() const;
   int maxMapErrorSteps() const;
@@ -143,6 +168,14 @@ struct ReplayResult {
   PenetrationSummary penetrationOverall;
   double penetrationSeconds = 0;  // wall time of the measurements
   bool noveltyGuard = true;       // the guards were applied (ReplayOptions::noveltyGuard)
+  // Quality levels.
+  std::vector<ModelLevels> levels;        // per batch, plan order
+  std::vector<uint32_t> levelCharacters;  // scene character of each FrameRecord::levels entry
+  std::vector<std::string> levelReasons;  // the first frame's reason per entry
+  std::optional<double> frameBudgetMs;    // the budget the planner spent (nullopt: none)
+  std::optional<double> tolerancePixels;
+  uint32_t levelHoldFrames = 0;
+  std::string levelCostsSource;  // where the planner's costs came from, or why there were none
   bool failed() const { return !failures.empty() || issueCount > 0; }
 };
 

@@ -4,6 +4,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <utility>
@@ -11,6 +12,7 @@
 
 #include "swish/files/atomic_write.hpp"
 #include "swish/io/svg_plot.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
 
 namespace swish::replay {
@@ -56,6 +58,13 @@ std::string fmt(double v, const char* f = "%.4g") {
   return s;
 }
 double num(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
+double finiteMean(const std::vector<double>& v) {
+  double sum = 0;
+  size_t n = 0;
+  for (double x : v)
+    if (std::isfinite(x)) sum += x, ++n;
+  return n ? sum / double(n) : NAN;
+}
 
 // Pooled ground truth; figures only where something was measured (null would read as zero error).
 json truthJson(const TruthSummary& t) {
@@ -194,6 +203,12 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
                                  {"blend", nv.blend},
                                  {"flagged", nv.flagged}});
     }
+    if (!f.levels.empty()) {
+      fj["levels"] = f.levels;
+      fj["levelChanges"] = f.levelChanges;
+      fj["predictedGpuMs"] = f.predictedGpuMs;
+      fj["weightedErrorMm"] = f.weightedErrorMm;
+    }
     if (f.checked)
       fj["gpuVsCpu"] = {{"maxPositionErrorMm", f.maxPositionErrorMm()},
                         {"maxNormalErrorDeg", f.maxNormalErrorDeg()},
@@ -254,6 +269,71 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
                                {"max", *std::max_element(v.begin(), v.end())},
                                {"framesFlagged", flaggedPerChar[c]}};
     }
+  }
+  // Quality levels: each model's ladder (with the calibrated cost and the truth per level), each
+  // character's levels over the replay, and the budget against the measured GPU time.
+  {
+    json lv = {{"frameBudgetMs", r.frameBudgetMs ? json(*r.frameBudgetMs) : json(nullptr)},
+               {"tolerancePixels", r.tolerancePixels ? json(*r.tolerancePixels) : json(nullptr)},
+               {"holdFrames", r.levelHoldFrames},
+               {"costs", r.levelCostsSource},
+               {"models", json::array()},
+               {"characters", json::array()}};
+    for (const ModelLevels& m : r.levels) {
+      json mj{{"model", m.model}, {"ladder", runtime::toJson(m.ladder)}};
+      if (!m.calibratedMsPerCharacter.empty()) mj["calibratedMsPerCharacter"] = m.calibratedMsPerCharacter;
+      if (!m.truth.empty()) {
+        mj["truth"] = json::array();
+        for (size_t l = 0; l < m.truth.size(); ++l)
+          mj["truth"].push_back({{"level", m.ladder[l].name},
+                                 {"vertexDistances", m.truth[l].samples},
+                                 {"meanMm", m.truth[l].meanMm},
+                                 {"p95Mm", m.truth[l].p95Mm},
+                                 {"maxMm", m.truth[l].maxMm}});
+      }
+      lv["models"].push_back(mj);
+    }
+    const size_t window = size_t(std::max(1.0, std::round(scene.framesPerSecond)));
+    for (size_t s = 0; s < r.levelCharacters.size(); ++s) {
+      const uint32_t c = r.levelCharacters[s];
+      std::map<int, uint32_t> counts;
+      std::vector<size_t> changeFrames;
+      for (size_t f = 0; f < r.frames.size(); ++f) {
+        if (s >= r.frames[f].levels.size()) continue;
+        ++counts[r.frames[f].levels[s]];
+        if (f > 0 && s < r.frames[f - 1].levels.size() && r.frames[f].levels[s] != r.frames[f - 1].levels[s])
+          changeFrames.push_back(f);
+      }
+      size_t worst = 0;  // most changes within any one second of frames
+      for (size_t a = 0; a < changeFrames.size(); ++a) {
+        size_t b = a;
+        while (b < changeFrames.size() && changeFrames[b] < changeFrames[a] + window) ++b;
+        worst = std::max(worst, b - a);
+      }
+      json cj{{"name", scene.characters[c].name},
+              {"firstReason", s < r.levelReasons.size() ? r.levelReasons[s] : std::string()},
+              {"changes", changeFrames.size()},
+              {"maxChangesPerSecond", worst},
+              {"framesPerLevel", json::object()}};
+      for (const auto& [l, n] : counts) cj["framesPerLevel"][std::to_string(l)] = n;
+      lv["characters"].push_back(cj);
+    }
+    std::vector<double> predicted, measured, weighted, full;
+    size_t over = 0;
+    for (const auto& f : r.frames) {
+      if (f.levels.empty()) continue;
+      predicted.push_back(f.predictedGpuMs);
+      measured.push_back(f.times.gpuTotal);
+      weighted.push_back(f.weightedErrorMm);
+      full.push_back(f.fullErrorMm);
+      if (r.frameBudgetMs && std::isfinite(f.times.gpuTotal) && f.times.gpuTotal > *r.frameBudgetMs) ++over;
+    }
+    lv["summary"] = {{"medianPredictedGpuMs", quantile(predicted, 0.5)},
+                     {"medianGpuMs", quantile(measured, 0.5)},
+                     {"framesOverBudget", over},
+                     {"meanWeightedErrorMm", finiteMean(weighted)},
+                     {"meanFullErrorMm", finiteMean(full)}};
+    j["levels"] = lv;
   }
   j["characters"] = perChar;
   json summary;
@@ -358,6 +438,61 @@ std::string reportMarkdown(const json& j) {
       }
       s << "![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
     }
+  }
+  if (j.contains("levels") && !j["levels"]["models"].empty()) {
+    const json& lv = j["levels"];
+    s << "## Quality levels\n\n";
+    s << "Each character runs at a level of its model's ladder (full quality down to the mean shape skinned), "
+         "chosen per frame by the level planner from its size on screen"
+      << (lv["frameBudgetMs"].is_number() ? " and the frame budget of " + fmt(num(lv["frameBudgetMs"])) + " GPU ms"
+                                          : std::string(" (no frame budget)"))
+      << (lv["tolerancePixels"].is_number()
+              ? ", at the cheapest level within " + fmt(num(lv["tolerancePixels"])) + " px of error on screen"
+              : std::string(""))
+      << "; a character keeps a level at least " << lv["holdFrames"]
+      << " frames. Costs: " << lv["costs"].get<std::string>() << ".\n\n";
+    for (const auto& m : lv["models"]) {
+      const json& ladder = m["ladder"];
+      s << "Model `" << m["model"].get<std::string>() << "`: errors measured on "
+        << (ladder["poses"].get<uint32_t>() > 0 ? ladder["measured_on"].get<std::string>()
+                                                : std::string("nothing (the model's ladder is not measured)"))
+        << ".\n\n| level | components | normal maps | vertex mean / p95 mm (ladder) | normal deg | CPU us per "
+           "character | GPU ms per character (calibrated) | vertex mean / p95 mm against truth here |\n"
+           "|---|---:|---|---:|---:|---:|---:|---:|\n";
+      for (size_t l = 0; l < ladder["levels"].size(); ++l) {
+        const json& e = ladder["levels"][l];
+        s << "| " << l << " " << e["name"].get<std::string>() << " | " << e["mesh_components"] << " | "
+          << (e["normal_maps"].get<bool>() ? "yes" : "no") << " | " << fmt(num(e["vertex_mean_mm"]), "%.2f") << " / "
+          << fmt(num(e["vertex_p95_mm"]), "%.2f") << " | " << fmt(num(e["normal_mean_deg"]), "%.2f") << " | "
+          << fmt(num(e["cpu_us_per_character"]), "%.1f") << " | "
+          << (m.contains("calibratedMsPerCharacter") ? fmt(num(m["calibratedMsPerCharacter"][l]), "%.3f") : "-")
+          << " | "
+          << (m.contains("truth") && l < m["truth"].size()
+                  ? fmt(num(m["truth"][l]["meanMm"]), "%.2f") + " / " + fmt(num(m["truth"][l]["p95Mm"]), "%.2f")
+                  : std::string("-"))
+          << " |\n";
+      }
+      s << "\n";
+    }
+    const json& sm = lv["summary"];
+    s << "Per frame (medians): predicted GPU " << fmt(num(sm["medianPredictedGpuMs"]), "%.3f") << " ms, measured GPU "
+      << fmt(num(sm["medianGpuMs"]), "%.3f") << " ms";
+    if (lv["frameBudgetMs"].is_number())
+      s << "; " << sm["framesOverBudget"] << " frames measured over the budget of " << fmt(num(lv["frameBudgetMs"]))
+        << " ms";
+    s << ". Screen-weighted ladder error of the chosen levels " << fmt(num(sm["meanWeightedErrorMm"]), "%.2f")
+      << " mm against " << fmt(num(sm["meanFullErrorMm"]), "%.2f")
+      << " mm at full quality (mean over frames; the weight is each character's projected area).\n\n"
+      << "![levels per frame](plots/levels_per_frame.svg)\n\n"
+      << "| character | level on the first frame, and why | frames per level | changes | most changes in one "
+         "second |\n|---|---|---|---:|---:|\n";
+    for (const auto& c : lv["characters"]) {
+      std::string per;
+      for (const auto& [l, n] : c["framesPerLevel"].items()) per += (per.empty() ? "" : ", ") + l + ": " + n.dump();
+      s << "| " << c["name"].get<std::string>() << " | " << c["firstReason"].get<std::string>() << " | " << per << " | "
+        << c["changes"] << " | " << c["maxChangesPerSecond"] << " |\n";
+    }
+    s << "\n";
   }
   {
     const json& nv = j["novelty"];
@@ -605,6 +740,36 @@ void writeReport(const std::filesystem::path& dir, const runtime::Scene& scene, 
     writeTextFileAtomic(
         dir / "plots/penetration_per_frame.svg",
         plot("Garment inside the body, worst character per frame", "scene frame", "mm; vertices / 10", ps));
+  }
+  if (!r.levelCharacters.empty()) {
+    // Levels over time: up to 12 characters one line each, else the mean level; the budget's prediction
+    // and the measured GPU time beside them.
+    std::vector<PlotSeries> ls;
+    if (r.levelCharacters.size() <= 12) {
+      for (uint32_t c : r.levelCharacters) ls.push_back({scene.characters[c].name, {}, {}, ""});
+      for (const auto& f : r.frames)
+        for (size_t s = 0; s < f.levels.size() && s < ls.size(); ++s)
+          ls[s].x.push_back(f.frame), ls[s].y.push_back(f.levels[s]);
+    } else {
+      PlotSeries mean{"mean level over characters", {}, {}, ""}, worst{"cheapest level", {}, {}, ""};
+      for (const auto& f : r.frames) {
+        if (f.levels.empty()) continue;
+        double sum = 0, mx = 0;
+        for (uint8_t l : f.levels) sum += l, mx = std::max(mx, double(l));
+        mean.x.push_back(f.frame), mean.y.push_back(sum / double(f.levels.size()));
+        worst.x.push_back(f.frame), worst.y.push_back(mx);
+      }
+      ls = {mean, worst};
+    }
+    PlotSeries predicted{"predicted GPU ms", {}, {}, ""}, measured{"measured GPU ms", {}, {}, ""};
+    for (const auto& f : r.frames)
+      if (!f.levels.empty())
+        predicted.x.push_back(f.frame), predicted.y.push_back(f.predictedGpuMs), measured.x.push_back(f.frame),
+            measured.y.push_back(f.times.gpuTotal);
+    if (!predicted.x.empty()) ls.push_back(predicted);
+    ls.push_back(measured);
+    writeTextFileAtomic(dir / "plots/levels_per_frame.svg",
+                        plot("Quality level per character (0 = full) and GPU time", "scene frame", "level; ms", ls));
   }
   io::SvgBarChart stages;
   stages.title = "Median time per stage", stages.unit = "ms";
