@@ -102,7 +102,7 @@ const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::V
     const QualityLadder& ladder = *ladders_[c];
     if (fixed_[c]) {
       level[c] = *fixed_[c];
-      ch.reason = "fixed by the scene";
+      ch.reason = "fixed (the scene's level or --level)";
       continue;
     }
     const bool held = !first_ && frame < lastChange_[c] + settings_.holdFrames;

@@ -237,7 +237,7 @@ TEST(LevelPlanner, HoldsALevelAndKeepsFixedOnes) {
   const PlannedLevels& p = planner.plan(10, roots);
   EXPECT_EQ(p.characters[0].level, 2u);
   EXPECT_TRUE(p.characters[0].changed);
-  EXPECT_EQ(p.characters[1].reason, "fixed by the scene");
+  EXPECT_EQ(p.characters[1].reason, "fixed (the scene's level or --level)");
   EXPECT_NE(test::errorOf([&] { LevelPlanner bad({&ladder}, {7u}, s); }).find("level 7"), std::string::npos);
   EXPECT_EQ(levelIndex(ladder, "L2", "x"), 2u);
   EXPECT_EQ(levelIndex(ladder, "3", "x"), 3u);
