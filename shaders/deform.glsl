@@ -31,6 +31,17 @@
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
+//
+// Quality levels (runtime/quality_levels.hpp): instance i reconstructs from its first k_i components
+// only. The work shrinks per instance in this one dispatch, without a pipeline per level: instance i
+// reads instanceGroups[i] = ceil(k_i / 4) vec4 groups of weights (one word per instance, the same
+// address in every thread, so lavapipe's SIMD lanes and a GPU's waves all take the same side of the
+// `q < groups` branches), and every vertex loads only the first maxGroups groups of its basis (a push
+// constant: a frame whose characters are all cheap reads less of the basis, the largest input). The
+// weights of instance i from k_i to the end of its last group are zero (DeformPass::packWeights), so a
+// group read whole adds exact zeros: the sum is the reference's sum over k < k_i, k ascending. The
+// loops stay unrolled with uniform branches inside, rather than a loop bounded by `groups`, so that
+// `basis` keeps constant indices (registers); a level is a branch skipped, not a different loop.
 #include "swish_buffers.glsl"
 #include "swish_layouts.h"
 
@@ -52,18 +63,31 @@ void main() {
   if (v >= p.vertexCount) return;
   const uint n3 = p.vertexCount * 3u;
 
+  // Groups of the basis loaded: as many as the instance reading most reads (the min keeps a maxGroups
+  // beyond the K4 groups there are in range; the per-instance min below keeps unloaded entries unread).
+  const uint loadGroups = min(p.maxGroups, K4);
   float basis[3 * K];
   uint joints[INFLUENCES];
   float skinW[INFLUENCES];
   FloatsIn meanBuf = FloatsIn(p.mean);
   const vec3 mean = vec3(meanBuf.v[3u * v], meanBuf.v[3u * v + 1u], meanBuf.v[3u * v + 2u]);
 #ifdef SWISH_DEFORM_BASIS_TEXELS
-  [[unroll]] for (uint k = 0u; k < K; ++k)
-    [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = texelFetch(basisTexels, int(k * n3 + 3u * v + a)).x;
+  [[unroll]] for (uint k = 0u; k < K; ++k) {
+    if (k / 4u < loadGroups) {
+      [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = texelFetch(basisTexels, int(k * n3 + 3u * v + a)).x;
+    } else {
+      [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = 0.0;
+    }
+  }
 #else
   FloatsIn basisBuf = FloatsIn(p.basis);
-  [[unroll]] for (uint k = 0u; k < K; ++k)
-    [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = basisBuf.v[k * n3 + 3u * v + a];
+  [[unroll]] for (uint k = 0u; k < K; ++k) {
+    if (k / 4u < loadGroups) {
+      [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = basisBuf.v[k * n3 + 3u * v + a];
+    } else {
+      [[unroll]] for (uint a = 0u; a < 3u; ++a) basis[3u * k + a] = 0.0;
+    }
+  }
 #endif
   UintsIn jointBuf = UintsIn(p.skinJoints);
   FloatsIn skinWeightBuf = FloatsIn(p.skinWeights);
@@ -73,13 +97,19 @@ void main() {
   }
 
   FloatsOut outBuf = FloatsOut(p.positionsOut);
+  const bool perInstanceGroups = p.instanceGroups != uvec2(0u);
+  UintsIn groupsBuf = UintsIn(p.instanceGroups);
   for (uint instance = 0u; instance < p.instanceCount; ++instance) {
+    // The same word in every thread.
+    const uint groups = perInstanceGroups ? min(groupsBuf.v[instance], loadGroups) : loadGroups;
     precise vec3 x = mean;
     [[unroll]] for (uint q = 0u; q < K4; ++q) {
-      const vec4 w4 = texelFetch(weightTexels, int(instance * K4 + q));  // the same texel in every thread
-      [[unroll]] for (uint j = 0u; j < 4u; ++j) {
-        const uint k = 4u * q + j;
-        if (k < K) x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w4[j];
+      if (q < groups) {
+        const vec4 w4 = texelFetch(weightTexels, int(instance * K4 + q));  // the same texel in every thread
+        [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+          const uint k = 4u * q + j;
+          if (k < K) x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w4[j];
+        }
       }
     }
     precise vec3 y = x;

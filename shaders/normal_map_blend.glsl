@@ -12,6 +12,9 @@
 // format lane by lane; the buffers, the copy and the exact dispatch below are measurably faster
 // (docs/performance.md, "Normal-map blend", for this and the choices below).
 //
+// Each character blends one layer: character c's own (layer c), or layers[c] where the pass is given a
+// list (FrameRecorder leaves out characters without a map this frame).
+//
 // One invocation per column of ROWS x 4 texels of one character (ROWS block rows of 4 texels, a
 // multiple of 4: maps are multiples of 4; NormalMapBlendPass picks 16, 8 or 4, the largest dividing the
 // map height): the character's slot and alpha are loaded once for 4 * ROWS texels, and each row is ONE
@@ -61,11 +64,14 @@ void main() {
   const uint character = gl_GlobalInvocationID.z;  // the dispatch has characterCount layers
   if (!EXACT && bx >= blocksX) return;
   const NormalMapBlendCharacter ch = Characters(p.characters).c[character];
+  // Characters at a quality level without normal maps are left out of the dispatch: the others name
+  // their layers, and the left-out layers are neither read nor written.
+  const uint layer = p.layers == uvec2(0u) ? character : UintsIn(p.layers).v[character];
   const uint rowsPerMap = p.height * blocksX;  // block rows of 4 texels
   for (uint r = 0u; r < ROWS; ++r) {
     const uint row = (y0 + r) * blocksX + bx;
     const uvec2 words = texelFetch(decodedRows, int(ch.decodedSlot * rowsPerMap + row)).xy;
-    const uint at = character * rowsPerMap + row;
+    const uint at = layer * rowsPerMap + row;
     const uvec4 prev = texelFetch(prevRows, int(at));
     uvec4 blendedRow;
     for (uint i = 0u; i < 4u; ++i) {

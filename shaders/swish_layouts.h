@@ -7,7 +7,9 @@
 //   positions/normals : float[instance][vertex][3]   (same as swish::Points3f rows, one block per instance)
 //   tangents          : float[instance][vertex][4]   (xyz tangent, w = bitangent sign)
 //   PCA mean          : float[3N];  PCA basis: float[k][3N] (column-major 3N x K, as Eigen stores MeshPca::basis)
-//   mesh weights      : float[instance][K4], K4 = K rounded up to 4, zero padded (read as vec4 texels)
+//   mesh weights      : float[instance][K4], K4 = K rounded up to 4, zero padded (read as vec4 texels);
+//                       an instance at a quality level of k < K components has zeros from k on
+//   instance groups   : uint[instance], the vec4 groups of mesh weights each instance reads, ceil(k / 4)
 //   skin matrix rows  : vec4[instance][joint][3], rows 0..2 of each affine skinning matrix (texels)
 //   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
 //   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
@@ -38,18 +40,22 @@ struct alignas(8) Address {
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
 // push-out of the posed body proxy (runtime/reference_push_out.hpp). The mesh weights
 // (float[instanceCount][K4]) and skin matrix rows (vec4[instanceCount][jointCount][3]) are texel
-// buffers of its descriptor set.
+// buffers of its descriptor set. Quality levels: instance i reads only its first instanceGroups[i]
+// vec4 groups of weights, and every vertex loads only the first maxGroups groups of its basis.
 struct DeformParams {
-  SWISH_ADDRESS mean;           // float[3N]
-  SWISH_ADDRESS basis;          // float[K][3N]
-  SWISH_ADDRESS skinJoints;     // uint[N][influences]
-  SWISH_ADDRESS skinWeights;    // float[N][influences]
-  SWISH_ADDRESS positionsOut;   // float[instanceCount][N][3]
-  SWISH_ADDRESS capsules;       // float[instanceCount][capsuleCount][8]: posed capsules (unused when 0)
+  SWISH_ADDRESS mean;            // float[3N]
+  SWISH_ADDRESS basis;           // float[K][3N]
+  SWISH_ADDRESS skinJoints;      // uint[N][influences]
+  SWISH_ADDRESS skinWeights;     // float[N][influences]
+  SWISH_ADDRESS positionsOut;    // float[instanceCount][N][3]
+  SWISH_ADDRESS capsules;        // float[instanceCount][capsuleCount][8]: posed capsules (unused when 0)
+  SWISH_ADDRESS instanceGroups;  // uint[instanceCount]: weight groups each instance reads; 0: maxGroups each
   uint vertexCount;
   uint instanceCount;
   uint jointCount;
-  uint capsuleCount;            // 0: no push-out
+  uint capsuleCount;             // 0: no push-out
+  uint maxGroups;                // the most groups an instance reads (K4 / 4 without instanceGroups)
+  uint pad0;
 };
 
 // tangent_frames.comp: normals and tangents of deformed meshes, one thread per (vertex, instance).
@@ -94,6 +100,7 @@ struct NormalMapBlendCharacter {
 // descriptor set, beside the previous and current images.
 struct NormalMapBlendParams {
   SWISH_ADDRESS characters;   // NormalMapBlendCharacter[characterCount]
+  SWISH_ADDRESS layers;       // uint[characterCount]: the layer (of prev and out) of each character; 0: c -> c
   uint width;
   uint height;
   uint characterCount;
@@ -110,13 +117,14 @@ struct CopyVec4Params {
 
 #ifdef __cplusplus
 static_assert(sizeof(Address) == 8);
-static_assert(sizeof(DeformParams) == 6 * 8 + 16);
+static_assert(sizeof(DeformParams) == 7 * 8 + 24);
 static_assert(sizeof(TangentFramesParams) == 9 * 8 + 16);
 static_assert(sizeof(VqDecodeParams) == 5 * 8 + 16);
 static_assert(sizeof(NormalMapBlendCharacter) == 8);
-static_assert(sizeof(NormalMapBlendParams) == 8 + 16);
+static_assert(sizeof(NormalMapBlendParams) == 2 * 8 + 16);
 static_assert(sizeof(CopyVec4Params) == 2 * 8 + 8);
-static_assert(sizeof(TangentFramesParams) <= 128, "push constants: 128 bytes are all Vulkan guarantees");
+static_assert(sizeof(TangentFramesParams) <= 128 && sizeof(DeformParams) <= 128,
+              "push constants: 128 bytes are all Vulkan guarantees");
 }  // namespace swish::gpu::layout
 #undef SWISH_ADDRESS
 #endif

@@ -1,20 +1,24 @@
 // Conformance of the deform kernel (shaders/deform.comp via gpu::DeformPass) to its CPU references:
 // runtime::referencePcaReconstruct (skinning off) and runtime::referenceSkin (skinning on), on seeded
 // random models (seed printed; SWISH_TEST_SEED overrides), odd sizes, many instances, NaN/Inf inputs
-// and exactly representable inputs. Every output is followed by guard words; every input is checked
-// unchanged afterwards.
+// and exactly representable inputs; and at quality levels (runtime/quality_levels.hpp): every level of
+// the default ladder, and mixed per-instance levels in one dispatch. Every output is followed by guard
+// words; every input is checked unchanged afterwards.
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <ostream>
 
+#include "support/error_message.hpp"
 #include "support/gpu_buffers.hpp"
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
 #include "swish/gpu/deform_pass.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_pca.hpp"
 #include "swish/runtime/reference_skinning.hpp"
 
@@ -38,6 +42,11 @@ struct DeformInputs {
   std::vector<float> weights;   // instances x K
   std::vector<Mat4f> matrices;  // instances x joints
   uint32_t instances = 0;
+  std::vector<uint32_t> components;  // per instance: its quality level's k (empty: K for all)
+  // Per instance: how many leading components the reference reads.
+  uint32_t componentsOf(uint32_t i) const {
+    return components.empty() ? uint32_t(model.meshComponents()) : components[i];
+  }
 };
 
 DeformInputs randomInputs(uint64_t seed, const DeformCase& c) {
@@ -67,15 +76,27 @@ struct GpuDeformResult {
 
 // basisTexels: the pass reads the basis as texels (deform_basis_texels.comp) where the device's
 // maxTexelBufferElements allows, else through its address (deform.comp).
-GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinning, bool basisTexels) {
+// With per-instance components: the groups buffer, and `poisonUnreadGroups` writes NaN into every
+// packed weight group beyond an instance's own (what packWeights zeroes): the kernel must not read them.
+GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinning, bool basisTexels,
+                          bool poisonUnreadGroups = false) {
   const Model& m = in.model;
   const uint32_t n = uint32_t(m.gameMesh.vertexCount()), k = uint32_t(m.meshComponents());
   const std::vector<uint32_t> joints(m.gameMesh.skin.joints.begin(), m.gameMesh.skin.joints.end());
   CheckedInput mean(ctx, std::span<const float>(m.meshPca.mean.data(), 3 * n), "mean");
   CheckedInput basis(ctx, std::span<const float>(m.meshPca.basis.data(), size_t(m.meshPca.basis.size())), "basis");
   std::vector<float> weightRows(gpu::DeformPass::weightsBytes(in.instances, k) / sizeof(float));
-  gpu::DeformPass::packWeights(in.weights.data(), in.instances, k, weightRows.data());  // the kernel's padded rows
+  gpu::DeformPass::packWeights(in.weights.data(), in.instances, k, in.components,
+                               weightRows.data());  // the kernel's padded rows
+  std::vector<uint32_t> groups(std::max<size_t>(in.components.size(), 1));
+  const uint32_t maxGroups = gpu::DeformPass::packGroups(in.components, k, groups.data());
+  const uint32_t k4 = gpu::DeformPass::paddedComponents(k);
+  if (poisonUnreadGroups && !in.components.empty())
+    for (uint32_t i = 0; i < in.instances; ++i)
+      std::fill(weightRows.begin() + i * k4 + 4 * groups[i], weightRows.begin() + (i + 1) * k4,
+                std::numeric_limits<float>::quiet_NaN());
   CheckedInput weights(ctx, std::span<const float>(weightRows), "weights");
+  CheckedInput instanceGroups(ctx, std::span<const uint32_t>(groups), "instance groups");
   std::vector<float> matrixRows(in.matrices.size() * 12);
   gpu::DeformPass::packSkinMatrices(in.matrices.data(), in.matrices.size(), matrixRows.data());  // the kernel's layout
   CheckedInput matrices(ctx, std::span<const float>(matrixRows), "skin matrices");
@@ -98,11 +119,15 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   a.vertexCount = n;
   a.instanceCount = in.instances;
   a.jointCount = uint32_t(m.skeleton.size());
+  if (!in.components.empty()) {
+    a.instanceGroups = instanceGroups.address();
+    a.maxGroups = maxGroups;
+  }
   ctx.submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, a); });
 
   GpuDeformResult r;
   r.positions = out.read<float>(ctx);
-  for (const CheckedInput* c : {&mean, &basis, &weights, &matrices, &skinJoints, &skinWeights})
+  for (const CheckedInput* c : {&mean, &basis, &weights, &instanceGroups, &matrices, &skinJoints, &skinWeights})
     if (auto s = c->unchanged(ctx); !s.empty()) r.problems.push_back(s);
   if (auto s = out.guardsIntact(ctx); !s.empty()) r.problems.push_back(s);
   return r;
@@ -113,7 +138,8 @@ std::vector<float> referencePositions(const DeformInputs& in, bool skinning) {
   const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
   std::vector<float> out;
   for (uint32_t i = 0; i < in.instances; ++i) {
-    Points3f p = runtime::referencePcaReconstruct(m.meshPca, std::span(in.weights).subspan(i * k, k));
+    Points3f p =
+        runtime::referencePcaReconstruct(m.meshPca, std::span(in.weights).subspan(i * k, k), in.componentsOf(i));
     if (skinning)
       p = runtime::referenceSkin(p, m.gameMesh.skin,
                                  std::vector<Mat4f>(in.matrices.begin() + i * j, in.matrices.begin() + (i + 1) * j));
@@ -125,17 +151,20 @@ std::vector<float> referencePositions(const DeformInputs& in, bool skinning) {
 // PCA tolerance: the reference sums K products onto the mean in float. A device may contract each
 // multiply-add into an FMA or reorder nothing else, so each of the K additions can round differently:
 // the error is bounded by (K + 1) * eps * (|mean| + sum_k |basis_k * w_k|) (the standard gamma_K bound
-// of a length-K reduction), evaluated per element from the inputs.
+// of a length-K reduction), evaluated per element from the inputs. At a quality level of k_i < K the
+// sum has k_i terms (the kernel's further terms of the instance's last group add exact zeros), so
+// the bound is over those: a kernel that read weights beyond k_i would exceed it.
 std::function<double(size_t)> pcaTolerance(const DeformInputs& in) {
   const Model& m = in.model;
   const size_t k = size_t(m.meshComponents()), rows = size_t(m.meshPca.mean.size());
   auto bound = std::make_shared<std::vector<double>>(in.instances * rows);
   for (uint32_t i = 0; i < in.instances; ++i)
     for (size_t r = 0; r < rows; ++r) {
+      const size_t ki = in.componentsOf(i);
       double mag = std::abs(double(m.meshPca.mean[Eigen::Index(r)]));
-      for (size_t c = 0; c < k; ++c)
+      for (size_t c = 0; c < ki; ++c)
         mag += std::abs(double(m.meshPca.basis(Eigen::Index(r), Eigen::Index(c))) * in.weights[i * k + c]);
-      (*bound)[i * rows + r] = double(k + 1) * FLT_EPSILON * mag;
+      (*bound)[i * rows + r] = double(ki + 1) * FLT_EPSILON * mag;
     }
   return [bound](size_t e) { return (*bound)[e]; };
 }
@@ -241,14 +270,135 @@ TEST_F(DeformSpecialValues, ExactlyRepresentableInputsGiveExactResults) {
     mat(3, 3) = 1.f;
     for (int r = 0; r < 3; ++r) mat(r, 3) = float(int(rng.below(20)) - 10);
   }
-  for (bool skinning : {false, true})
-    for (const bool basisTexels : {false, true}) {
-      SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
-      const auto gpu = runDeform(ctx(), in, skinning, basisTexels);
-      for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-      EXPECT_TRUE(test::matchesReference(skinning ? "skinned positions" : "PCA positions", gpu.positions,
-                                         referencePositions(in, skinning), [](size_t) { return 0.0; }));
-    }
+  // Also at quality levels (k = 0..3 per instance): the zero weights that pad an instance's last group
+  // must add exactly nothing, so the result is the reference's shorter sum bit for bit.
+  for (const bool levels : {false, true}) {
+    in.components.clear();
+    if (levels) in.components = {2, 0, 1};
+    for (bool skinning : {false, true})
+      for (const bool basisTexels : {false, true}) {
+        SCOPED_TRACE(std::string(basisTexels ? "basis as texels" : "basis through its address") +
+                     (levels ? ", levels 2 0 1" : ""));
+        const auto gpu = runDeform(ctx(), in, skinning, basisTexels, levels);
+        for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+        EXPECT_TRUE(test::matchesReference(skinning ? "skinned positions" : "PCA positions", gpu.positions,
+                                           referencePositions(in, skinning), [](size_t) { return 0.0; }));
+      }
+  }
+}
+
+// Quality levels: instance i reads its first k_i components only.
+
+// Garbage where each instance's level ends: NaN, Inf and huge values in every weight from k_i on, in the
+// weights the CPU hands over (as FrameKernelInputs::meshWeights may hold the network's full output).
+// The reference ignores them by definition; on the GPU packWeights must zero them within the
+// instance's last group, and runDeform's poisonUnreadGroups puts NaN in the groups beyond it, which
+// the kernel must not read. Any of them reaching a sum makes that output NaN or huge: a failure.
+void poisonWeightsBeyondLevels(DeformInputs& in, Rng& rng) {
+  const uint32_t k = uint32_t(in.model.meshComponents());
+  const float garbage[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                           -std::numeric_limits<float>::infinity(), 1e30f, -3e37f};
+  for (uint32_t i = 0; i < in.instances; ++i)
+    for (uint32_t c = in.componentsOf(i); c < k; ++c) in.weights[size_t(i) * k + c] = garbage[rng.below(5)];
+}
+
+// Both forms of the basis, PCA alone (the derived bound, over each instance's own k_i terms) and
+// skinned (skinTolerance).
+void expectLevelsMatchReference(gpu::Context& ctx, const DeformInputs& in) {
+  const auto pcaRef = referencePositions(in, false), skinnedRef = referencePositions(in, true);
+  const auto pcaBound = pcaTolerance(in);
+  for (const bool basisTexels : {false, true}) {
+    SCOPED_TRACE(basisTexels ? "basis as texels" : "basis through its address");
+    const auto pca = runDeform(ctx, in, false, basisTexels, true);
+    for (const auto& p : pca.problems) ADD_FAILURE() << p;
+    test::CompareReport rep;
+    EXPECT_TRUE(test::matchesReference("pre-skinning positions", pca.positions, pcaRef, pcaBound, &rep));
+    EXPECT_EQ(rep.nonFinite, 0u);
+    const auto skinned = runDeform(ctx, in, true, basisTexels, true);
+    for (const auto& p : skinned.problems) ADD_FAILURE() << p;
+    test::CompareReport srep;
+    EXPECT_TRUE(test::matchesReference(
+        "skinned positions", skinned.positions, skinnedRef, [&](size_t e) { return skinTolerance(skinnedRef[e]); },
+        &srep));
+    std::printf("max |gpu - reference| = %.3g m (PCA), %.3g m (skinned) over %zu values\n", rep.maxAbsError,
+                srep.maxAbsError, srep.compared);
+  }
+}
+
+class DeformLevels : public test::GpuTest {};
+
+// Every level of runtime::defaultLadder of a K = 30 model (30, 15, 7, 3 and 0 components: odd k, k not
+// a multiple of 4, the mean shape), all 22 instances at that level in one dispatch.
+TEST_F(DeformLevels, EveryLevelOfTheDefaultLadderMatchesReference) {
+  SWISH_TEST_SEED_SCOPE(seed, 0x1AD0);
+  const DeformInputs base = randomInputs(seed, {997, 30, 4, 22});
+  Rng rng(seed + 1);
+  const runtime::QualityLadder ladder = runtime::defaultLadder(base.model);
+  std::vector<uint32_t> ks;
+  for (const auto& level : ladder.levels) ks.push_back(level.meshComponents);
+  EXPECT_EQ(ks, (std::vector<uint32_t>{30, 15, 7, 3, 0})) << "the ladder this test was written for";
+  for (const auto& level : ladder.levels) {
+    SCOPED_TRACE("level " + level.name);
+    DeformInputs in = base;
+    in.components.assign(in.instances, level.meshComponents);
+    poisonWeightsBeyondLevels(in, rng);
+    expectLevelsMatchReference(ctx(), in);
+  }
+}
+
+// Mixed levels in one dispatch: every k from 0 to K = 30 at least once in 37 instances (so every place
+// in a group where a level can end, and whole groups), in a shuffled order; then a frame whose levels
+// all end well below K (maxGroups 5 of 8: the basis beyond is not loaded), and one of only k = 0 and 1.
+TEST_F(DeformLevels, MixedLevelsInOneDispatchMatchReference) {
+  SWISH_TEST_SEED_SCOPE(seed, 0x313ED);
+  const DeformInputs base = randomInputs(seed, {613, 30, 4, 37});
+  Rng rng(seed + 1);
+  std::vector<uint32_t> all;
+  for (uint32_t k = 0; k <= 30; ++k) all.push_back(k);
+  while (all.size() < base.instances) all.push_back(uint32_t(rng.below(31)));
+  for (size_t i = all.size(); i > 1; --i) std::swap(all[i - 1], all[rng.below(i)]);
+  std::vector<uint32_t> low(base.instances), lowest(base.instances);
+  for (auto& k : low) k = uint32_t(rng.below(18));  // 0..17: at most 5 groups
+  low[5] = 17;
+  for (auto& k : lowest) k = uint32_t(rng.below(2));
+  for (const auto& [name, components] :
+       {std::pair<const char*, std::vector<uint32_t>>{"0..30", all}, {"0..17", low}, {"0..1", lowest}}) {
+    SCOPED_TRACE(std::string("levels ") + name);
+    DeformInputs in = base;
+    in.components = components;
+    poisonWeightsBeyondLevels(in, rng);
+    expectLevelsMatchReference(ctx(), in);
+  }
+}
+
+// Levels the kernel cannot honour are refused, naming the instance.
+TEST_F(DeformLevels, BadLevelsAreRejectedWithAReason) {
+  const std::vector<float> w(2 * 6, 1.f);
+  std::vector<float> rows(2 * 8);
+  std::vector<uint32_t> groups(2);
+  EXPECT_NE(test::errorOf([&] {
+              gpu::DeformPass::packWeights(w.data(), 2, 6, std::vector<uint32_t>{3, 7}, rows.data());
+            }).find("instance 1 reads 7 mesh components"),
+            std::string::npos);
+  EXPECT_NE(test::errorOf([&] {
+              gpu::DeformPass::packWeights(w.data(), 2, 6, std::vector<uint32_t>{3}, rows.data());
+            }).find("1 per-instance component counts for 2 instances"),
+            std::string::npos);
+  EXPECT_NE(test::errorOf([&] {
+              gpu::DeformPass::packGroups(std::vector<uint32_t>{9, 0}, 6, groups.data());
+            }).find("instance 0 reads 9"),
+            std::string::npos);
+  const gpu::DeformPass pass(ctx(), 6, 4);
+  gpu::DeformPass::Args a;
+  a.vertexCount = 1;
+  a.instanceCount = 1;
+  a.instanceInputs = VkDescriptorSet(uintptr_t(1));  // never used: record throws first
+  a.instanceGroups = 4096;
+  a.maxGroups = 3;  // 6 components are 2 groups
+  VkCommandBuffer cmd = ctx().beginOneTime();
+  EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("maxGroups 3 beyond the 2 weight groups"),
+            std::string::npos);
+  ctx().abandonOneTime(cmd);
 }
 
 }  // namespace

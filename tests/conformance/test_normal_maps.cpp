@@ -4,7 +4,9 @@
 // snorm16, because Vulkan lets a device round float -> snorm to either neighbour; alpha = 0 and 1 are
 // exact. Seeded random databases (seed printed; SWISH_TEST_SEED overrides), odd sizes, maps selected
 // several times, out-of-range indices, guard words and unchanged inputs.
+#include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <ostream>
 
 #include "support/gpu_buffers.hpp"
@@ -219,6 +221,97 @@ TEST_F(NormalMapSpecialCases, BlendMatchesReferenceWithinOneSnorm16Step) {
           EXPECT_LE(maxDiff, exact ? 0 : 1) << "character " << c << " (alpha " << chars[c].alpha << ")";
         }
       }
+}
+
+// Characters naming their layers (FrameRecorder leaves out the instances without a map this frame): 3
+// characters blend layers 4, 1 and 2 of 6, out of order (runs of one and two layers for the copy into
+// the images). Each matches the reference blend of ITS layer's previous map; every other layer is
+// neither written in the blend's output nor in the images (those of the copy form still hold the
+// output's unwritten marker, the images their zeros). Exact and bounds-checked dispatches, both outputs.
+TEST_F(NormalMapSpecialCases, BlendWritesOnlyTheLayersItsCharactersName) {
+  SWISH_TEST_SEED_SCOPE(seed, 0x1A7E5);
+  Rng rng(seed);
+  if (!ctx().supportsNormalMaps()) GTEST_SKIP() << "device lacks RG16_SNORM storage images";
+  for (const bool shared : {false, true})
+    for (const auto& [width, height] : {std::pair<uint32_t, uint32_t>{64, 8}, {12, 12}}) {
+      SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + (shared ? ", shared texels" : ""));
+      const gpu::NormalMapBlendPass pass(ctx(), width);
+      const uint32_t layers = 6;
+      const size_t per = size_t(width) * height * 2;
+      std::vector<runtime::DecodedNormalMap> decoded(2, {width, height, std::vector<int8_t>(per)});
+      std::vector<int8_t> decodedAll;
+      for (auto& d : decoded) {
+        for (auto& b : d.xy) b = int8_t(int(rng.below(256)) - 128);
+        decodedAll.insert(decodedAll.end(), d.xy.begin(), d.xy.end());
+      }
+      const std::vector<gpu::NormalMapBlendPass::Character> chars = {{1, 0.25f}, {0, 1.f}, {1, float(rng.uniform())}};
+      const std::vector<uint32_t> charLayers = {4, 1, 2};
+      std::vector<runtime::BlendedNormalMap> prev;
+      std::vector<int16_t> prevAll;
+      for (uint32_t l = 0; l < layers; ++l) {
+        auto m = runtime::BlendedNormalMap::zeros(width, height);
+        for (auto& v : m.xy) v = int16_t(int(rng.below(65535)) - 32767);
+        prevAll.insert(prevAll.end(), m.xy.begin(), m.xy.end());
+        prev.push_back(std::move(m));
+      }
+      CheckedInput decodedIn(ctx(), std::span<const int8_t>(decodedAll), "decoded");
+      CheckedInput charsIn(ctx(), std::span<const gpu::NormalMapBlendPass::Character>(chars), "characters");
+      CheckedInput layersIn(ctx(), std::span<const uint32_t>(charLayers), "layers");
+      CheckedInput prevIn(ctx(), std::span<const int16_t>(prevAll), "previous maps");
+      GuardedOutput outTexels(ctx(), prevAll.size() * sizeof(int16_t), "blended maps");
+      gpu::NormalMapImages outImg(ctx(), width, height, layers, shared);
+      if (shared && !outImg.sharesTexels()) continue;  // the device does not allow it: only the copy form runs
+      const gpu::Buffer& out = shared ? outImg.texels() : outTexels.buffer();
+      {
+        const auto binding = pass.makeBinding(ctx(), prevIn.buffer(), out, decodedIn.buffer());
+        gpu::NormalMapBlendPass::Args a;
+        a.characters = charsIn.address();
+        a.layers = layersIn.address();
+        a.hostLayers = charLayers;
+        a.maxLayers = layers;
+        a.width = width;
+        a.height = height;
+        a.characterCount = uint32_t(chars.size());
+        a.outTexels = out.handle();
+        a.outMaps = outImg.image();
+        a.outMapsShareTexels = shared;
+        ctx().submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, binding.get(), a); });
+      }
+      for (const CheckedInput* c : {&decodedIn, &charsIn, &layersIn, &prevIn})
+        if (auto s = c->unchanged(ctx()); !s.empty()) ADD_FAILURE() << s;
+      const auto images = outImg.download(ctx());
+      std::vector<int16_t> texels;
+      if (!shared) {
+        if (auto s = outTexels.guardsIntact(ctx()); !s.empty()) ADD_FAILURE() << s;
+        texels = outTexels.read<int16_t>(ctx());
+      }
+      for (uint32_t l = 0; l < layers; ++l) {
+        const auto layerOf = [&](const std::vector<int16_t>& all) {
+          return std::vector<int16_t>(all.begin() + std::ptrdiff_t(l * per),
+                                      all.begin() + std::ptrdiff_t((l + 1) * per));
+        };
+        const std::vector<int16_t> image = layerOf(images);
+        const auto c = size_t(std::find(charLayers.begin(), charLayers.end(), l) - charLayers.begin());
+        if (c == charLayers.size()) {
+          EXPECT_EQ(image, std::vector<int16_t>(per, 0)) << "layer " << l << " of no character was written";
+          if (!shared) {
+            std::vector<int16_t> unwritten(per);  // the marker GuardedOutput fills its words with
+            const uint32_t marker = GuardedOutput::kUnwritten;
+            for (size_t i = 0; i < per; i += 2) std::memcpy(&unwritten[i], &marker, 4);
+            EXPECT_EQ(layerOf(texels), unwritten) << "layer " << l << " of no character was written in the output";
+          }
+          continue;
+        }
+        if (!shared) {
+          EXPECT_EQ(layerOf(texels), image) << "layer " << l << ": the images must hold a copy of the blended texels";
+        }
+        runtime::BlendedNormalMap ref = prev[l];
+        runtime::referenceNormalBlend(ref, decoded[chars[c].decodedSlot], chars[c].alpha);
+        int maxDiff = 0;
+        for (size_t i = 0; i < per; ++i) maxDiff = std::max(maxDiff, std::abs(int(image[i]) - int(ref.xy[i])));
+        EXPECT_LE(maxDiff, chars[c].alpha == 1.f ? 0 : 1) << "layer " << l << " (character " << c << ")";
+      }
+    }
 }
 
 }  // namespace

@@ -9,8 +9,10 @@
 // by one random stream), so the kernel's own 1e-4 could not be justified.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 
+#include "support/error_message.hpp"
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
 #include "support/random_model.hpp"
@@ -18,6 +20,7 @@
 #include "swish/core/mesh_frames.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/reference_tangent_frames.hpp"
 
@@ -171,6 +174,108 @@ TEST_F(WholeFrame, DecodedMapsAreKeptAcrossFramesAndTheirSlotsReused) {
   }
 }
 
+// Quality levels per instance (runtime::defaultLadder: full and k15 with maps; k7, k3 and the mean shape
+// without), in the same dispatches: each instance's k (with garbage in its weights beyond k), and
+// kNoMap for the levels without maps. Those instances get no decode and no blend, and their normal
+// maps must stay bit for bit what the GPU had after the previous frame (and equal the reference's,
+// which hands prevMaps back), across two frames in flight (their layers come from the other slot, a
+// copy only when the slot's layer is older) and with one; every other output matches the reference
+// as in the tests above. Frame 3 has no instance with a map (no decode or blend dispatch at all); before
+// it, a frame recorded into a command buffer that is thrown away (then forgetDecodedMaps) must not
+// make the recorder believe its layers were written.
+TEST_F(WholeFrame, QualityLevelsPerInstanceMatchReferenceAndKeepMapsOfLevelsWithoutThem) {
+  SWISH_TEST_SEED_SCOPE(seed, 0x1E7E15);
+  Rng modelRng(seed);
+  test::RandomModelSpec spec;
+  spec.vertices = 311;
+  spec.meshComponents = 30;
+  spec.normalMaps = 6;
+  spec.mapSize = 24;
+  spec.codebookSize = 40;
+  spec.bodyCapsules = 8;
+  const Model model = test::makeRandomModel(modelRng, spec);
+  const runtime::QualityLadder ladder = runtime::defaultLadder(model);
+  ASSERT_EQ(ladder.size(), 5u);
+  ASSERT_TRUE(ladder[1].normalMaps && !ladder[2].normalMaps);
+  const uint32_t instances = 22;
+  gpu::GpuModel gpuModel(ctx(), model, "random model");
+  // Per frame, each instance's level: frame 0 all full (every layer gets a map); instance 0 then stays
+  // without maps, instance 1 alternates, the rest are drawn; frame 3 all without maps.
+  Rng levelRng(seed + 2);
+  std::vector<std::vector<size_t>> levels(6, std::vector<size_t>(instances, 0));
+  for (size_t f = 1; f < levels.size(); ++f)
+    for (uint32_t i = 0; i < instances; ++i)
+      levels[f][i] = i == 0 ? 4 : i == 1 ? (f % 2 ? 2 : 1) : f == 3 ? 2 + levelRng.below(3) : levelRng.below(5);
+  for (const uint32_t framesInFlight : {2u, 1u})
+    for (const bool share : {true, false}) {
+      SCOPED_TRACE(std::to_string(framesInFlight) + " frames in flight, " +
+                   (share ? "shared texels" : "copied texels"));
+      Rng rng(seed + 1);  // the same frames for every recorder
+      gpu::FrameRecorderOptions options;
+      options.framesInFlight = framesInFlight;
+      options.shareNormalMapTexels = share;
+      gpu::FrameRecorder recorder(ctx(), gpuModel, instances, options);
+      std::vector<runtime::BlendedNormalMap> prevMaps, prevGpuMaps;
+      std::vector<int> lastBlended(instances, -1);
+      uint32_t fullDispatches = 0;
+      for (int frame = 0; frame < int(levels.size()); ++frame) {
+        SCOPED_TRACE("frame " + std::to_string(frame));
+        auto in = randomFrameInputs(rng, model, instances, true);
+        std::vector<uint32_t> kept;
+        for (uint32_t i = 0; i < instances; ++i) {
+          const runtime::QualityLevel& level = ladder[levels[size_t(frame)][i]];
+          in.meshComponents.push_back(level.meshComponents);
+          for (int c = int(level.meshComponents); c < model.meshComponents(); ++c)
+            in.meshWeights[size_t(i) * size_t(model.meshComponents()) + size_t(c)] =
+                std::numeric_limits<float>::quiet_NaN();  // must be ignored
+          if (!level.normalMaps) {
+            in.selectedMaps[i] = runtime::kNoMap;
+            kept.push_back(i);
+          }
+        }
+        if (frame == 3) {  // thrown away: blends every instance, its layers never written
+          auto lost = randomFrameInputs(rng, model, instances, true);
+          VkCommandBuffer cmd = ctx().beginOneTime();
+          recorder.record(cmd, uint64_t(frame), lost);
+          ctx().abandonOneTime(cmd);
+          recorder.forgetDecodedMaps();
+        }
+        uint32_t dispatches = 0;
+        ctx().submitAndWait([&](VkCommandBuffer cmd) { dispatches = recorder.record(cmd, uint64_t(frame), in); });
+        const uint32_t slot = recorder.slotOf(uint64_t(frame));
+        const auto gpu = recorder.download(slot);
+        const auto ref = runtime::referenceFrame(model, in, prevMaps);
+        expectFrameMatches(model, gpu, ref, frame);
+        for (uint32_t i : kept) {
+          EXPECT_EQ(gpu.normalMaps[i].xy,
+                    prevGpuMaps.empty() ? std::vector<int16_t>(gpu.normalMaps[i].xy.size(), 0) : prevGpuMaps[i].xy)
+              << "instance " << i << " has no map this frame: its map must stay as it was";
+          EXPECT_EQ(ref.normalMaps[i].xy, prevMaps[i].xy) << "reference, instance " << i;
+        }
+        const gpu::FrameResources& fr = recorder.frame(slot);
+        EXPECT_EQ(fr.blendedCount, instances - kept.size());
+        // A kept layer is copied only where the other slot holds a newer map: after a blend in the
+        // frame before, or after forgetDecodedMaps (frame 3); never with one frame in flight.
+        uint32_t copies = 0;
+        for (uint32_t i : kept) copies += framesInFlight > 1 && (lastBlended[i] == frame - 1 || frame == 3);
+        EXPECT_EQ(fr.carriedLayers, copies);
+        if (frame == 0) fullDispatches = dispatches;
+        if (kept.size() == instances) {
+          EXPECT_EQ(dispatches, fullDispatches - 2) << "no decode and no blend without a map";
+          EXPECT_EQ(fr.decodeJobCount, 0u);
+          if (ctx().supportsTimestamps()) {
+            EXPECT_TRUE(std::isnan(recorder.stageTimes(slot).vqDecodeMs));
+            EXPECT_TRUE(std::isnan(recorder.stageTimes(slot).normalBlendMs));
+          }
+        }
+        for (uint32_t i = 0; i < instances; ++i)
+          if (in.selectedMaps[i] != runtime::kNoMap) lastBlended[i] = frame;
+        prevMaps = ref.normalMaps;
+        prevGpuMaps = gpu.normalMaps;
+      }
+    }
+}
+
 TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
   SWISH_TEST_SEED_SCOPE(seed, 0x40AB);
   Rng rng(seed);
@@ -188,6 +293,14 @@ TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
   if (ctx().supportsTimestamps()) {
     EXPECT_TRUE(std::isnan(recorder.stageTimes(0).vqDecodeMs));
   }
+  // What a frame evaluator hands over for a model without a database: kNoMap for every instance.
+  auto noMaps = in;
+  noMaps.selectedMaps.assign(3, runtime::kNoMap);
+  noMaps.blendAlpha.assign(3, 0.f);
+  ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, 1, noMaps); });
+  const auto again = recorder.download(0);
+  EXPECT_TRUE(again.normalMaps.empty());
+  expectFrameMatches(model, again, runtime::referenceFrame(model, noMaps), 0);
 }
 
 TEST_F(WholeFrame, BadInputsAreRejectedWithAReason) {
@@ -201,6 +314,12 @@ TEST_F(WholeFrame, BadInputsAreRejectedWithAReason) {
   EXPECT_THROW(recorder.record(cmd, 0, in), Error);
   in = randomFrameInputs(rng, model, 3, true);
   EXPECT_THROW(recorder.record(cmd, 0, in), Error);  // beyond the capacity of 2
+  in = randomFrameInputs(rng, model, 2, true);
+  in.meshComponents = {uint32_t(model.meshComponents()) + 1, 0};
+  EXPECT_NE(test::errorOf([&] { recorder.record(cmd, 0, in); }).find("instance 0 reads"), std::string::npos);
+  in.meshComponents = {1};
+  EXPECT_NE(test::errorOf([&] { recorder.record(cmd, 0, in); }).find("1 per-instance mesh component counts"),
+            std::string::npos);
   ctx().abandonOneTime(cmd);
 }
 

@@ -316,8 +316,9 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
           &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook, &g.indices})
       model += b->size();
     const auto& f = rec.frame(0);
-    for (const gpu::Buffer* b : {&f.meshWeights, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions,
-                                 &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
+    for (const gpu::Buffer* b :
+         {&f.meshWeights, &f.instanceGroups, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions,
+          &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
       frame += b->handle() ? b->size() : 0;  // blendedTexels: none where the images share its memory
     frame += uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4;
     // Shared texels need a device that samples linear 2D arrays (and lays them out tightly): lavapipe does.

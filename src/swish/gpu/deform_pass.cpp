@@ -18,6 +18,35 @@ void DeformPass::packWeights(const float* w, uint32_t instances, uint32_t k, flo
   }
 }
 
+void DeformPass::packWeights(const float* w, uint32_t instances, uint32_t k, std::span<const uint32_t> components,
+                             float* out) {
+  if (components.empty()) return packWeights(w, instances, k, out);
+  if (components.size() != instances)
+    throw Error("deform pass: " + std::to_string(components.size()) + " per-instance component counts for " +
+                std::to_string(instances) + " instances");
+  const uint32_t k4 = paddedComponents(k);
+  for (uint32_t i = 0; i < instances; ++i) {
+    const uint32_t ki = components[i];
+    if (ki > k)
+      throw Error("deform pass: instance " + std::to_string(i) + " reads " + std::to_string(ki) +
+                  " mesh components; the model has " + std::to_string(k));
+    std::copy(w + size_t(i) * k, w + size_t(i) * k + ki, out + size_t(i) * k4);
+    std::fill(out + size_t(i) * k4 + ki, out + size_t(i + 1) * k4, 0.f);
+  }
+}
+
+uint32_t DeformPass::packGroups(std::span<const uint32_t> components, uint32_t k, uint32_t* out) {
+  uint32_t most = 0;
+  for (size_t i = 0; i < components.size(); ++i) {
+    if (components[i] > k)
+      throw Error("deform pass: instance " + std::to_string(i) + " reads " + std::to_string(components[i]) +
+                  " mesh components; the model has " + std::to_string(k));
+    out[i] = groupsOf(components[i]);
+    most = std::max(most, out[i]);
+  }
+  return most;
+}
+
 void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
   for (size_t i = 0; i < count; ++i)
     for (int r = 0; r < 3; ++r)
@@ -25,7 +54,8 @@ void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
 }
 
 DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats)
-    : basisTexels_(basisFloats > 0 && basisFloats <= ctx.properties().limits.maxTexelBufferElements) {
+    : basisTexels_(basisFloats > 0 && basisFloats <= ctx.properties().limits.maxTexelBufferElements),
+      meshComponents_(k) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
     throw Error("deform pass: " + std::to_string(k) + " mesh components; the kernel supports 1.." +
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
@@ -66,6 +96,15 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.instanceCount = a.instanceCount;
   p.jointCount = a.jointCount;
   p.capsuleCount = a.capsuleCount;
+  p.instanceGroups = layout::Address::of(a.instanceGroups);
+  p.maxGroups = groupsOf(meshComponents_);
+  if (a.instanceGroups) {
+    if (a.maxGroups > p.maxGroups)
+      throw Error("deform pass: maxGroups " + std::to_string(a.maxGroups) + " beyond the " +
+                  std::to_string(p.maxGroups) + " weight groups of " + std::to_string(meshComponents_) + " components");
+    p.maxGroups = a.maxGroups;
+  }
+  p.pad0 = 0;
   pipeline_.bind(cmd, &p, sizeof(p), a.instanceInputs);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
   return 1;

@@ -14,6 +14,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <span>
 
 #include "swish/core/types.hpp"
 #include "swish/gpu/compute_pipeline.hpp"
@@ -37,6 +38,13 @@ class DeformPass {
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;
     uint32_t jointCount = 0;
+    // Per-instance quality levels: uint[instanceCount], the vec4 weight groups each instance reads
+    // (groupsOf(k_i), packGroups), its weight rows zero from k_i on (packWeights with components).
+    // 0: every instance reads all groupsOf(K).
+    VkDeviceAddress instanceGroups = 0;
+    // With instanceGroups: the most groups an instance reads (packGroups returns it), at most
+    // groupsOf(K); each vertex loads that many groups of its basis. Ignored without instanceGroups.
+    uint32_t maxGroups = 0;
   };
 
   // Layout of the mesh-weights buffer: float[instances][paddedComponents(K)], each row zero padded.
@@ -46,6 +54,19 @@ class DeformPass {
   }
   // Writes `instances` rows of K weights (row-major, as FrameKernelInputs holds them) in that layout.
   static void packWeights(const float* weights, uint32_t instances, uint32_t k, float* out);
+  // The same for instances at quality levels: row i keeps its first components[i] weights (<= k) and
+  // zeros the rest of its padded row, whatever `weights` holds there, so that the groups the kernel
+  // reads whole add exact zeros beyond k_i. components empty: k for every instance. Throws Error naming
+  // the instance on a size mismatch or a component count above k.
+  static void packWeights(const float* weights, uint32_t instances, uint32_t k, std::span<const uint32_t> components,
+                          float* out);
+  // Weight groups (vec4 texels) an instance of `components` leading components reads.
+  static uint32_t groupsOf(uint32_t components) { return (components + 3) / 4; }
+  // Layout of the instance-groups buffer: uint[instances].
+  static VkDeviceSize groupsBytes(uint32_t instances) { return VkDeviceSize(instances) * 4; }
+  // Writes groupsOf(components[i]) for each instance (components.size() of them, each <= k, else
+  // Error) into out; returns the largest (Args::maxGroups; 0 for no instances).
+  static uint32_t packGroups(std::span<const uint32_t> components, uint32_t k, uint32_t* out);
   // Layout of the skin-matrices buffer: vec4[instances][jointCount][3], the top three rows of each
   // affine skinning matrix (3 texel fetches per influence instead of 4 columns).
   static VkDeviceSize skinMatricesBytes(uint32_t instances, uint32_t joints) {
@@ -62,6 +83,7 @@ class DeformPass {
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
              uint64_t basisFloats = 0);
   bool basisTexels() const { return basisTexels_; }
+  uint32_t meshComponents() const { return meshComponents_; }  // K of the pipeline
 
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
   // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise).
@@ -73,6 +95,7 @@ class DeformPass {
 
  private:
   bool basisTexels_ = false;
+  uint32_t meshComponents_ = 0;
   DescriptorLayout inputsLayout_;
   ComputePipeline pipeline_;
 };

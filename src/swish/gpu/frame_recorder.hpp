@@ -4,6 +4,13 @@
 //   deform + push-out (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
 //   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch,
 //   into the normal-map images' own memory where they share it, else then a copy into them)
+// Quality levels (runtime/quality_levels.hpp), per instance in the same dispatches:
+// FrameKernelInputs::meshComponents sets the weight groups each instance's deform reads (and, by their
+// maximum, the basis each vertex loads); an instance whose selectedMaps entry is kNoMap is left out of
+// the decode and the blend, and its layer keeps its map: unchanged with one frame in flight, else copied
+// from the previous frame's slot (only when this slot's layer is older: a character that stays without
+// maps costs nothing after framesInFlight - 1 frames). A frame where no instance has a map records no
+// decode and no blend dispatch.
 // with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
 // uses slot f % framesInFlight and its blend reads the previous slot's blended maps
 // (FrameResources::blendOutput()).
@@ -62,7 +69,8 @@ class FrameRecorder {
   // The slot's decoded maps are kept for later frames: a caller that throws a recorded command buffer
   // away instead of submitting it calls forgetDecodedMaps() before the next record().
   uint32_t record(VkCommandBuffer cmd, uint64_t frameIndex, const runtime::FrameKernelInputs& inputs);
-  // Every slot's decoded maps are decoded again when next selected.
+  // Every slot's decoded maps are decoded again when next selected, and every layer of an instance
+  // without a map is copied from the previous slot when next kept.
   void forgetDecodedMaps();
 
   // After the fence of that frame's submission.
@@ -83,7 +91,20 @@ class FrameRecorder {
   NormalMapBlendPass blend_;
   std::vector<FrameResources> frames_;
   std::vector<float> weightRows_, matrixRows_, posedCapsules_;  // inputs in DeformPass's layouts
-  uint64_t records_ = 0;  // record() calls with normal maps: the clock of FrameResources::slotLastUsed
+  std::vector<uint32_t> groups_;                                // DeformPass::packGroups
+  uint64_t records_ = 0;  // record() calls that decoded: the clock of FrameResources::slotLastUsed
+  // Per instance (layer): the version of its current map, set by each blend or upload from versionClock_;
+  // FrameResources::layerVersion says which slots hold it.
+  std::vector<uint64_t> mapVersion_;
+  uint64_t versionClock_ = 0;
+
+  // Where the blend's layer list lies in FrameResources::blendCharacters: after the characters.
+  VkDeviceSize blendLayersOffset() const { return VkDeviceSize(capacity_) * sizeof(NormalMapBlendPass::Character); }
+  // Decode jobs and blend characters of the instances `blended` (those with a map); returns dispatches.
+  uint32_t recordDecode(VkCommandBuffer cmd, FrameResources& f, const runtime::FrameKernelInputs& in,
+                        const std::vector<uint32_t>& blended);
+  // Brings the layers of the instances `kept` (without a map) in slot `slot` to their current maps.
+  void carryLayersOver(VkCommandBuffer cmd, uint32_t slot, const std::vector<uint32_t>& kept);
 };
 
 }  // namespace swish::gpu

@@ -18,6 +18,7 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
   const VkDeviceSize n = m.vertexCount(), c = std::max(1u, cap);
   meshWeights = Buffer(ctx, DeformPass::weightsBytes(uint32_t(c), m.kernelMeshComponents()), MemoryKind::HostVisible,
                        tag + "mesh weights");
+  instanceGroups = Buffer(ctx, DeformPass::groupsBytes(uint32_t(c)), MemoryKind::HostVisible, tag + "instance groups");
   skinMatrices = Buffer(ctx, std::max<VkDeviceSize>(16, DeformPass::skinMatricesBytes(uint32_t(c), m.jointCount())),
                         MemoryKind::HostVisible, tag + "skin matrices");
   if (m.capsuleCount() > 0)
@@ -33,8 +34,8 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
   }
   if (withMaps) {
     decodeSlotMaps = Buffer(ctx, 2 * c * sizeof(uint32_t), MemoryKind::HostVisible, tag + "decode jobs");
-    blendCharacters =
-        Buffer(ctx, c * sizeof(layout::NormalMapBlendCharacter), MemoryKind::HostVisible, tag + "blend characters");
+    blendCharacters = Buffer(ctx, c * (sizeof(layout::NormalMapBlendCharacter) + sizeof(uint32_t)),
+                             MemoryKind::HostVisible, tag + "blend characters");
     decodedMaps = Buffer(ctx, c * m.mapWidth() * m.mapHeight() * 2, MemoryKind::DeviceLocal, tag + "decoded maps");
     normalMaps = NormalMapImages(ctx, m.mapWidth(), m.mapHeight(), uint32_t(c), shareTexels);
     if (!normalMaps.sharesTexels())
@@ -52,6 +53,7 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
     });
     slotMap.assign(c, kNoMap);
     slotLastUsed.assign(c, 0);
+    layerVersion.assign(c, 0);  // version 0: all zeros, as the images start
   }
   timestamps = TimestampQueries(ctx, 5);
 }

@@ -33,11 +33,14 @@ struct FrameResources {
                  bool withNormalMaps, uint32_t slot, bool shareTexels = true);
 
   // Inputs, written by FrameRecorder::record.
-  Buffer meshWeights;      // float[instances][K4] (DeformPass::packWeights)
-  Buffer skinMatrices;     // vec4[instances][joints][3] (DeformPass::packSkinMatrices)
-  Buffer posedCapsules;    // float[instances][capsules][8] (runtime::poseBodyProxy); empty without a proxy
-  Buffer decodeSlotMaps;   // the VQ decode jobs: uint[2][instances], maps then the slots they go to
-  Buffer blendCharacters;  // layout::NormalMapBlendCharacter[instances]
+  Buffer meshWeights;     // float[instances][K4] (DeformPass::packWeights), zero beyond each instance's k
+  Buffer instanceGroups;  // uint[instances]: weight groups each instance's deform reads (DeformPass::packGroups)
+  Buffer skinMatrices;    // vec4[instances][joints][3] (DeformPass::packSkinMatrices)
+  Buffer posedCapsules;   // float[instances][capsules][8] (runtime::poseBodyProxy); empty without a proxy
+  Buffer decodeSlotMaps;  // the VQ decode jobs: uint[2][instances], maps then the slots they go to
+  // layout::NormalMapBlendCharacter[instances], then uint[instances]: the layer of each (the blend's
+  // characters are the instances with a map this frame)
+  Buffer blendCharacters;
   // Outputs.
   Buffer positions;            // float[instances][N][3]
   Buffer normals;              // float[instances][N][3]
@@ -60,12 +63,20 @@ struct FrameResources {
   static constexpr uint32_t kNoMap = 0xFFFFFFFFu;
   std::vector<uint32_t> slotMap;
   std::vector<uint64_t> slotLastUsed;
+  // Per layer of normalMaps (and of blendOutput()): the version of that instance's map it holds
+  // (FrameRecorder counts a version per blend or upload; kUnknownVersion: not known). An instance
+  // without a map this frame keeps its map: its layer here is brought to the current version by a copy
+  // from a slot that holds it, unless it holds it already (always with one frame in flight).
+  static constexpr uint64_t kUnknownVersion = ~uint64_t(0);
+  std::vector<uint64_t> layerVersion;
   TimestampQueries timestamps;
 
   // What the last record() into this frame did (for readback and timings).
   uint32_t instanceCount = 0;
   uint32_t decodedSlotCount = 0;  // distinct maps the frame selected (slots it read)
   uint32_t decodeJobCount = 0;    // of those, maps it decoded (not already in a slot)
+  uint32_t blendedCount = 0;      // instances whose map it blended (those with a map this frame)
+  uint32_t carriedLayers = 0;     // layers of instances without a map it copied from another slot
   bool recordedTangentFrames = false;
   bool recordedNormalMaps = false;
 };

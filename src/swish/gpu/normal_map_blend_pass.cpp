@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstddef>
 #include <iterator>
+#include <utility>
+#include <vector>
 
 #include "shaders/swish_layouts.h"
 #include "swish/core/error.hpp"
@@ -47,8 +49,22 @@ uint32_t NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding
                 " is not a multiple of 4 or not the pass's width " + std::to_string(width_));
   if (a.outTexels == VK_NULL_HANDLE || a.outMaps == VK_NULL_HANDLE)
     throw Error("normal-map blend: no output buffer or images to copy the blended maps into");
+  std::vector<uint32_t> sorted(a.hostLayers.begin(), a.hostLayers.end());  // the layers written, ascending
+  std::sort(sorted.begin(), sorted.end());
+  if (a.layers) {
+    if (sorted.size() != a.characterCount)
+      throw Error("normal-map blend: " + std::to_string(sorted.size()) + " host layers for " +
+                  std::to_string(a.characterCount) + " characters");
+    for (size_t i = 0; i < sorted.size(); ++i) {
+      if (sorted[i] >= a.maxLayers)
+        throw Error("normal-map blend: layer " + std::to_string(sorted[i]) + " of " + std::to_string(a.maxLayers));
+      if (i > 0 && sorted[i] == sorted[i - 1])
+        throw Error("normal-map blend: layer " + std::to_string(sorted[i]) + " given to two characters");
+    }
+  }
   layout::NormalMapBlendParams p;
   p.characters = layout::Address::of(a.characters);
+  p.layers = layout::Address::of(a.layers);
   p.width = a.width;
   p.height = a.height;
   p.characterCount = a.characterCount;
@@ -77,23 +93,43 @@ uint32_t NormalMapBlendPass::record(VkCommandBuffer cmd, VkDescriptorSet binding
   ib.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
   ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  // The layers written, as runs of consecutive layers: one copy region (and barrier range) per run.
+  std::vector<std::pair<uint32_t, uint32_t>> runs;  // first layer, count
+  if (!a.layers) {
+    runs.emplace_back(0, a.characterCount);
+  } else {
+    for (uint32_t layer : sorted)
+      if (!runs.empty() && runs.back().first + runs.back().second == layer)
+        ++runs.back().second;
+      else
+        runs.emplace_back(layer, 1);
+  }
   ib.image = a.outMaps;
-  ib.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, a.characterCount};
+  std::vector<VkImageMemoryBarrier> ibs(runs.size(), ib);
+  std::vector<VkBufferImageCopy> copies(runs.size());
+  const VkDeviceSize layerBytes = texelBytes(a.width, a.height, 1);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    ibs[r].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, runs[r].first, runs[r].second};
+    VkBufferImageCopy& c = copies[r];  // tightly packed rows and layers: the texels' layout is the image's
+    c.bufferOffset = runs[r].first * layerBytes;
+    c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, runs[r].first, runs[r].second};
+    c.imageExtent = {a.width, a.height, 1};
+  }
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr,
-                       1, &ib);
-  VkBufferImageCopy c{};  // tightly packed rows and layers: the texels' layout is the image's
-  c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, a.characterCount};
-  c.imageExtent = {a.width, a.height, 1};
-  vkCmdCopyBufferToImage(cmd, a.outTexels, a.outMaps, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+                       uint32_t(ibs.size()), ibs.data());
+  vkCmdCopyBufferToImage(cmd, a.outTexels, a.outMaps, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(copies.size()),
+                         copies.data());
   // Back to GENERAL and to the compute stage, so that a consumer's barrier from
   // COMPUTE_SHADER/SHADER_WRITE (the contract of FrameRecorder and of the public API) chains to the
   // copy's writes.
-  ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  ib.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-  ib.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+  for (VkImageMemoryBarrier& b : ibs) {
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+  }
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0,
-                       nullptr, 1, &ib);
+                       nullptr, uint32_t(ibs.size()), ibs.data());
   return 1;
 }
 

@@ -31,6 +31,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <span>
 
 #include "swish/gpu/compute_pipeline.hpp"
 #include "swish/gpu/descriptor_binding.hpp"
@@ -63,13 +64,18 @@ class NormalMapBlendPass {
   }
 
   struct Args {
-    VkDeviceAddress characters = 0;       // Character[characterCount]
-    uint32_t width = 0, height = 0;       // multiples of 4, those of the bound buffers, decoded slots and images; width
-                                          // that of the pass
-    uint32_t characterCount = 0;          // <= layers of the bound buffers and of outMaps
+    VkDeviceAddress characters = 0;  // Character[characterCount]
+    uint32_t width = 0, height = 0;  // multiples of 4, those of the bound buffers, decoded slots and images; width
+                                     // that of the pass
+    uint32_t characterCount = 0;     // <= layers of the bound buffers and of outMaps
+    // uint[characterCount]: the layer each character blends (of prev, out and outMaps), distinct; 0:
+    // character c blends layer c. hostLayers: the same list on the host (for the copy into outMaps;
+    // required with `layers`, each below maxLayers, else Error).
+    VkDeviceAddress layers = 0;
+    std::span<const uint32_t> hostLayers;
+    uint32_t maxLayers = 0;               // layers of the bound buffers and images (checked against hostLayers)
     VkBuffer outTexels = VK_NULL_HANDLE;  // the `out` buffer of the binding, copied into outMaps
-    VkImage outMaps =
-        VK_NULL_HANDLE;               // a NormalMapImages::image() (layout GENERAL): layers 0..characterCount-1 written
+    VkImage outMaps = VK_NULL_HANDLE;     // a NormalMapImages::image() (layout GENERAL): the characters' layers written
     bool outMapsShareTexels = false;  // outMaps lies over outTexels' memory (NormalMapImages::sharesTexels): no copy
   };
 

@@ -68,6 +68,7 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
     a.push_back({owner, name, bufferBytes(bytes), image});
   };
   add("mesh weights", c * kk * 4);
+  add("instance groups", c * 4);     // the weight groups each instance's quality level reads
   add("skin matrices", c * j * 48);  // the top three rows of each affine matrix
   add("positions", c * n * 12);
   if (frames) {
@@ -80,8 +81,8 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
   }
   if (maps) {
     const uint64_t texels = uint64_t(m.normalMaps.width) * m.normalMaps.height;
-    add("decode jobs", c * 8);  // map + slot of each map decoded
-    add("blend characters", c * 8);
+    add("decode jobs", c * 8);        // map + slot of each map decoded
+    add("blend characters", c * 12);  // slot + alpha, then the layer of each
     add("decoded maps", c * texels * 2);
     if (normalMapsShareTexels) {
       add("normal maps (RG16 snorm array, linear: the blend's output)", c * texels * 4, true);

@@ -19,13 +19,15 @@ inline constexpr uint32_t kNoMap = 0xFFFFFFFFu;
 
 struct FrameKernelInputs {
   uint32_t instanceCount = 0;
-  std::vector<float> meshWeights;  // instanceCount x K, instance-major (the MLP's mesh weights)
+  std::vector<float> meshWeights;   // instanceCount x K, instance-major (the MLP's mesh weights)
+  std::vector<Mat4f> skinMatrices;  // instanceCount x jointCount (Skeleton::skinningMatrices per instance)
+  // instanceCount database maps (kNoMap: that instance's map stays as it was), or empty: no normal-map
+  // work this frame
+  std::vector<uint32_t> selectedMaps;
+  std::vector<float> blendAlpha;  // instanceCount weights of the new map (the temporal filter's alpha)
   // Per instance: the leading mesh components its deform reads (its quality level's k, 0..K; the weights
   // beyond it count as 0 whatever meshWeights holds). Empty: K for every instance.
   std::vector<uint32_t> meshComponents;
-  std::vector<Mat4f> skinMatrices;     // instanceCount x jointCount (Skeleton::skinningMatrices per instance)
-  std::vector<uint32_t> selectedMaps;  // instanceCount database maps, or empty: no normal-map work this frame
-  std::vector<float> blendAlpha;       // instanceCount weights of the new map (the temporal filter's alpha)
   // Push the skinned garment out of the model's body proxy (reference_push_out.hpp); no effect for a
   // model without one.
   bool pushOut = true;
@@ -35,18 +37,19 @@ struct FrameKernelInputs {
 };
 
 struct ReferenceFrameOutputs {
-  std::vector<Points3f> positions;           // per instance, skinned
-  std::vector<Points3f> normals;             // per instance
-  std::vector<Points4f> tangents;            // per instance
-  std::vector<BlendedNormalMap> normalMaps;  // per instance (empty when no maps were selected)
+  std::vector<Points3f> positions;  // per instance, skinned
+  std::vector<Points3f> normals;    // per instance
+  std::vector<Points4f> tangents;   // per instance
+  // per instance (empty when selectedMaps is): an instance with kNoMap keeps its previous map
+  std::vector<BlendedNormalMap> normalMaps;
 };
 
-// The skinned positions of one instance alone (PCA -> skinning -> push-out when `pushOut` and the model
-// has a proxy): what referenceFrame's positions are, without the rest of the frame.
+// The skinned positions of one instance alone (PCA of its meshComponents -> skinning -> push-out when
+// `pushOut` and the model has a proxy): what referenceFrame's positions are, without the rest of the frame.
 Points3f referencePositions(const Model& model, const FrameKernelInputs& inputs, uint32_t instance, bool pushOut);
 
 // prevMaps: each character's normal map after the previous frame (empty: all zeros, as the GPU images
-// start).
+// start); an instance whose selectedMaps entry is kNoMap gets it back unchanged.
 ReferenceFrameOutputs referenceFrame(const Model& model, const FrameKernelInputs& inputs,
                                      const std::vector<BlendedNormalMap>& prevMaps = {});
 

@@ -5,10 +5,17 @@
 namespace swish::runtime {
 
 Points3f referencePcaReconstruct(const MeshPca& pca, std::span<const float> weights) {
-  const Eigen::Index k = pca.components();
-  if (Eigen::Index(weights.size()) != k)
-    throw Error("PCA reconstruction: " + std::to_string(weights.size()) + " weights for " + std::to_string(k) +
-                " components");
+  return referencePcaReconstruct(pca, weights, uint32_t(pca.components()));
+}
+
+Points3f referencePcaReconstruct(const MeshPca& pca, std::span<const float> weights, uint32_t components) {
+  if (Eigen::Index(weights.size()) != pca.components())
+    throw Error("PCA reconstruction: " + std::to_string(weights.size()) + " weights for " +
+                std::to_string(pca.components()) + " components");
+  if (Eigen::Index(components) > pca.components())
+    throw Error("PCA reconstruction: " + std::to_string(components) + " leading components of " +
+                std::to_string(pca.components()));
+  const Eigen::Index k = Eigen::Index(components);
   const Eigen::Index n = pca.mean.size() / 3;
   Points3f out(n, 3);
   for (Eigen::Index row = 0; row < 3 * n; ++row) {
