@@ -120,8 +120,8 @@ int runLevels(const LevelsCliOptions& o) {
   if (ownClips) {
     if (!ds.contains("clips") || !ds["clips"].is_array() || ds["clips"].empty())
       throw Error(o.model + ": the metadata names no clips the model was baked from; give some with --clips");
-    sources = bake::parseClipList(ds["clips"], o.model + ": metadata dataset_settings.clips: ",
-                                  entry.file.parent_path());
+    sources =
+        bake::parseClipList(ds["clips"], o.model + ": metadata dataset_settings.clips: ", entry.file.parent_path());
   } else {
     for (const std::string& c : o.clips) {
       if (!fs::is_regular_file(c)) throw Error("--clips: " + c + " does not exist");
@@ -157,9 +157,9 @@ int runLevels(const LevelsCliOptions& o) {
         "and thinned the samples to its pose list, so a clip frame is in general not a training pose: like the bake "
         "report's held-out poses, these are random frames of the training clips (the same motion, not unseen "
         "motion).\n");
-  std::printf("Simulating %zu truth poses (a few seconds of CPU each) on %s...\n", frames.size(),
-              o.threads > 0 ? (std::to_string(o.threads) + (o.threads == 1 ? " thread" : " threads")).c_str()
-                            : "all cores");
+  std::printf(
+      "Simulating %zu truth poses (a few seconds of CPU each) on %s...\n", frames.size(),
+      o.threads > 0 ? (std::to_string(o.threads) + (o.threads == 1 ? " thread" : " threads")).c_str() : "all cores");
   std::fflush(stdout);
 
   // The truth of each frame, in parallel; progress with the time left.
@@ -177,7 +177,8 @@ int runLevels(const LevelsCliOptions& o) {
       p.pose = pose;
       p.gameMeshPreSkin = shape.gameMeshPreSkin;
       // Skinned as the run time skins the prediction: the model's weights, the whole pose (root included).
-      p.gameMeshWorld = skinPositions(shape.gameMeshPreSkin, model.gameMesh.skin, model.skeleton.skinningMatrices(pose));
+      p.gameMeshWorld =
+          skinPositions(shape.gameMeshPreSkin, model.gameMesh.skin, model.skeleton.skinningMatrices(pose));
       if (truthMaps) p.normalMap = shape.normalMap;
       truths[i] = std::move(p);
     } else {
@@ -213,9 +214,9 @@ int runLevels(const LevelsCliOptions& o) {
     std::printf("%zu of %zu truth simulations failed and are left out (as the bake leaves such poses out), e.g. %s\n",
                 size_t(failed), frames.size(), firstFailure.c_str());
 
-  const std::string measuredOn =
-      std::to_string(poses.size()) + " frames of " + (ownClips ? "the model's training clips " : "the clips ") +
-      clipNames + " (swish levels; truth: " + truth + ")";
+  const std::string measuredOn = std::to_string(poses.size()) + " frames of " +
+                                 (ownClips ? "the model's training clips " : "the clips ") + clipNames +
+                                 " (swish levels; truth: " + truth + ")";
   runtime::QualityLadder ladder = bake::measureLadder(model, poses, measuredOn);
   std::printf("Timing the run-time CPU path per level...\n");
   std::fflush(stdout);

@@ -295,8 +295,8 @@ std::string ladderMarkdown(const QualityLadder& ladder, const QualityLadder* sub
   for (size_t i = 0; i < ladder.size(); ++i) {
     const QualityLevel& l = ladder.levels[i];
     md << "| " << l.name << " | " << l.meshComponents << " | " << (l.normalMaps ? "yes" : "no") << " | "
-       << f2(l.vertexMeanMm) << " | " << f2(l.vertexP95Mm) << " | " << f2(l.vertexMaxMm) << " | "
-       << f2(l.normalMeanDeg) << " | " << f2(l.cpuUsPerCharacter) << " |";
+       << f2(l.vertexMeanMm) << " | " << f2(l.vertexP95Mm) << " | " << f2(l.vertexMaxMm) << " | " << f2(l.normalMeanDeg)
+       << " | " << f2(l.cpuUsPerCharacter) << " |";
     if (subjects) {
       const bool same = i < subjects->size() && subjects->levels[i].name == l.name;
       md << " " << (same ? f2(subjects->levels[i].vertexMeanMm) : "-") << " | "

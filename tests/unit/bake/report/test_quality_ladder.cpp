@@ -90,12 +90,11 @@ TEST(QualityLadder, TruthInTheModelsSpanGivesZeroAtFullAndTheDroppedComponentsBe
     lambdas.push_back(lambda);
     const Eigen::VectorXd w = Eigen::Map<const VecXf>(lambda.data(), K).cast<double>();
     const Eigen::VectorXd pre = m.meshPca.mean.cast<double>() + m.meshPca.basis.cast<double>() * w;
-    const Points3f preF = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
-                              pre.data(), Eigen::Index(n), 3)
-                              .cast<float>();
+    const Points3f preF =
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pre.data(), Eigen::Index(n), 3)
+            .cast<float>();
     p.gameMeshWorld = skinPositions(preF, m.gameMesh.skin, m.skeleton.skinningMatrices(p.pose));
-    const uint32_t selected =
-        search.find(std::span<const float>(lambda.data() + K, size_t(m.normalCodeDims()))).index;
+    const uint32_t selected = search.find(std::span<const float>(lambda.data() + K, size_t(m.normalCodeDims()))).index;
     p.normalMap = decodeVqMap(m.normalMaps, selected);
   }
   std::vector<const DatasetPose*> ptrs;
@@ -169,7 +168,8 @@ TEST(QualityLadder, FullLevelIsTheEvaluationsTotalAndSkinnedItsMeanShapeBaseline
     for (Eigen::Index k = 0; k < p.gameMeshPreSkin.size(); ++k)
       p.gameMeshPreSkin.data()[k] += float(rng.normal(0, 0.01));
     p.gameMeshWorld = skinPositions(p.gameMeshPreSkin, m.gameMesh.skin, m.skeleton.skinningMatrices(p.pose));
-    p.normalMap = {m.normalMaps.width, m.normalMaps.height, std::vector<float>(size_t(m.normalMaps.width) * m.normalMaps.height * 2)};
+    p.normalMap = {m.normalMaps.width, m.normalMaps.height,
+                   std::vector<float>(size_t(m.normalMaps.width) * m.normalMaps.height * 2)};
     for (float& x : p.normalMap.xy) x = float(rng.uniformf(-0.5f, 0.5f));
   }
   std::vector<const DatasetPose*> ptrs;
