@@ -16,11 +16,13 @@
 #include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/pipeline/part2_training.hpp"
 #include "swish/bake/report/bake_report.hpp"
+#include "swish/bake/report/subject_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/novelty_guard.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/theta.hpp"
 
@@ -120,11 +122,80 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   EXPECT_DOUBLE_EQ(report["vertex_error_held_out"]["baseline_rest_skinned"]["p95_mm"].get<double>(),
                    out.evaluation.restSkinnedMm.p95);
 
+  // The quality levels on the same held-out poses through the same path: the full level is the model's
+  // error above, the skinned level the mean-shape baseline; the report has the section, its plot and the
+  // JSON; the model carries the ladder without the times (its bytes follow from the recipe).
+  const runtime::QualityLadder& ladder = out.ladder;
+  ASSERT_EQ(ladder.size(), 3u);  // K = 3: full, k1 (maps), skinned (K/4 = K/8 = 0 is the skinned level)
+  EXPECT_EQ(ladder.poses, 16u);
+  EXPECT_EQ(ladder.levels[0].name, "full");
+  EXPECT_DOUBLE_EQ(ladder.levels[0].vertexMeanMm, out.evaluation.totalMm.mean);
+  EXPECT_DOUBLE_EQ(ladder.levels[0].vertexP95Mm, out.evaluation.totalMm.p95);
+  EXPECT_DOUBLE_EQ(ladder.levels[0].vertexMaxMm, out.evaluation.totalMm.max);
+  EXPECT_DOUBLE_EQ(ladder.levels[0].normalMeanDeg, out.evaluation.normalTotal.meanDegrees);
+  EXPECT_EQ(ladder.levels.back().meshComponents, 0u);
+  EXPECT_DOUBLE_EQ(ladder.levels.back().vertexMeanMm, out.evaluation.meanSkinnedMm.mean);
+  EXPECT_GT(ladder.levels[0].cpuUsPerCharacter, 0.0);
+  EXPECT_EQ(ladder.levels.back().cpuUsPerCharacter, 0.0);
+  EXPECT_FALSE(ladder.timedOn.empty());
+  EXPECT_TRUE(std::filesystem::exists(dir / "quality_levels.svg"));
+  EXPECT_EQ(report["quality_levels"]["levels"].size(), ladder.size());
+  EXPECT_DOUBLE_EQ(report["quality_levels"]["levels"][0]["vertex_mean_mm"].get<double>(), out.evaluation.totalMm.mean);
+  EXPECT_TRUE(report["quality_levels"]["problems"].is_array());
+  {
+    std::ifstream mdIn(md);
+    const std::string text((std::istreambuf_iterator<char>(mdIn)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("## Quality levels"), std::string::npos);
+    EXPECT_NE(text.find("| full | 3 | yes |"), std::string::npos) << text;
+  }
+
+  // Held-out subjects (part1.holdout): the same levels on their frames, beside the random ones in the
+  // report. Their stand-in: 16 more poses of the same synthetic character (same seed, drawn after).
+  {
+    const Dataset more = syntheticDataset(seed, 176, 32);
+    Dataset holdout;
+    holdout.character = more.character;
+    holdout.inputJoints = more.inputJoints;
+    holdout.poses.assign(more.poses.begin() + 160, more.poses.end());
+    nlohmann::json origins = nlohmann::json::array();
+    for (auto& p : holdout.poses) {
+      p.id = uint32_t(origins.size());
+      origins.push_back({{"clip", "99_01"}, {"subject", "99"}});
+    }
+    const SubjectEvaluation subjects = evaluateHeldOutSubjects(out, ds, holdout, origins, {"99"}, 16);
+    ASSERT_TRUE(subjects.levels.measured());
+    ASSERT_EQ(subjects.levels.size(), ladder.size());
+    EXPECT_EQ(subjects.levels.poses, 16u);
+    EXPECT_DOUBLE_EQ(subjects.levels.levels[0].vertexMeanMm, subjects.overall.totalMm.mean);
+    EXPECT_DOUBLE_EQ(subjects.levels.levels.back().vertexMeanMm, subjects.overall.meanSkinnedMm.mean);
+    EXPECT_TRUE(std::isnan(subjects.levels.levels[0].cpuUsPerCharacter));  // it goes into the metadata too
+    EXPECT_TRUE(subjects.toJson().contains("quality_levels"));
+    const auto sdir = tmp / "report_subjects";
+    const auto smd = writeBakeReport(out, ds, sdir, 0, &subjects);
+    const auto sreport = nlohmann::json::parse(std::ifstream(sdir / "report.json"));
+    EXPECT_EQ(sreport["quality_levels"]["held_out_subjects"]["levels"].size(), ladder.size());
+    std::ifstream mdIn(smd);
+    const std::string text((std::istreambuf_iterator<char>(mdIn)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("held-out subjects mean mm"), std::string::npos) << text;
+  }
+
   saveModel(out.model, dir / "synthetic.swish");
   const Model loaded = loadModel(dir / "synthetic.swish");
   EXPECT_EQ(loaded.metadata, out.model.metadata);
   const auto meta = nlohmann::json::parse(loaded.metadata);
   EXPECT_TRUE(meta.contains("errors"));
+  const runtime::QualityLadder carried = runtime::ladderOf(loaded);
+  ASSERT_TRUE(meta.contains(runtime::kQualityLevelsKey));
+  ASSERT_EQ(carried.size(), ladder.size());
+  EXPECT_EQ(carried.poses, 16u);
+  EXPECT_NE(carried.measuredOn.find("held-out"), std::string::npos) << carried.measuredOn;
+  for (size_t i = 0; i < carried.size(); ++i) {
+    EXPECT_EQ(carried.levels[i].name, ladder.levels[i].name);
+    EXPECT_DOUBLE_EQ(carried.levels[i].vertexMeanMm, ladder.levels[i].vertexMeanMm);
+    EXPECT_DOUBLE_EQ(carried.levels[i].normalMeanDeg, ladder.levels[i].normalMeanDeg);
+    EXPECT_TRUE(std::isnan(carried.levels[i].cpuUsPerCharacter));  // times: the report's, not the model's
+  }
+  EXPECT_TRUE(carried.timedOn.empty());
   // The loaded model runs through the runtime: MLP -> novelty guard -> reference frame (PCA, skinning,
   // frames, VQ, blend).
   ASSERT_FALSE(loaded.noveltyGuard.empty());

@@ -153,6 +153,17 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
       std::snprintf(line, sizeof line, "part 2: %3.0f%% %-32s %6.1f s elapsed", 100.0 * f, stage.c_str(), el);
     log(line);
   });
+  if (out.ladder.measured()) {
+    std::string line = "part 2: quality levels on the held-out poses (vertex mean mm, CPU us per character):";
+    char item[96];
+    for (const runtime::QualityLevel& l : out.ladder.levels) {
+      std::snprintf(item, sizeof item, " %s %.2f / %.1f;", l.name.c_str(), l.vertexMeanMm, l.cpuUsPerCharacter);
+      line += item;
+    }
+    const size_t problems = ladderProblems(out.ladder).size();
+    log(line +
+        (problems ? " NOT monotone (" + std::to_string(problems) + " pairs; report.md says which)" : " monotone"));
+  }
   std::optional<SubjectEvaluation> subjects;
   if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {
     log("part 2: evaluating on the held-out subjects' dataset " + cfg.holdoutDatasetDir().string());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "swish/bake/compression/bc5_baseline.hpp"
 #include "swish/bake/training/body_proxy_fit.hpp"
@@ -241,6 +242,22 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
                                  ds.character.body.triangleCount() > 0 ? &ds.character.body : nullptr);
   stage("evaluation");
 
+  // The quality ladder on the same held-out poses, through the same path (its full level is the
+  // evaluation's total); the CPU times go to the report only. No held-out pose (test fraction 0): the
+  // levels stay unmeasured and the model carries none.
+  report("quality levels", 0.97);
+  out.ladder = runtime::ladderOf(out.model);
+  if (!held.empty()) {
+    char on[160];
+    std::snprintf(on, sizeof on, "the bake's held-out poses (%.0f %% of the dataset, drawn at random, not trained on)",
+                  100.0 * st.testFraction);
+    out.ladder = measureLadder(out.model, held, out.ladder, on);
+    std::vector<const Pose*> heldPoses;
+    for (const DatasetPose* p : held) heldPoses.push_back(&p->pose);
+    timeLadderCpu(out.model, heldPoses, out.ladder);
+  }
+  stage("quality levels");
+
   const auto& ev = out.evaluation;
   out.metadata["errors"] = {
       {"held_out_poses", ev.poses},
@@ -257,6 +274,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
        {{"best_epoch", out.regressor.bestEpoch},
         {"epochs", out.regressor.epochsRun},
         {"validation_loss", out.regressor.bestValidationLoss}}}};
+  if (out.ladder.measured()) out.metadata[runtime::kQualityLevelsKey] = runtime::toJson(withoutTimes(out.ladder));
   if (maps) {
     out.metadata["errors"]["normal_database"] = toJson(ev.normalDatabase);
     out.metadata["errors"]["normal_selection"] = toJson(ev.normalSelection);

@@ -13,6 +13,7 @@
 #include "swish/bake/compression/vq_codebook.hpp"
 #include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/bake/report/quality_ladder.hpp"
 #include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/model/model.hpp"
 
@@ -68,6 +69,11 @@ struct BakeTrainOutput {
   uint64_t bc5AtVqMemoryBytes = 0;
   MlpTrainResult regressor;
   BakeEvaluation evaluation;
+  // The model's quality levels (runtime/quality_levels.hpp) measured on the same held-out poses as
+  // `evaluation` (its full level is evaluation.totalMm), with CPU times; the model's metadata carries
+  // them without the times (quality_ladder.hpp, withoutTimes: the model's bytes stay a function of the
+  // recipe), the report with them.
+  runtime::QualityLadder ladder;
   std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
   std::vector<uint32_t> pinnedPoses;  // indices into dataset.poses always trained on (the rest pose part 1 added)
   std::vector<StageTime> stages;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/bake/report/quality_ladder.hpp"
 #include "swish/files/atomic_write.hpp"
 #include "swish/io/error_heat_map.hpp"
 #include "swish/io/png.hpp"
@@ -127,6 +128,9 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   std::filesystem::create_directories(dir);
   nlohmann::json r = bakeReportJson(out, ds);
   if (subjects) r["held_out_subjects"] = subjects->toJson();
+  const bool levels = out.ladder.measured();
+  const runtime::QualityLadder* subjectLevels = subjects && subjects->levels.measured() ? &subjects->levels : nullptr;
+  if (levels) r["quality_levels"] = ladderReportJson(out.ladder, subjectLevels);
   writeTextFileAtomic(dir / "report.json", r.dump(2) + "\n");
   const auto& ev = out.evaluation;
 
@@ -173,6 +177,13 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
      << f2(100.0 * out.meshPca.explainedVariance[out.meshPca.components()]) << "% of the training variance ("
      << (out.meshPca.randomized ? "randomised" : "exact") << " SVD).\n\n![error against K](error_vs_k.svg)\n\n";
   if (subjects) md << subjects->markdown(ev);
+  if (levels) {
+    writeTextFileAtomic(dir / "quality_levels.svg", ladderPlotSvg(out.ladder, subjectLevels));
+    md << ladderMarkdown(out.ladder, subjectLevels, "quality_levels.svg");
+    if (subjects && !subjects->guard.rows.empty())
+      md << "The levels are measured with the novelty guard of the mesh error above (the clamp); a blend the guard "
+            "study above chooses is not in these figures.\n\n";
+  }
   if (ev.penetrationMeasured) {
     md << "## Garment inside the body\n\nHeld-out poses against the character's posed body, truth and model side by "
           "side "

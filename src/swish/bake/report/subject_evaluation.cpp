@@ -46,6 +46,7 @@ nlohmann::json SubjectEvaluation::toJson() const {
                       {"overall", evaluationSummary(overall)},
                       {"per_clip", clips}};
   if (!guard.rows.empty()) j["novelty_guard_study"] = guard.toJson();
+  if (levels.measured()) j["quality_levels"] = runtime::toJson(levels);
   return j;
 }
 
@@ -247,6 +248,9 @@ SubjectEvaluation evaluateHeldOutSubjects(const BakeTrainOutput& out, const Data
   for (uint32_t i : out.trainingPoses) trained.push_back(&training.poses[i]);
   for (uint32_t i : out.testPoses) random.push_back(&training.poses[i]);
   r.guard = studyNoveltyGuard(out.model, trained, all, random);
+  if (out.ladder.measured())
+    r.levels = withoutTimes(
+        measureLadder(out.model, all, out.ladder, "the held-out subjects' frames (evenly spaced over their clips)"));
   return r;
 }
 

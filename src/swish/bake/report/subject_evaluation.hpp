@@ -55,10 +55,14 @@ struct SubjectEvaluation {
   };
   std::vector<Clip> perClip;
   GuardStudy guard;
+  // The model's quality levels (the random held-out frames' ladder, BakeTrainOutput::ladder) on the
+  // held-out subjects' frames: errors only (the times are the same work, in the ladder).
+  runtime::QualityLadder levels;
 
   // {"subjects", "poses", "overall": {...}, "per_clip": [{"clip", "subject", ...}]}, each evaluation as
   // {"poses", "vertex": {mean_mm, p95_mm, max_mm}, "baseline_rest_skinned", "baseline_mean_skinned",
-  //  "normal_total": {mean_deg, ...}}: what the report and the model metadata carry.
+  //  "normal_total": {mean_deg, ...}}, and "quality_levels" (the levels on the subjects, without times):
+  // what the report and the model metadata carry.
   nlohmann::json toJson() const;
   // The report's section: the held-out subjects against `randomFrames` (the bake's random held-out
   // frames of training clips) side by side, then per clip.
