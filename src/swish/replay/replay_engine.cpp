@@ -259,8 +259,9 @@ void ReplayEngine::Impl::setUpLevels() {
 }
 
 // The planner's costs: per batch and level, the GPU time of a frame with every character of the batch at
-// that level (median of a few frames of the scene's first poses) shared out per character. The
-// calibration's frames are thrown away: filters start again and decoded maps are forgotten.
+// that level (median of a few frames of the scene's first poses) shared out per character, so that a
+// frame's fixed cost is shared too. The calibration's frames are thrown away: filters start again (the
+// first real frame blends with alpha 1) and decoded maps are forgotten.
 void ReplayEngine::Impl::calibrateLevels() {
   if (!plan.gpuWork || !levelPlanner || !levelPlanner->settings().frameBudgetMs) return;
   constexpr int kRepeats = 5;
@@ -298,14 +299,15 @@ void ReplayEngine::Impl::calibrateLevels() {
           }
         VkCommandBuffer cmd = ctx->beginOneTime();
         try {
-          B.recorder->forgetDecodedMaps();  // every repeat decodes its maps, as a first frame does
           B.recorder->record(cmd, 0, B.inputs);
         } catch (...) {
           ctx->abandonOneTime(cmd);
           throw;
         }
         ctx->endOneTimeAndWait(cmd);
-        if (r > 0) ms.push_back(B.recorder->stageTimes(0).totalMs);  // the first warms caches up
+        // The first frame decodes its maps and warms caches up; the others are the steady state, in
+        // which a frame decodes only the maps newly selected.
+        if (r > 0) ms.push_back(B.recorder->stageTimes(0).totalMs);
       }
       std::sort(ms.begin(), ms.end());
       perBatch[b].push_back(ms[ms.size() / 2] / double(std::max(n, 1u)));
