@@ -50,7 +50,11 @@ uint32_t levelIndex(const QualityLadder& ladder, const std::string& nameOrIndex,
     if (i < ladder.size()) return i;
   }
   std::string offered;
-  for (size_t i = 0; i < ladder.size(); ++i) offered += (i ? ", " : "") + std::to_string(i) + " " + ladder[i].name;
+  for (size_t i = 0; i < ladder.size(); ++i) {
+    if (i > 0) offered += ", ";
+    offered += std::to_string(i);
+    offered += " " + ladder[i].name;
+  }
   throw Error(what + ": no level '" + nameOrIndex + "' (the model's levels: " + offered + ")");
 }
 
@@ -60,7 +64,8 @@ LevelPlanner::LevelPlanner(std::vector<const QualityLadder*> ladders, std::vecto
   if (fixed_.empty()) fixed_.resize(ladders_.size());
   if (fixed_.size() != ladders_.size()) throw Error("level planner: fixed levels for another number of characters");
   for (size_t c = 0; c < ladders_.size(); ++c) {
-    if (!ladders_[c] || ladders_[c]->empty()) throw Error("level planner: character " + std::to_string(c) + " has no ladder");
+    if (!ladders_[c] || ladders_[c]->empty())
+      throw Error("level planner: character " + std::to_string(c) + " has no ladder");
     if (fixed_[c] && *fixed_[c] >= ladders_[c]->size())
       throw Error("level planner: character " + std::to_string(c) + " fixed at level " + std::to_string(*fixed_[c]) +
                   " of a ladder of " + std::to_string(ladders_[c]->size()));
@@ -168,9 +173,9 @@ const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::V
       }
       for (size_t c = 0; c < n; ++c)
         if (stepped[c])
-          out_.characters[c].reason =
-              fixed1(out_.characters[c].view.heightPixels) + " px tall: stepped down to fit the budget of " +
-              fixed1(*settings_.frameBudgetMs) + " ms";
+          out_.characters[c].reason = fixed1(out_.characters[c].view.heightPixels) +
+                                      " px tall: stepped down to fit the budget of " +
+                                      fixed1(*settings_.frameBudgetMs) + " ms";
     }
     out_.predictedMs = total;
   }

@@ -39,10 +39,10 @@ struct LevelCamera {
 
 // What a character looks like from the camera this frame.
 struct CharacterView {
-  double distance = 0;       // metres from the camera, along the view direction (depth)
-  double heightPixels = 0;   // projected height of a characterHeight-metre figure
-  double pixelsPerMm = 0;    // image pixels one millimetre covers at that depth
-  bool inView = false;       // in front of the camera and within the field of view (with a margin)
+  double distance = 0;      // metres from the camera, along the view direction (depth)
+  double heightPixels = 0;  // projected height of a characterHeight-metre figure
+  double pixelsPerMm = 0;   // image pixels one millimetre covers at that depth
+  bool inView = false;      // in front of the camera and within the field of view (with a margin)
   double weight() const { return inView ? heightPixels * heightPixels : 0.0; }  // projected area, px^2
 };
 
@@ -72,7 +72,7 @@ struct LevelChoice {
 };
 
 struct PlannedLevels {
-  std::vector<LevelChoice> characters;  // in the planner's character order
+  std::vector<LevelChoice> characters;                            // in the planner's character order
   double predictedMs = std::numeric_limits<double>::quiet_NaN();  // NaN without costs
   bool overBudget = false;  // the budget could not be met (levels held, fixed or at their cheapest)
   // Screen-weighted mean vertex error (mm) of the chosen levels and of full quality (ladder means; NaN

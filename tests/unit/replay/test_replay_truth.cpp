@@ -194,7 +194,9 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
       EXPECT_TRUE(std::isfinite(p.model.deepestMm) && p.model.deepestMm < 150.0);
     }
     for (const auto& c : f.truth)
-      if (c.ok) EXPECT_EQ(c.comparedWithout, proxy) << "frame " << f.frame;
+      if (c.ok) {
+        EXPECT_EQ(c.comparedWithout, proxy) << "frame " << f.frame;
+      }
   }
   EXPECT_EQ(r.penetrationOverall.model.frames, 10u);
   EXPECT_TRUE(rep["penetration"]["overall"]["model"]["deepestMm"].is_number());

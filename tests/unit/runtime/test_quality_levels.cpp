@@ -90,11 +90,13 @@ TEST(QualityLadder, RoundTripsThroughTheMetadataAndKeepsTheRest) {
 TEST(QualityLadder, RejectsLaddersTheModelCannotRun) {
   const Model m = modelWith(8, 0);
   const auto parse = [&](const char* text) { return ladderFromJson(nlohmann::json::parse(text), m, "ladder"); };
-  EXPECT_NE(test::errorOf([&] { parse(R"({"levels": [{"name": "a", "mesh_components": 9, "normal_maps": false}]})"); })
-                .find("more than the model's 8"),
+  EXPECT_NE(test::errorOf([&] {
+              parse(R"({"levels": [{"name": "a", "mesh_components": 9, "normal_maps": false}]})");
+            }).find("more than the model's 8"),
             std::string::npos);
-  EXPECT_NE(test::errorOf([&] { parse(R"({"levels": [{"name": "a", "mesh_components": 8, "normal_maps": true}]})"); })
-                .find("no normal-map database"),
+  EXPECT_NE(test::errorOf([&] {
+              parse(R"({"levels": [{"name": "a", "mesh_components": 8, "normal_maps": true}]})");
+            }).find("no normal-map database"),
             std::string::npos);
   EXPECT_NE(test::errorOf([&] {
               parse(R"({"levels": [{"name": "a", "mesh_components": 4, "normal_maps": false},
@@ -102,8 +104,9 @@ TEST(QualityLadder, RejectsLaddersTheModelCannotRun) {
             }).find("costs more than the level before it"),
             std::string::npos);
   EXPECT_NE(test::errorOf([&] { parse(R"({"levels": []})"); }).find("empty"), std::string::npos);
-  EXPECT_NE(test::errorOf([&] { parse(R"({"levels": [{"mesh_components": 4, "normal_maps": false}]})"); })
-                .find("levels[0].name"),
+  EXPECT_NE(test::errorOf([&] {
+              parse(R"({"levels": [{"mesh_components": 4, "normal_maps": false}]})");
+            }).find("levels[0].name"),
             std::string::npos);
 }
 

@@ -52,8 +52,9 @@ TEST(ReferenceLevels, PcaReadsOnlyTheLeadingComponents) {
     const Points3f full = referencePcaReconstruct(m.meshPca, zeroed);
     ASSERT_EQ(got.size(), full.size());
     for (Eigen::Index i = 0; i < got.size(); ++i) ASSERT_EQ(got.data()[i], full.data()[i]) << "value " << i;
-    if (k == 0)
+    if (k == 0) {
       for (Eigen::Index i = 0; i < got.size(); ++i) ASSERT_EQ(got.data()[i], m.meshPca.mean[i]);
+    }
   }
   EXPECT_NE(test::errorOf([&] { referencePcaReconstruct(m.meshPca, w, 10); }).find("10 leading components of 9"),
             std::string::npos);
