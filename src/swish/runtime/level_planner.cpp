@@ -120,7 +120,9 @@ const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::V
     movable[c] = true;
     level[c] = 0;
     ch.reason = "full quality";
-    if (!ch.view.inView) {
+    // Without a tolerance every character starts at full quality (a budget then steps the ones out of
+    // view down first: their weight is 0).
+    if (settings_.tolerancePixels && !ch.view.inView) {
       level[c] = uint32_t(ladder.size() - 1);
       ch.reason = "out of view";
     } else if (settings_.tolerancePixels && ladder.measured()) {

@@ -9,7 +9,8 @@
 //     ladder's mean, mm) times that; a character's weight is its projected area, so the error a player
 //     sees is the screen-weighted mean over characters.
 //   - A pixel tolerance (optional): a character runs at the cheapest level whose error on screen is below
-//     it. Without one every character starts from full quality (what the replay did before levels).
+//     it, and at the cheapest level when it is out of view. Without one every character starts from full
+//     quality (what the replay did before levels), in view or not.
 //   - A frame budget (optional, GPU milliseconds): while the predicted frame cost is above it, the
 //     character whose next cheaper level adds the least screen-weighted error per millisecond saved is
 //     stepped down (greedy, as LOD systems spend a budget): small and far characters first, the nearest

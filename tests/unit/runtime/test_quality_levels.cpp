@@ -179,13 +179,20 @@ TEST(LevelPlanner, ToleranceChoosesTheCheapestLevelWithinItOnScreen) {
   s.camera.verticalFovDegrees = 90;
   s.camera.imageHeightPixels = 1000;
   s.tolerancePixels = 0.5;  // 0.05 px per mm at 10 m: 10 mm fit; 0.025 at 20 m: 20 mm fit
-  LevelPlanner planner({&ladder, &ladder, &ladder}, {}, s);
-  const std::vector<Eigen::Vector3d> roots = {{0, 1, 0}, {0, 1, 10}, {0, 1, -9}};
+  LevelPlanner planner({&ladder, &ladder, &ladder, &ladder}, {}, s);
+  const std::vector<Eigen::Vector3d> roots = {{0, 1, 0}, {0, 1, 10}, {0, 1, -9}, {0, 1, -30}};
   const PlannedLevels& p = planner.plan(0, roots);
   EXPECT_EQ(p.characters[0].level, 2u);  // 8 mm * 0.05 = 0.4 px
   EXPECT_EQ(p.characters[1].level, 2u);  // 30 mm * 0.025 = 0.75 px: too much
   EXPECT_EQ(p.characters[2].level, 0u);  // 1 m away: 2 mm would be a whole pixel
   EXPECT_NE(p.characters[0].reason.find("within"), std::string::npos);
+  EXPECT_EQ(p.characters[3].level, 3u);  // behind the camera
+  EXPECT_EQ(p.characters[3].reason, "out of view");
+  // Neither tolerance nor budget: everyone at full quality, in view or not (the replay before levels).
+  LevelPlannerSettings none = s;
+  none.tolerancePixels.reset();
+  LevelPlanner plain({&ladder, &ladder, &ladder, &ladder}, {}, none);
+  for (const LevelChoice& c : plain.plan(0, roots).characters) EXPECT_EQ(c.level, 0u);
 }
 
 TEST(LevelPlanner, BudgetStepsDownSmallAndFarCharactersFirst) {
