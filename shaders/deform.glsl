@@ -33,15 +33,21 @@
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
 //
 // Quality levels (runtime/quality_levels.hpp): instance i reconstructs from its first k_i components
-// only. The work shrinks per instance in this one dispatch, without a pipeline per level: instance i
-// reads instanceGroups[i] = ceil(k_i / 4) vec4 groups of weights (one word per instance, the same
-// address in every thread, so lavapipe's SIMD lanes and a GPU's waves all take the same side of the
-// `q < groups` branches), and every vertex loads only the first maxGroups groups of its basis (a push
-// constant: a frame whose characters are all cheap reads less of the basis, the largest input). The
-// weights of instance i from k_i to the end of its last group are zero (DeformPass::packWeights), so a
-// group read whole adds exact zeros: the sum is the reference's sum over k < k_i, k ascending. The
-// loops stay unrolled with uniform branches inside, rather than a loop bounded by `groups`, so that
-// `basis` keeps constant indices (registers); a level is a branch skipped, not a different loop.
+// only, in this one dispatch, and reads only the weight groups (vec4 texels) its level needs. Levels
+// come as BANDS of weight groups fixed at pipeline creation (specialisation constants, from
+// DeformPass::bandsOf: K4, then about K4 / 2, K4 / 4, K4 / 8 groups, then 0, the distinct ones): the
+// host orders the instances by band (instanceOrder) and gives each band's end (bandEnd), and each band
+// is its own instance loop whose body is unrolled to exactly that band's groups. Why loops and not
+// branches: a uniform `if (q < groups)` inside one unrolled body is what a GPU skips cheaply, but
+// lavapipe (Mesa 22.3) runs both sides of every `if` under a lane mask, so it saved nothing there
+// (docs/performance.md, "Quality levels"); a loop's later iterations are real branches everywhere, so
+// a band's loop costs what its instances need. An empty band still costs lavapipe one masked
+// iteration of its body, which is why frames without levels use a pipeline with one band (BANDS = 1,
+// instanceOrder 0: the kernel as it was) and why the bands are few. An instance whose k_i is below its
+// band's groups reads zeros there: DeformPass::packWeights zeroes each row from k_i, and adding an
+// exact zero changes nothing, so the sum is the reference's sum over k < k_i, k ascending. Each vertex
+// loads only the basis groups of the widest band in use (maxGroups, a push constant: skipped on GPUs,
+// masked on lavapipe, where the basis is loaded once per vertex whatever the instance count).
 #include "swish_buffers.glsl"
 #include "swish_layouts.h"
 
@@ -49,6 +55,11 @@ layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint K = 1;               // mesh PCA components
 layout(constant_id = 2) const uint INFLUENCES = 4;      // skin influences per vertex
 layout(constant_id = 3) const bool APPLY_SKINNING = true;  // false: write the pre-skinning shape
+layout(constant_id = 4) const uint BANDS = 1;           // bands of weight groups, 1..5 (1: all at K4)
+layout(constant_id = 5) const uint BAND1 = 0;           // weight groups of bands 1..4 (descending;
+layout(constant_id = 6) const uint BAND2 = 0;           //  band 0 reads all K4; those from BANDS on
+layout(constant_id = 7) const uint BAND3 = 0;           //  are unused)
+layout(constant_id = 8) const uint BAND4 = 0;
 
 layout(push_constant) uniform Push { DeformParams p; };
 layout(set = 0, binding = 0) uniform samplerBuffer weightTexels;  // vec4[instance][K4 / 4]
@@ -58,19 +69,81 @@ layout(set = 0, binding = 2) uniform samplerBuffer basisTexels;  // float[K][3N]
 #endif
 const uint K4 = (K + 3u) / 4u;
 
+// This thread's vertex: loaded once, read by every instance.
+uint v;
+vec3 mean;
+float basis[3 * K];
+uint joints[INFLUENCES];
+float skinW[INFLUENCES];
+
+// One instance's vertex from its first `groups` weight groups (a constant at every call, so that the
+// unrolled loop keeps constant indices into `basis` and drops the groups beyond).
+void deformInstance(const uint instance, const uint groups) {
+  precise vec3 x = mean;
+  [[unroll]] for (uint q = 0u; q < K4; ++q) {
+    if (q < groups) {
+      const vec4 w4 = texelFetch(weightTexels, int(instance * K4 + q));  // the same texel in every thread
+      [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+        const uint k = 4u * q + j;
+        if (k < K) x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w4[j];
+      }
+    }
+  }
+  precise vec3 y = x;
+  if (APPLY_SKINNING) {
+    // Each matrix comes as its top three rows (3 fetches); the columns summed below are their
+    // components. The zero-weight skip is a select, not a branch: every lane runs the same fetches
+    // (lavapipe gathers per lane, masked branches do not save that), and a skipped matrix still
+    // cannot bring its NaN/Inf in.
+    precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
+    [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
+      const int m = int((instance * p.jointCount + joints[i]) * 3u);
+      const float w = skinW[i];
+      const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2);
+      const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w);
+      const bool use = w != 0.0;
+      b0 = use ? b0 + w * c0 : b0;
+      b1 = use ? b1 + w * c1 : b1;
+      b2 = use ? b2 + w * c2 : b2;
+      b3 = use ? b3 + w * c3 : b3;
+    }
+    y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
+  }
+  if (p.capsuleCount > 0u) {
+    FloatsIn caps = FloatsIn(p.capsules);
+    for (uint c = 0u; c < p.capsuleCount; ++c) {
+      const uint b = (instance * p.capsuleCount + c) * 8u;
+      const vec3 a = vec3(caps.v[b], caps.v[b + 1u], caps.v[b + 2u]);
+      const float r = caps.v[b + 3u];
+      const vec3 d = vec3(caps.v[b + 4u], caps.v[b + 5u], caps.v[b + 6u]);
+      const float invLenSq = caps.v[b + 7u];
+      precise const vec3 w = y - a;
+      precise const float t = clamp(((w.x * d.x + w.y * d.y) + w.z * d.z) * invLenSq, 0.0, 1.0);
+      precise const vec3 q = a + d * t;
+      precise const vec3 e = y - q;
+      precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
+      if (s > 1e-12 && s < r * r) y = q + e * (r / sqrt(s));  // kMinPushDistanceSq
+    }
+  }
+  FloatsOut outBuf = FloatsOut(p.positionsOut);
+  const uint o = (instance * p.vertexCount + v) * 3u;
+  outBuf.v[o] = y.x;
+  outBuf.v[o + 1u] = y.y;
+  outBuf.v[o + 2u] = y.z;
+}
+
+// Where band b ends in instanceOrder (the last band at instanceCount).
+uint bandEnd(const uint b) { return b + 1u >= BANDS ? p.instanceCount : p.bandEnd[b]; }
+
 void main() {
-  const uint v = gl_GlobalInvocationID.x;
+  v = gl_GlobalInvocationID.x;
   if (v >= p.vertexCount) return;
   const uint n3 = p.vertexCount * 3u;
 
-  // Groups of the basis loaded: as many as the instance reading most reads (the min keeps a maxGroups
-  // beyond the K4 groups there are in range; the per-instance min below keeps unloaded entries unread).
+  // Basis groups loaded: those of the widest band in use (the min keeps a maxGroups beyond K4 in range).
   const uint loadGroups = min(p.maxGroups, K4);
-  float basis[3 * K];
-  uint joints[INFLUENCES];
-  float skinW[INFLUENCES];
   FloatsIn meanBuf = FloatsIn(p.mean);
-  const vec3 mean = vec3(meanBuf.v[3u * v], meanBuf.v[3u * v + 1u], meanBuf.v[3u * v + 2u]);
+  mean = vec3(meanBuf.v[3u * v], meanBuf.v[3u * v + 1u], meanBuf.v[3u * v + 2u]);
 #ifdef SWISH_DEFORM_BASIS_TEXELS
   [[unroll]] for (uint k = 0u; k < K; ++k) {
     if (k / 4u < loadGroups) {
@@ -96,61 +169,19 @@ void main() {
     skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
   }
 
-  FloatsOut outBuf = FloatsOut(p.positionsOut);
-  const bool perInstanceGroups = p.instanceGroups != uvec2(0u);
-  UintsIn groupsBuf = UintsIn(p.instanceGroups);
-  for (uint instance = 0u; instance < p.instanceCount; ++instance) {
-    // The same word in every thread.
-    const uint groups = perInstanceGroups ? min(groupsBuf.v[instance], loadGroups) : loadGroups;
-    precise vec3 x = mean;
-    [[unroll]] for (uint q = 0u; q < K4; ++q) {
-      if (q < groups) {
-        const vec4 w4 = texelFetch(weightTexels, int(instance * K4 + q));  // the same texel in every thread
-        [[unroll]] for (uint j = 0u; j < 4u; ++j) {
-          const uint k = 4u * q + j;
-          if (k < K) x = x + vec3(basis[3u * k], basis[3u * k + 1u], basis[3u * k + 2u]) * w4[j];
-        }
-      }
-    }
-    precise vec3 y = x;
-    if (APPLY_SKINNING) {
-      // Each matrix comes as its top three rows (3 fetches); the columns summed below are their
-      // components. The zero-weight skip is a select, not a branch: every lane runs the same fetches
-      // (lavapipe gathers per lane, masked branches do not save that), and a skipped matrix still
-      // cannot bring its NaN/Inf in.
-      precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
-      [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
-        const int m = int((instance * p.jointCount + joints[i]) * 3u);
-        const float w = skinW[i];
-        const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2);
-        const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w);
-        const bool use = w != 0.0;
-        b0 = use ? b0 + w * c0 : b0;
-        b1 = use ? b1 + w * c1 : b1;
-        b2 = use ? b2 + w * c2 : b2;
-        b3 = use ? b3 + w * c3 : b3;
-      }
-      y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
-    }
-    if (p.capsuleCount > 0u) {
-      FloatsIn caps = FloatsIn(p.capsules);
-      for (uint c = 0u; c < p.capsuleCount; ++c) {
-        const uint b = (instance * p.capsuleCount + c) * 8u;
-        const vec3 a = vec3(caps.v[b], caps.v[b + 1u], caps.v[b + 2u]);
-        const float r = caps.v[b + 3u];
-        const vec3 d = vec3(caps.v[b + 4u], caps.v[b + 5u], caps.v[b + 6u]);
-        const float invLenSq = caps.v[b + 7u];
-        precise const vec3 w = y - a;
-        precise const float t = clamp(((w.x * d.x + w.y * d.y) + w.z * d.z) * invLenSq, 0.0, 1.0);
-        precise const vec3 q = a + d * t;
-        precise const vec3 e = y - q;
-        precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
-        if (s > 1e-12 && s < r * r) y = q + e * (r / sqrt(s));  // kMinPushDistanceSq
-      }
-    }
-    const uint o = (instance * p.vertexCount + v) * 3u;
-    outBuf.v[o] = y.x;
-    outBuf.v[o + 1u] = y.y;
-    outBuf.v[o + 2u] = y.z;
+  if (BANDS == 1u) {  // every instance at K4 groups, in order
+    for (uint instance = 0u; instance < p.instanceCount; ++instance) deformInstance(instance, K4);
+    return;
   }
+  // The instances band by band, in instanceOrder (the same word in every thread).
+  UintsIn order = UintsIn(p.instanceOrder);
+  uint j = 0u;
+  for (; j < bandEnd(0u); ++j) deformInstance(order.v[j], K4);
+  for (; j < bandEnd(1u); ++j) deformInstance(order.v[j], BAND1);
+  if (BANDS > 2u)
+    for (; j < bandEnd(2u); ++j) deformInstance(order.v[j], BAND2);
+  if (BANDS > 3u)
+    for (; j < bandEnd(3u); ++j) deformInstance(order.v[j], BAND3);
+  if (BANDS > 4u)
+    for (; j < bandEnd(4u); ++j) deformInstance(order.v[j], BAND4);
 }

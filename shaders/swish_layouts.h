@@ -9,7 +9,7 @@
 //   PCA mean          : float[3N];  PCA basis: float[k][3N] (column-major 3N x K, as Eigen stores MeshPca::basis)
 //   mesh weights      : float[instance][K4], K4 = K rounded up to 4, zero padded (read as vec4 texels);
 //                       an instance at a quality level of k < K components has zeros from k on
-//   instance groups   : uint[instance], the vec4 groups of mesh weights each instance reads, ceil(k / 4)
+//   instance order    : uint[instance], the instances band by band (deform quality levels, deform.glsl)
 //   skin matrix rows  : vec4[instance][joint][3], rows 0..2 of each affine skinning matrix (texels)
 //   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
 //   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
@@ -40,8 +40,9 @@ struct alignas(8) Address {
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
 // push-out of the posed body proxy (runtime/reference_push_out.hpp). The mesh weights
 // (float[instanceCount][K4]) and skin matrix rows (vec4[instanceCount][jointCount][3]) are texel
-// buffers of its descriptor set. Quality levels: instance i reads only its first instanceGroups[i]
-// vec4 groups of weights, and every vertex loads only the first maxGroups groups of its basis.
+// buffers of its descriptor set. Quality levels (pipelines with more than one band): the instances
+// come band by band in instanceOrder, band b ending at bandEnd[b] (the last at instanceCount), each
+// reading its band's weight groups; every vertex loads only the first maxGroups groups of its basis.
 struct DeformParams {
   SWISH_ADDRESS mean;            // float[3N]
   SWISH_ADDRESS basis;           // float[K][3N]
@@ -49,12 +50,13 @@ struct DeformParams {
   SWISH_ADDRESS skinWeights;     // float[N][influences]
   SWISH_ADDRESS positionsOut;    // float[instanceCount][N][3]
   SWISH_ADDRESS capsules;        // float[instanceCount][capsuleCount][8]: posed capsules (unused when 0)
-  SWISH_ADDRESS instanceGroups;  // uint[instanceCount]: weight groups each instance reads; 0: maxGroups each
+  SWISH_ADDRESS instanceOrder;   // uint[instanceCount]: instances by band (unused with one band)
   uint vertexCount;
   uint instanceCount;
   uint jointCount;
   uint capsuleCount;             // 0: no push-out
-  uint maxGroups;                // the most groups an instance reads (K4 / 4 without instanceGroups)
+  uint maxGroups;                // basis groups each vertex loads: the widest band in use (K4 / 4 at most)
+  uint bandEnd[4];               // end of bands 0..3 in instanceOrder (bands beyond the pipeline's: unused)
   uint pad0;
 };
 
@@ -117,7 +119,7 @@ struct CopyVec4Params {
 
 #ifdef __cplusplus
 static_assert(sizeof(Address) == 8);
-static_assert(sizeof(DeformParams) == 7 * 8 + 24);
+static_assert(sizeof(DeformParams) == 7 * 8 + 40);
 static_assert(sizeof(TangentFramesParams) == 9 * 8 + 16);
 static_assert(sizeof(VqDecodeParams) == 5 * 8 + 16);
 static_assert(sizeof(NormalMapBlendCharacter) == 8);

@@ -5,21 +5,31 @@
 // tangent-frames pass on the same 22 deformed instances, single-pass kernel vs the two-pass
 // (per-triangle terms + per-vertex gather) that FrameRecorder uses. And the push-out step of the deform
 // (the body proxy's capsules, runtime/reference_push_out.hpp): the same dispatch with and without it,
-// alternating, its share of the deform pass reported (goal <= 10%).
+// alternating, its share of the deform pass reported (goal <= 10%). And quality levels (issue 21): the
+// deform pass and the whole frame (FrameRecorder) of 22 characters of the committed default model
+// (assets/default/default.swish) at each level of its default ladder, and at a mix of them.
 //   ./bench_deform --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 
+#include "support/paths.hpp"
 #include "support/random_model.hpp"
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/copy_vec4_pass.hpp"
 #include "swish/gpu/deform_pass.hpp"
 #include "swish/gpu/empty_dispatch_pass.hpp"
+#include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 #include "swish/gpu/timestamp_queries.hpp"
+#include "swish/model/model_file.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_push_out.hpp"
 
 namespace swish {
@@ -290,6 +300,237 @@ void BM_EmptyDispatch(benchmark::State& state) {
   state.counters["dispatches"] = n;
 }
 BENCHMARK(BM_EmptyDispatch)->Arg(1)->Arg(100)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.3);
+
+// Quality levels ---------------------------------------------------------------------------------
+
+// The committed default model on the device, and its default ladder (runtime::defaultLadder: full,
+// k64, k32-flat, k16-flat, skinned for its K = 128 with maps). SWISH_DEFAULT_MODEL overrides the path
+// (a build run from another checkout).
+struct DefaultModel {
+  Model model;
+  std::unique_ptr<gpu::GpuModel> gpu;
+  runtime::QualityLadder ladder;
+};
+
+const DefaultModel* defaultModel(gpu::Context& ctx) {
+  static std::unique_ptr<DefaultModel> m;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    const char* env = std::getenv("SWISH_DEFAULT_MODEL");
+    const std::filesystem::path file =
+        env ? std::filesystem::path(env) : test::sourceDir() / "assets/default/default.swish";
+    if (std::filesystem::exists(file)) {
+      m = std::make_unique<DefaultModel>();
+      m->model = loadModel(file);
+      m->gpu = std::make_unique<gpu::GpuModel>(ctx, m->model, "default");
+      m->ladder = runtime::defaultLadder(m->model);
+      std::fprintf(stderr, "bench_deform: %s: %u vertices, K %d, ladder", file.c_str(), m->gpu->vertexCount(),
+                   m->model.meshComponents());
+      for (const auto& l : m->ladder.levels) std::fprintf(stderr, " %s", l.name.c_str());
+      std::fprintf(stderr, "\n");
+    }
+  }
+  return m.get();
+}
+
+// The level of each of `instances` characters: all at ladder level `level`; for level ==
+// ladder.size() a mix (a crowd seen from the side line: a few near at full, most far): per 11
+// characters 2 full, 2 at level 1, 3 at level 2, 2 at level 3, 2 at the last level; for
+// ladder.size() + 1 all at full but one at the last level (the frame where bands gain least).
+std::vector<size_t> levelsOf(const runtime::QualityLadder& ladder, size_t level, uint32_t instances) {
+  std::vector<size_t> out(instances, level);
+  if (level == ladder.size()) {
+    static const size_t mix[11] = {0, 0, 1, 1, 2, 2, 2, 3, 3, 4, 4};
+    for (uint32_t i = 0; i < instances; ++i) out[i] = std::min(mix[i % 11], ladder.size() - 1);
+  } else if (level == ladder.size() + 1) {  // all full but the last, at the cheapest level
+    std::fill(out.begin(), out.end(), 0);
+    out.back() = ladder.size() - 1;
+  }
+  return out;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// The configurations timed against each other: "full_nobands" (the pipeline without bands: every
+// instance reads all K, the pass as it was before levels and as FrameRecorder runs a frame without
+// levels), then each ladder level for all 22 characters (the pipeline with bands), then the mix.
+// Every iteration times each once, in turn, so that the drift of a shared machine (lavapipe runs on
+// its CPUs) hits all alike; the counters are per-configuration medians.
+struct LevelConfig {
+  std::string name;
+  size_t level;  // ladder index, ladder.size(): mixed
+  bool bands;    // the pipeline with bands (FrameRecorder's whenever an instance is below K)
+};
+
+std::vector<LevelConfig> levelConfigs(const runtime::QualityLadder& ladder, bool withUnbanded) {
+  std::vector<LevelConfig> c;
+  if (withUnbanded) c.push_back({"full_nobands", 0, false});
+  for (size_t l = 0; l < ladder.size(); ++l) c.push_back({ladder[l].name, l, true});
+  c.push_back({"mixed", ladder.size(), true});
+  c.push_back({"one_" + ladder.levels.back().name, ladder.size() + 1, true});
+  return c;
+}
+
+// The deform pass alone: 22 instances of the default model per configuration (levelConfigs); reports
+// the median GPU time of each in microseconds (<name>_us).
+void BM_DeformLevels(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const DefaultModel* dm = defaultModel(*ctx);
+  if (!dm) return state.SkipWithError("no committed default model");
+  const gpu::GpuModel& g = *dm->gpu;
+  const uint32_t instances = 22, k = g.kernelMeshComponents();
+  Rng rng(21);
+  std::vector<float> w(size_t(instances) * k);
+  for (auto& x : w) x = float(rng.normal());
+  std::vector<Mat4f> mats;
+  for (uint32_t i = 0; i < instances; ++i) {
+    const auto m = dm->model.skeleton.skinningMatrices(test::makeRandomPose(rng, dm->model.skeleton, 0.3f));
+    mats.insert(mats.end(), m.begin(), m.end());
+  }
+  std::vector<float> matrixRows(mats.size() * 12);
+  gpu::DeformPass::packSkinMatrices(mats.data(), mats.size(), matrixRows.data());
+  gpu::Buffer matrices(*ctx, matrixRows.size() * 4, gpu::MemoryKind::DeviceLocal, "matrices");
+  matrices.upload(*ctx, matrixRows.data(), matrixRows.size() * 4);
+  gpu::Buffer positions(*ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal,
+                        "positions");
+  // As FrameRecorder makes it: the basis as texels where the device allows.
+  const gpu::DeformPass pass(*ctx, k, g.influences(), true, g.basis.size() / sizeof(float));
+  struct Run {
+    gpu::Buffer weights, order;
+    gpu::DescriptorBinding inputs;
+    gpu::DeformPass::Args args;
+    std::vector<double> us;
+  };
+  const std::vector<LevelConfig> configs = levelConfigs(dm->ladder, true);
+  std::vector<Run> runs(configs.size());
+  for (size_t c = 0; c < configs.size(); ++c) {
+    std::vector<uint32_t> components;
+    for (size_t l : levelsOf(dm->ladder, configs[c].level, instances))
+      components.push_back(dm->ladder[l].meshComponents);
+    std::vector<float> rows(gpu::DeformPass::weightsBytes(instances, k) / 4);
+    gpu::DeformPass::packWeights(w.data(), instances, k, components, rows.data());
+    const gpu::DeformPass::Levels levels = gpu::DeformPass::packLevels(components, k);
+    Run& r = runs[c];
+    r.weights = gpu::Buffer(*ctx, rows.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
+    r.weights.upload(*ctx, rows.data(), rows.size() * 4);
+    r.order = gpu::Buffer(*ctx, levels.order.size() * 4, gpu::MemoryKind::DeviceLocal, "instance order");
+    r.order.upload(*ctx, levels.order.data(), levels.order.size() * 4);
+    r.inputs = pass.bindInstanceInputs(*ctx, r.weights, matrices, &g.basis);
+    gpu::DeformPass::Args& a = r.args;
+    a.mean = g.mean.address();
+    a.basis = g.basis.address();
+    a.instanceInputs = r.inputs.get();
+    a.skinJoints = g.skinJoints.address();
+    a.skinWeights = g.skinWeights.address();
+    a.positionsOut = positions.address();
+    a.vertexCount = g.vertexCount();
+    a.instanceCount = instances;
+    a.jointCount = g.jointCount();
+    if (configs[c].bands) {
+      a.instanceOrder = r.order.address();
+      a.bandEnd = levels.bandEnd;
+      a.maxGroups = levels.maxGroups;
+    }
+  }
+  gpu::TimestampQueries ts(*ctx, 2);
+  for (const Run& r : runs)  // warm-up (first-use compile)
+    gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { pass.record(cmd, r.args); });
+  for (auto _ : state) {
+    double sum = 0;
+    for (Run& r : runs) {
+      const double t = gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { pass.record(cmd, r.args); });
+      r.us.push_back(t * 1e6);
+      sum += t;
+    }
+    state.SetIterationTime(sum);
+  }
+  for (size_t c = 0; c < configs.size(); ++c) state.counters[configs[c].name + "_us"] = median(runs[c].us);
+  state.SetLabel("22 instances of the default model, medians per level; Time: all of them in turn");
+}
+BENCHMARK(BM_DeformLevels)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(2.0);
+
+// Whole frames (FrameRecorder: deform, normals + tangents, VQ decode, blend; two frames in flight) of
+// 22 characters of the default model, one recorder per configuration (levelConfigs), a frame of each in
+// turn per iteration, from GPU timestamps. Every character with maps selects a random database map
+// every frame (the decode's worst case: few maps are still in a slot); characters at a level without
+// maps select kNoMap. Counters: median frame time per configuration (<name>_us); the median per stage
+// goes to stderr.
+void BM_FrameLevels(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const DefaultModel* dm = defaultModel(*ctx);
+  if (!dm) return state.SkipWithError("no committed default model");
+  const Model& model = dm->model;
+  const uint32_t instances = 22, k = uint32_t(model.meshComponents()), maps = model.normalMaps.mapCount();
+  struct Run {
+    std::unique_ptr<gpu::FrameRecorder> recorder;
+    std::vector<size_t> levels;
+    runtime::FrameKernelInputs in;
+    std::vector<double> deform, frames, decode, blend, total;  // us
+  };
+  const std::vector<LevelConfig> configs = levelConfigs(dm->ladder, false);
+  std::vector<Run> runs(configs.size());
+  Rng rng(22);
+  for (size_t c = 0; c < configs.size(); ++c) {
+    Run& r = runs[c];
+    r.recorder = std::make_unique<gpu::FrameRecorder>(*ctx, *dm->gpu, instances);
+    r.levels = levelsOf(dm->ladder, configs[c].level, instances);
+    runtime::FrameKernelInputs& in = r.in;
+    in.instanceCount = instances;
+    in.meshWeights.resize(size_t(instances) * k);
+    for (auto& x : in.meshWeights) x = float(rng.normal());
+    for (uint32_t i = 0; i < instances; ++i) {
+      const auto m = model.skeleton.skinningMatrices(test::makeRandomPose(rng, model.skeleton, 0.3f));
+      in.skinMatrices.insert(in.skinMatrices.end(), m.begin(), m.end());
+      in.meshComponents.push_back(dm->ladder[r.levels[i]].meshComponents);
+    }
+    in.blendAlpha.assign(instances, 0.3f);
+    in.selectedMaps.assign(instances, runtime::kNoMap);
+  }
+  uint64_t frame = 0;
+  auto runFrame = [&](Run& r, bool keep) {
+    for (uint32_t i = 0; i < instances && maps > 0; ++i)
+      r.in.selectedMaps[i] = dm->ladder[r.levels[i]].normalMaps ? uint32_t(rng.below(maps)) : runtime::kNoMap;
+    const uint64_t f = frame;
+    ctx->submitAndWait([&](VkCommandBuffer cmd) { r.recorder->record(cmd, f, r.in); });
+    const gpu::StageTimes t = r.recorder->stageTimes(r.recorder->slotOf(f));
+    const auto us = [](double ms) { return std::isnan(ms) ? 0.0 : ms * 1e3; };
+    if (keep) {
+      r.deform.push_back(us(t.deformMs));
+      r.frames.push_back(us(t.tangentFramesMs));
+      r.decode.push_back(us(t.vqDecodeMs));
+      r.blend.push_back(us(t.normalBlendMs));
+      r.total.push_back(us(t.totalMs));
+    }
+    return t.totalMs * 1e-3;
+  };
+  for (int i = 0; i < 3; ++i, ++frame)  // warm-up: first-use compiles, both slots
+    for (Run& r : runs) runFrame(r, false);
+  for (auto _ : state) {
+    double sum = 0;
+    for (Run& r : runs) sum += runFrame(r, true);
+    ++frame;
+    state.SetIterationTime(sum);
+  }
+  std::fprintf(stderr, "bench_deform: BM_FrameLevels medians (us), %zu frames each:\n  %-10s %8s %8s %8s %8s %8s\n",
+               runs[0].total.size(), "level", "deform", "frames", "decode", "blend", "total");
+  for (size_t c = 0; c < configs.size(); ++c) {
+    const Run& r = runs[c];
+    std::fprintf(stderr, "  %-10s %8.0f %8.0f %8.0f %8.0f %8.0f\n", configs[c].name.c_str(), median(r.deform),
+                 median(r.frames), median(r.decode), median(r.blend), median(r.total));
+    state.counters[configs[c].name + "_us"] = median(r.total);
+  }
+  state.SetLabel("22 characters of the default model, medians per level; Time: all of them in turn");
+}
+BENCHMARK(BM_FrameLevels)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(5.0);
 
 }  // namespace
 }  // namespace swish

@@ -76,8 +76,9 @@ struct GpuDeformResult {
 
 // basisTexels: the pass reads the basis as texels (deform_basis_texels.comp) where the device's
 // maxTexelBufferElements allows, else through its address (deform.comp).
-// With per-instance components: the groups buffer, and `poisonUnreadGroups` writes NaN into every
-// packed weight group beyond an instance's own (what packWeights zeroes): the kernel must not read them.
+// With per-instance components: the kernel with bands (DeformPass::packLevels), and `poisonUnreadGroups`
+// writes NaN into every packed weight group beyond the instance's band (zero up to there, as packWeights
+// leaves them): the kernel must not read them.
 GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinning, bool basisTexels,
                           bool poisonUnreadGroups = false) {
   const Model& m = in.model;
@@ -88,15 +89,16 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   std::vector<float> weightRows(gpu::DeformPass::weightsBytes(in.instances, k) / sizeof(float));
   gpu::DeformPass::packWeights(in.weights.data(), in.instances, k, in.components,
                                weightRows.data());  // the kernel's padded rows
-  std::vector<uint32_t> groups(std::max<size_t>(in.components.size(), 1));
-  const uint32_t maxGroups = gpu::DeformPass::packGroups(in.components, k, groups.data());
+  const gpu::DeformPass::Levels levels = gpu::DeformPass::packLevels(in.components, k);
   const uint32_t k4 = gpu::DeformPass::paddedComponents(k);
   if (poisonUnreadGroups && !in.components.empty())
     for (uint32_t i = 0; i < in.instances; ++i)
-      std::fill(weightRows.begin() + i * k4 + 4 * groups[i], weightRows.begin() + (i + 1) * k4,
+      std::fill(weightRows.begin() + i * k4 + 4 * levels.groups[i], weightRows.begin() + (i + 1) * k4,
                 std::numeric_limits<float>::quiet_NaN());
   CheckedInput weights(ctx, std::span<const float>(weightRows), "weights");
-  CheckedInput instanceGroups(ctx, std::span<const uint32_t>(groups), "instance groups");
+  std::vector<uint32_t> order = levels.order;
+  if (order.empty()) order.push_back(0);  // (a buffer of 1 word: unread without levels)
+  CheckedInput instanceOrder(ctx, std::span<const uint32_t>(order), "instance order");
   std::vector<float> matrixRows(in.matrices.size() * 12);
   gpu::DeformPass::packSkinMatrices(in.matrices.data(), in.matrices.size(), matrixRows.data());  // the kernel's layout
   CheckedInput matrices(ctx, std::span<const float>(matrixRows), "skin matrices");
@@ -120,14 +122,15 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   a.instanceCount = in.instances;
   a.jointCount = uint32_t(m.skeleton.size());
   if (!in.components.empty()) {
-    a.instanceGroups = instanceGroups.address();
-    a.maxGroups = maxGroups;
+    a.instanceOrder = instanceOrder.address();
+    a.bandEnd = levels.bandEnd;
+    a.maxGroups = levels.maxGroups;
   }
   ctx.submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, a); });
 
   GpuDeformResult r;
   r.positions = out.read<float>(ctx);
-  for (const CheckedInput* c : {&mean, &basis, &weights, &instanceGroups, &matrices, &skinJoints, &skinWeights})
+  for (const CheckedInput* c : {&mean, &basis, &weights, &instanceOrder, &matrices, &skinJoints, &skinWeights})
     if (auto s = c->unchanged(ctx); !s.empty()) r.problems.push_back(s);
   if (auto s = out.guardsIntact(ctx); !s.empty()) r.problems.push_back(s);
   return r;
@@ -291,9 +294,9 @@ TEST_F(DeformSpecialValues, ExactlyRepresentableInputsGiveExactResults) {
 
 // Garbage where each instance's level ends: NaN, Inf and huge values in every weight from k_i on, in the
 // weights the CPU hands over (as FrameKernelInputs::meshWeights may hold the network's full output).
-// The reference ignores them by definition; on the GPU packWeights must zero them within the
-// instance's last group, and runDeform's poisonUnreadGroups puts NaN in the groups beyond it, which
-// the kernel must not read. Any of them reaching a sum makes that output NaN or huge: a failure.
+// The reference ignores them by definition; on the GPU packWeights must zero them up to the groups of
+// the instance's band, and runDeform's poisonUnreadGroups puts NaN in the groups beyond, which the
+// kernel must not read. Any of them reaching a sum makes that output NaN or huge: a failure.
 void poisonWeightsBeyondLevels(DeformInputs& in, Rng& rng) {
   const uint32_t k = uint32_t(in.model.meshComponents());
   const float garbage[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
@@ -328,7 +331,8 @@ void expectLevelsMatchReference(gpu::Context& ctx, const DeformInputs& in) {
 class DeformLevels : public test::GpuTest {};
 
 // Every level of runtime::defaultLadder of a K = 30 model (30, 15, 7, 3 and 0 components: odd k, k not
-// a multiple of 4, the mean shape), all 22 instances at that level in one dispatch.
+// a multiple of 4, the mean shape), all 22 instances at that level in one dispatch: each level is one
+// band of the kernel (8, 4, 2, 1, 0 groups), the others empty.
 TEST_F(DeformLevels, EveryLevelOfTheDefaultLadderMatchesReference) {
   SWISH_TEST_SEED_SCOPE(seed, 0x1AD0);
   const DeformInputs base = randomInputs(seed, {997, 30, 4, 22});
@@ -337,6 +341,7 @@ TEST_F(DeformLevels, EveryLevelOfTheDefaultLadderMatchesReference) {
   std::vector<uint32_t> ks;
   for (const auto& level : ladder.levels) ks.push_back(level.meshComponents);
   EXPECT_EQ(ks, (std::vector<uint32_t>{30, 15, 7, 3, 0})) << "the ladder this test was written for";
+  EXPECT_EQ(gpu::DeformPass::bandsOf(30), (std::vector<uint32_t>{8, 4, 2, 1, 0}));
   for (const auto& level : ladder.levels) {
     SCOPED_TRACE("level " + level.name);
     DeformInputs in = base;
@@ -346,9 +351,10 @@ TEST_F(DeformLevels, EveryLevelOfTheDefaultLadderMatchesReference) {
   }
 }
 
-// Mixed levels in one dispatch: every k from 0 to K = 30 at least once in 37 instances (so every place
-// in a group where a level can end, and whole groups), in a shuffled order; then a frame whose levels
-// all end well below K (maxGroups 5 of 8: the basis beyond is not loaded), and one of only k = 0 and 1.
+// Mixed levels in one dispatch: every k from 0 to K = 30 at least once in 37 instances (every place in
+// a group where a level can end, whole groups, every band, instances below their band's groups), in a
+// shuffled order; then a frame whose levels all end well below K (bands 0 and 1 empty, maxGroups 2 of
+// 8: the basis beyond is not loaded), and one of only k = 0 and 1 (the two narrowest bands).
 TEST_F(DeformLevels, MixedLevelsInOneDispatchMatchReference) {
   SWISH_TEST_SEED_SCOPE(seed, 0x313ED);
   const DeformInputs base = randomInputs(seed, {613, 30, 4, 37});
@@ -358,8 +364,8 @@ TEST_F(DeformLevels, MixedLevelsInOneDispatchMatchReference) {
   while (all.size() < base.instances) all.push_back(uint32_t(rng.below(31)));
   for (size_t i = all.size(); i > 1; --i) std::swap(all[i - 1], all[rng.below(i)]);
   std::vector<uint32_t> low(base.instances), lowest(base.instances);
-  for (auto& k : low) k = uint32_t(rng.below(18));  // 0..17: at most 5 groups
-  low[5] = 17;
+  for (auto& k : low) k = uint32_t(rng.below(9));  // 0..8: at most 2 groups
+  low[5] = 8;
   for (auto& k : lowest) k = uint32_t(rng.below(2));
   for (const auto& [name, components] :
        {std::pair<const char*, std::vector<uint32_t>>{"0..30", all}, {"0..17", low}, {"0..1", lowest}}) {
@@ -371,11 +377,26 @@ TEST_F(DeformLevels, MixedLevelsInOneDispatchMatchReference) {
   }
 }
 
+// The bands: the narrowest that holds each instance's groups, instances in order within a band.
+TEST_F(DeformLevels, InstancesGoToTheNarrowestBandThatHoldsTheirComponents) {
+  EXPECT_EQ(gpu::DeformPass::bandsOf(128), (std::vector<uint32_t>{32, 16, 8, 4, 0}));
+  EXPECT_EQ(gpu::DeformPass::bandsOf(6), (std::vector<uint32_t>{2, 1, 0}));
+  EXPECT_EQ(gpu::DeformPass::bandsOf(1), (std::vector<uint32_t>{1, 0}));
+  const auto l = gpu::DeformPass::packLevels(std::vector<uint32_t>{128, 0, 20, 64, 65, 16, 1, 33, 0}, 128);
+  EXPECT_EQ(l.groups, (std::vector<uint32_t>{32, 0, 8, 16, 32, 4, 4, 16, 0}));
+  EXPECT_EQ(l.order, (std::vector<uint32_t>{0, 4, 3, 7, 2, 5, 6, 1, 8}));
+  EXPECT_EQ(l.bandEnd, (std::array<uint32_t, 4>{2, 4, 5, 7}));
+  EXPECT_EQ(l.maxGroups, 32u);
+  EXPECT_EQ(gpu::DeformPass::packLevels(std::vector<uint32_t>{0, 3}, 128).maxGroups, 4u);
+  const auto small = gpu::DeformPass::packLevels(std::vector<uint32_t>{0, 6, 3}, 6);  // bands 2, 1, 0
+  EXPECT_EQ(small.order, (std::vector<uint32_t>{1, 2, 0}));
+  EXPECT_EQ(small.bandEnd, (std::array<uint32_t, 4>{1, 2, 3, 3}));
+}
+
 // Levels the kernel cannot honour are refused, naming the instance.
 TEST_F(DeformLevels, BadLevelsAreRejectedWithAReason) {
   const std::vector<float> w(2 * 6, 1.f);
   std::vector<float> rows(2 * 8);
-  std::vector<uint32_t> groups(2);
   EXPECT_NE(test::errorOf([&] {
               gpu::DeformPass::packWeights(w.data(), 2, 6, std::vector<uint32_t>{3, 7}, rows.data());
             }).find("instance 1 reads 7 mesh components"),
@@ -385,19 +406,24 @@ TEST_F(DeformLevels, BadLevelsAreRejectedWithAReason) {
             }).find("1 per-instance component counts for 2 instances"),
             std::string::npos);
   EXPECT_NE(test::errorOf([&] {
-              gpu::DeformPass::packGroups(std::vector<uint32_t>{9, 0}, 6, groups.data());
+              gpu::DeformPass::packLevels(std::vector<uint32_t>{9, 0}, 6);
             }).find("instance 0 reads 9"),
             std::string::npos);
   const gpu::DeformPass pass(ctx(), 6, 4);
   gpu::DeformPass::Args a;
   a.vertexCount = 1;
-  a.instanceCount = 1;
+  a.instanceCount = 2;
   a.instanceInputs = VkDescriptorSet(uintptr_t(1));  // never used: record throws first
-  a.instanceGroups = 4096;
+  a.instanceOrder = 4096;
   a.maxGroups = 3;  // 6 components are 2 groups
   VkCommandBuffer cmd = ctx().beginOneTime();
   EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("maxGroups 3 beyond the 2 weight groups"),
             std::string::npos);
+  a.maxGroups = 2;
+  a.bandEnd = {2, 1, 2, 2};
+  EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("band 1 ends at 1, out of order"), std::string::npos);
+  a.bandEnd = {0, 3, 3, 3};
+  EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("band 1 ends at 3"), std::string::npos);
   ctx().abandonOneTime(cmd);
 }
 

@@ -317,7 +317,7 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
       model += b->size();
     const auto& f = rec.frame(0);
     for (const gpu::Buffer* b :
-         {&f.meshWeights, &f.instanceGroups, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions,
+         {&f.meshWeights, &f.instanceOrder, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions,
           &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
       frame += b->handle() ? b->size() : 0;  // blendedTexels: none where the images share its memory
     frame += uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4;

@@ -35,16 +35,34 @@ void DeformPass::packWeights(const float* w, uint32_t instances, uint32_t k, std
   }
 }
 
-uint32_t DeformPass::packGroups(std::span<const uint32_t> components, uint32_t k, uint32_t* out) {
-  uint32_t most = 0;
+std::vector<uint32_t> DeformPass::bandsOf(uint32_t k) {
+  const uint32_t g = groupsOf(k);
+  std::vector<uint32_t> bands;
+  for (const uint32_t b : {g, (g + 1) / 2, (g + 3) / 4, (g + 7) / 8, 0u})
+    if (bands.empty() || b < bands.back()) bands.push_back(b);
+  return bands;
+}
+
+DeformPass::Levels DeformPass::packLevels(std::span<const uint32_t> components, uint32_t k) {
+  const std::vector<uint32_t> bands = bandsOf(k);
+  Levels l;
+  std::vector<std::vector<uint32_t>> members(bands.size());
   for (size_t i = 0; i < components.size(); ++i) {
     if (components[i] > k)
       throw Error("deform pass: instance " + std::to_string(i) + " reads " + std::to_string(components[i]) +
                   " mesh components; the model has " + std::to_string(k));
-    out[i] = groupsOf(components[i]);
-    most = std::max(most, out[i]);
+    size_t b = 0;  // the narrowest band that holds the instance's groups
+    while (b + 1 < bands.size() && bands[b + 1] >= groupsOf(components[i])) ++b;
+    members[b].push_back(uint32_t(i));
+    l.groups.push_back(bands[b]);
+    l.maxGroups = std::max(l.maxGroups, bands[b]);
   }
-  return most;
+  for (size_t b = 0; b < bands.size(); ++b) {
+    l.order.insert(l.order.end(), members[b].begin(), members[b].end());
+    if (b < l.bandEnd.size()) l.bandEnd[b] = uint32_t(l.order.size());
+  }
+  for (size_t b = bands.size(); b < l.bandEnd.size(); ++b) l.bandEnd[b] = uint32_t(l.order.size());
+  return l;
 }
 
 void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
@@ -63,9 +81,14 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
     throw Error("deform pass: " + std::to_string(influences) + " skin influences; supported: 1..8");
   inputsLayout_ = DescriptorLayout(
       ctx, std::vector<VkDescriptorType>(basisTexels_ ? 3 : 2, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
-  pipeline_ = ComputePipeline(ctx, basisTexels_ ? "deform_basis_texels.comp" : "deform.comp",
-                              {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u}, sizeof(layout::DeformParams),
-                              inputsLayout_.get());
+  bands_ = bandsOf(k);
+  const char* shader = basisTexels_ ? "deform_basis_texels.comp" : "deform.comp";
+  // Specialisation constants: workgroup size, K, influences, skinning, bands and their groups (band 0: K).
+  std::vector<uint32_t> spec = {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u};
+  pipeline_ = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
+  spec[4] = uint32_t(bands_.size());
+  for (size_t b = 1; b < bands_.size(); ++b) spec[4 + b] = bands_[b];
+  bandedPipeline_ = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
 }
 
 DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
@@ -96,16 +119,23 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.instanceCount = a.instanceCount;
   p.jointCount = a.jointCount;
   p.capsuleCount = a.capsuleCount;
-  p.instanceGroups = layout::Address::of(a.instanceGroups);
+  p.instanceOrder = layout::Address::of(a.instanceOrder);
   p.maxGroups = groupsOf(meshComponents_);
-  if (a.instanceGroups) {
+  for (size_t b = 0; b < a.bandEnd.size(); ++b) p.bandEnd[b] = a.instanceCount;
+  if (a.instanceOrder) {
     if (a.maxGroups > p.maxGroups)
       throw Error("deform pass: maxGroups " + std::to_string(a.maxGroups) + " beyond the " +
                   std::to_string(p.maxGroups) + " weight groups of " + std::to_string(meshComponents_) + " components");
     p.maxGroups = a.maxGroups;
+    for (size_t b = 0; b + 1 < bands_.size(); ++b) {
+      if (a.bandEnd[b] > a.instanceCount || (b > 0 && a.bandEnd[b] < a.bandEnd[b - 1]))
+        throw Error("deform pass: band " + std::to_string(b) + " ends at " + std::to_string(a.bandEnd[b]) +
+                    ", out of order or beyond " + std::to_string(a.instanceCount) + " instances");
+      p.bandEnd[b] = a.bandEnd[b];
+    }
   }
   p.pad0 = 0;
-  pipeline_.bind(cmd, &p, sizeof(p), a.instanceInputs);
+  (a.instanceOrder ? bandedPipeline_ : pipeline_).bind(cmd, &p, sizeof(p), a.instanceInputs);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
   return 1;
 }

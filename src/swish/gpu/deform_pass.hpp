@@ -5,6 +5,9 @@
 // bound as texel buffers through a descriptor set made once per pair of buffers by bindInstanceInputs
 // (descriptor_binding.hpp says why), and with them the model's basis as R32 texels where it fits in the device's
 // maxTexelBufferElements (shaders/deform_basis_texels.comp; else shaders/deform.comp reads it through its address).
+// Quality levels (per-instance k, runtime/quality_levels.hpp) in the same one dispatch: two pipelines of
+// the same shader, one without bands (every instance at K: the pass as it was) and one with bandsOf(K);
+// record() takes the second where Args::instanceOrder is given (packLevels, packWeights with components).
 //
 // Records one dispatch into the caller's command buffer (never submits). Synchronisation the caller
 // provides: inputs written by the host before the submission (mapped memory; the submission makes them
@@ -13,8 +16,10 @@
 // the tangent-frames pass, VERTEX_INPUT/VERTEX_ATTRIBUTE_READ for a renderer).
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "swish/core/types.hpp"
 #include "swish/gpu/compute_pipeline.hpp"
@@ -38,13 +43,13 @@ class DeformPass {
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;
     uint32_t jointCount = 0;
-    // Per-instance quality levels: uint[instanceCount], the vec4 weight groups each instance reads
-    // (groupsOf(k_i), packGroups), its weight rows zero from k_i on (packWeights with components).
-    // 0: every instance reads all groupsOf(K).
-    VkDeviceAddress instanceGroups = 0;
-    // With instanceGroups: the most groups an instance reads (packGroups returns it), at most
-    // groupsOf(K); each vertex loads that many groups of its basis. Ignored without instanceGroups.
-    uint32_t maxGroups = 0;
+    // Per-instance quality levels (packLevels): the instances band by band, uint[instanceCount], with
+    // bandEnd and maxGroups from the same Levels; each instance's weight row zero from its k_i on
+    // (packWeights with components). 0: every instance reads all groupsOf(K), in order (the pipeline
+    // without bands).
+    VkDeviceAddress instanceOrder = 0;
+    std::array<uint32_t, 4> bandEnd{};  // Levels::bandEnd (with instanceOrder)
+    uint32_t maxGroups = 0;             // Levels::maxGroups (with instanceOrder)
   };
 
   // Layout of the mesh-weights buffer: float[instances][paddedComponents(K)], each row zero padded.
@@ -60,13 +65,24 @@ class DeformPass {
   // the instance on a size mismatch or a component count above k.
   static void packWeights(const float* weights, uint32_t instances, uint32_t k, std::span<const uint32_t> components,
                           float* out);
-  // Weight groups (vec4 texels) an instance of `components` leading components reads.
+  // Weight groups (vec4 texels) `components` leading components fill.
   static uint32_t groupsOf(uint32_t components) { return (components + 3) / 4; }
-  // Layout of the instance-groups buffer: uint[instances].
-  static VkDeviceSize groupsBytes(uint32_t instances) { return VkDeviceSize(instances) * 4; }
-  // Writes groupsOf(components[i]) for each instance (components.size() of them, each <= k, else
-  // Error) into out; returns the largest (Args::maxGroups; 0 for no instances).
-  static uint32_t packGroups(std::span<const uint32_t> components, uint32_t k, uint32_t* out);
+
+  // Quality levels come as bands of weight groups the kernel has an unrolled loop for (deform.glsl says
+  // why): groupsOf(K), then ceil of 1/2, 1/4 and 1/8 of it, then 0, the distinct ones, descending (at
+  // most kMaxBands). An instance of k components reads the narrowest band of at least groupsOf(k).
+  static constexpr uint32_t kMaxBands = 5;
+  static std::vector<uint32_t> bandsOf(uint32_t k);
+  struct Levels {
+    std::vector<uint32_t> order;        // the instances band by band, stable (Args::instanceOrder's contents)
+    std::array<uint32_t, 4> bandEnd{};  // end of bands 0..3 in `order` (bands beyond bandsOf(K): instanceCount)
+    uint32_t maxGroups = 0;             // groups of the widest band in use (0: every instance at k = 0)
+    std::vector<uint32_t> groups;       // per instance (in instance order): the groups it reads, its band's
+  };
+  // The bands of `components` (one per instance, each <= k, else Error naming the instance).
+  static Levels packLevels(std::span<const uint32_t> components, uint32_t k);
+  // Layout of the instance-order buffer: uint[instances].
+  static VkDeviceSize orderBytes(uint32_t instances) { return VkDeviceSize(instances) * 4; }
   // Layout of the skin-matrices buffer: vec4[instances][jointCount][3], the top three rows of each
   // affine skinning matrix (3 texel fetches per influence instead of 4 columns).
   static VkDeviceSize skinMatricesBytes(uint32_t instances, uint32_t joints) {
@@ -83,7 +99,8 @@ class DeformPass {
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
              uint64_t basisFloats = 0);
   bool basisTexels() const { return basisTexels_; }
-  uint32_t meshComponents() const { return meshComponents_; }  // K of the pipeline
+  uint32_t meshComponents() const { return meshComponents_; }    // K of the pipeline
+  const std::vector<uint32_t>& bands() const { return bands_; }  // bandsOf(K)
 
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
   // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise).
@@ -96,8 +113,10 @@ class DeformPass {
  private:
   bool basisTexels_ = false;
   uint32_t meshComponents_ = 0;
+  std::vector<uint32_t> bands_;  // bandsOf(K)
   DescriptorLayout inputsLayout_;
-  ComputePipeline pipeline_;
+  ComputePipeline pipeline_;        // one band: every instance at K (Args::instanceOrder 0)
+  ComputePipeline bandedPipeline_;  // bands_
 };
 
 }  // namespace swish::gpu

@@ -107,15 +107,14 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
                             weightRows_.data());
   }
   f.meshWeights.upload(*ctx_, weightRows_.data(), weightRows_.size() * sizeof(float));
-  // Per-instance groups only where some instance reads fewer than all K: at full quality the kernel
-  // reads no per-instance word.
+  // The deform's bands only where some instance reads fewer than all K: at full quality the kernel
+  // without bands runs, as it did before levels.
   const bool levels =
       k > 0 && std::any_of(in.meshComponents.begin(), in.meshComponents.end(), [&](uint32_t c) { return c < k; });
-  uint32_t maxGroups = 0;
+  DeformPass::Levels bands;
   if (levels) {
-    groups_.resize(in.instanceCount);
-    maxGroups = DeformPass::packGroups(in.meshComponents, uint32_t(k), groups_.data());
-    f.instanceGroups.upload(*ctx_, groups_.data(), groups_.size() * sizeof(uint32_t));
+    bands = DeformPass::packLevels(in.meshComponents, uint32_t(k));
+    f.instanceOrder.upload(*ctx_, bands.order.data(), bands.order.size() * sizeof(uint32_t));
   }
   matrixRows_.resize(in.skinMatrices.size() * 12);
   DeformPass::packSkinMatrices(in.skinMatrices.data(), in.skinMatrices.size(), matrixRows_.data());
@@ -149,8 +148,9 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
     d.capsuleCount = m.capsuleCount();
   }
   if (levels) {
-    d.instanceGroups = f.instanceGroups.address();
-    d.maxGroups = maxGroups;
+    d.instanceOrder = f.instanceOrder.address();
+    d.bandEnd = bands.bandEnd;
+    d.maxGroups = bands.maxGroups;
   }
   uint32_t dispatches = deform_.record(cmd, d);
   f.timestamps.mark(cmd, kAfterDeform);

@@ -4,16 +4,17 @@
 //   deform + push-out (all instances, one dispatch) -> barrier -> tangent frames (two dispatches: triangles, vertices)
 //   VQ decode (each newly selected map once, one dispatch) -> barrier -> normal-map blend (one dispatch,
 //   into the normal-map images' own memory where they share it, else then a copy into them)
-// Quality levels (runtime/quality_levels.hpp), per instance in the same dispatches:
-// FrameKernelInputs::meshComponents sets the weight groups each instance's deform reads (and, by their
-// maximum, the basis each vertex loads); an instance whose selectedMaps entry is kNoMap is left out of
-// the decode and the blend, and its layer keeps its map: unchanged with one frame in flight, else copied
-// from the previous frame's slot (only when this slot's layer is older: a character that stays without
-// maps costs nothing after framesInFlight - 1 frames). A frame where no instance has a map records no
-// decode and no blend dispatch.
 // with GPU timestamps around each pass. Resources exist per frame in flight (FrameResources); frame f
 // uses slot f % framesInFlight and its blend reads the previous slot's blended maps
 // (FrameResources::blendOutput()).
+//
+// Quality levels (runtime/quality_levels.hpp), per instance in the same dispatches:
+// FrameKernelInputs::meshComponents puts each instance in the deform's band of weight groups that
+// holds its k (DeformPass::packLevels; the kernel without bands where all are at K). An instance whose
+// selectedMaps entry is kNoMap is left out of the decode and the blend, and its layer keeps its map:
+// unchanged with one frame in flight, else copied from the previous frame's slot (only when this
+// slot's layer is older: a character that stays without maps costs nothing after framesInFlight - 1
+// frames). A frame where no instance has a map records no decode and no blend dispatch.
 //
 // Caller contract: before record(f), wait for the fence of the submission that used slot
 // f % framesInFlight last (frame f - framesInFlight); submit frames in order on one queue. After
@@ -91,7 +92,6 @@ class FrameRecorder {
   NormalMapBlendPass blend_;
   std::vector<FrameResources> frames_;
   std::vector<float> weightRows_, matrixRows_, posedCapsules_;  // inputs in DeformPass's layouts
-  std::vector<uint32_t> groups_;                                // DeformPass::packGroups
   uint64_t records_ = 0;  // record() calls that decoded: the clock of FrameResources::slotLastUsed
   // Per instance (layer): the version of its current map, set by each blend or upload from versionClock_;
   // FrameResources::layerVersion says which slots hold it.

@@ -18,7 +18,7 @@ FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bo
   const VkDeviceSize n = m.vertexCount(), c = std::max(1u, cap);
   meshWeights = Buffer(ctx, DeformPass::weightsBytes(uint32_t(c), m.kernelMeshComponents()), MemoryKind::HostVisible,
                        tag + "mesh weights");
-  instanceGroups = Buffer(ctx, DeformPass::groupsBytes(uint32_t(c)), MemoryKind::HostVisible, tag + "instance groups");
+  instanceOrder = Buffer(ctx, DeformPass::orderBytes(uint32_t(c)), MemoryKind::HostVisible, tag + "instance order");
   skinMatrices = Buffer(ctx, std::max<VkDeviceSize>(16, DeformPass::skinMatricesBytes(uint32_t(c), m.jointCount())),
                         MemoryKind::HostVisible, tag + "skin matrices");
   if (m.capsuleCount() > 0)

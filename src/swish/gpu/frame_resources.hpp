@@ -34,7 +34,7 @@ struct FrameResources {
 
   // Inputs, written by FrameRecorder::record.
   Buffer meshWeights;     // float[instances][K4] (DeformPass::packWeights), zero beyond each instance's k
-  Buffer instanceGroups;  // uint[instances]: weight groups each instance's deform reads (DeformPass::packGroups)
+  Buffer instanceOrder;   // uint[instances]: the deform's instances by quality band (DeformPass::packLevels)
   Buffer skinMatrices;    // vec4[instances][joints][3] (DeformPass::packSkinMatrices)
   Buffer posedCapsules;   // float[instances][capsules][8] (runtime::poseBodyProxy); empty without a proxy
   Buffer decodeSlotMaps;  // the VQ decode jobs: uint[2][instances], maps then the slots they go to

@@ -68,7 +68,7 @@ std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::strin
     a.push_back({owner, name, bufferBytes(bytes), image});
   };
   add("mesh weights", c * kk * 4);
-  add("instance groups", c * 4);     // the weight groups each instance's quality level reads
+  add("instance order", c * 4);      // the deform's instances by quality band
   add("skin matrices", c * j * 48);  // the top three rows of each affine matrix
   add("positions", c * n * 12);
   if (frames) {
