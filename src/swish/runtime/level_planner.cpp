@@ -75,7 +75,7 @@ LevelPlanner::LevelPlanner(std::vector<const QualityLadder*> ladders, std::vecto
   if (settings_.tolerancePixels && !(*settings_.tolerancePixels > 0.0))
     throw Error("level planner: the pixel tolerance must be positive");
   current_.assign(ladders_.size(), 0);
-  lastChange_.assign(ladders_.size(), 0);
+  lastChange_.assign(ladders_.size(), std::nullopt);
   out_.characters.resize(ladders_.size());
 }
 
@@ -93,7 +93,12 @@ void LevelPlanner::setCosts(LevelCosts costs) {
 
 double LevelPlanner::errorOf(size_t c, uint32_t level) const { return (*ladders_[c])[level].vertexMeanMm; }
 
-double LevelPlanner::costOf(size_t c, uint32_t level) const { return costs_.msPerCharacter[c][level]; }
+double LevelPlanner::costOf(size_t c, uint32_t level) const { return scale_ * costs_.msPerCharacter[c][level]; }
+
+void LevelPlanner::setCostScale(double scale) {
+  if (!(scale > 0.0 && std::isfinite(scale))) throw Error("level planner: the cost scale must be positive and finite");
+  scale_ = scale;
+}
 
 const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::Vector3d> roots) {
   const size_t n = ladders_.size();
@@ -110,10 +115,10 @@ const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::V
       ch.reason = "fixed (the scene's level or --level)";
       continue;
     }
-    const bool held = !first_ && frame < lastChange_[c] + settings_.holdFrames;
+    const bool held = !first_ && lastChange_[c] && frame < *lastChange_[c] + settings_.holdFrames;
     if (held) {
       level[c] = current_[c];
-      ch.reason = "held (changed " + std::to_string(frame - lastChange_[c]) + " frames ago, hold " +
+      ch.reason = "held (changed " + std::to_string(frame - *lastChange_[c]) + " frames ago, hold " +
                   std::to_string(settings_.holdFrames) + ")";
       continue;
     }
@@ -138,55 +143,85 @@ const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::V
     }
   }
 
-  // The budget: step down the character whose next level costs the least screen-weighted error per
-  // millisecond saved, until the prediction fits.
+  // The budget. Each movable character's best level is the one chosen above (full quality, or what the
+  // tolerance allows); with a budget it starts from where it is (its level last frame, never better than
+  // its best), then: above the budget, step down the character whose next level costs the least
+  // screen-weighted error per millisecond saved, until it fits; below kHeadroom of the budget, step up
+  // the one whose better level buys the most error per millisecond while the total stays below that.
+  // Between the two nothing moves: a dead band, so that a prediction near the budget does not make
+  // characters trade levels back and forth.
+  constexpr double kHeadroom = 0.85;
   out_.overBudget = false;
-  out_.predictedMs = std::numeric_limits<double>::quiet_NaN();
+  out_.predictedMs = out_.unscaledMs = std::numeric_limits<double>::quiet_NaN();
   if (!costs_.empty()) {
+    std::vector<uint32_t> best = level;
+    if (settings_.frameBudgetMs && !first_)
+      for (size_t c = 0; c < n; ++c)
+        if (movable[c]) level[c] = std::max(level[c], current_[c]);
     double total = 0;
     for (size_t c = 0; c < n; ++c) total += costOf(c, level[c]);
     if (settings_.frameBudgetMs) {
-      std::vector<bool> stepped(n, false);
-      while (total > *settings_.frameBudgetMs) {
-        size_t best = n;
-        double bestScore = std::numeric_limits<double>::infinity();
+      const double budget = *settings_.frameBudgetMs;
+      std::vector<int> moved(n, 0);
+      // Screen-weighted error added by moving character c from level a to level b (b > a: down).
+      const auto addedError = [&](size_t c, uint32_t a, uint32_t b) {
+        double e = errorOf(c, b) - errorOf(c, a);
+        if (!std::isfinite(e)) e = double(b) - double(a);  // an unmeasured ladder: one step of error per step
+        return e * out_.characters[c].view.weight();
+      };
+      while (total > budget) {
+        size_t pick = n;
+        double pickScore = std::numeric_limits<double>::infinity();
         for (size_t c = 0; c < n; ++c) {
           if (!movable[c] || level[c] + 1 >= ladders_[c]->size()) continue;
           const double saved = costOf(c, level[c]) - costOf(c, level[c] + 1);
           if (!(saved > 0.0)) continue;
-          double added = errorOf(c, level[c] + 1) - errorOf(c, level[c]);
-          if (!std::isfinite(added)) added = 1.0;  // an unmeasured ladder: one step of error per step
-          added = std::max(added, 0.0) * out_.characters[c].view.weight();
-          // Hysteresis: stepping down to a level the character holds already is half the price.
-          if (current_[c] >= level[c] + 1 && !first_) added *= 0.5;
-          const double score = added / saved;
-          if (score < bestScore) {
-            bestScore = score;
-            best = c;
-          }
+          const double score = std::max(addedError(c, level[c], level[c] + 1), 0.0) / saved;
+          if (score < pickScore) pickScore = score, pick = c;
         }
-        if (best == n) {
+        if (pick == n) {
           out_.overBudget = true;
           break;
         }
-        total -= costOf(best, level[best]) - costOf(best, level[best] + 1);
-        ++level[best];
-        stepped[best] = true;
+        total -= costOf(pick, level[pick]) - costOf(pick, level[pick] + 1);
+        ++level[pick];
+        --moved[pick];
       }
-      for (size_t c = 0; c < n; ++c)
-        if (stepped[c])
-          out_.characters[c].reason = fixed1(out_.characters[c].view.heightPixels) +
-                                      " px tall: stepped down to fit the budget of " +
-                                      fixed1(*settings_.frameBudgetMs) + " ms";
+      while (!first_ && !out_.overBudget) {
+        size_t pick = n;
+        double pickScore = 0;
+        for (size_t c = 0; c < n; ++c) {
+          if (!movable[c] || level[c] <= best[c]) continue;
+          const double extra = costOf(c, level[c] - 1) - costOf(c, level[c]);
+          if (total + std::max(extra, 0.0) > kHeadroom * budget) continue;
+          const double gained = -addedError(c, level[c], level[c] - 1);
+          const double score = gained / std::max(extra, 1e-9);
+          if (score > pickScore) pickScore = score, pick = c;
+        }
+        if (pick == n) break;
+        total += costOf(pick, level[pick] - 1) - costOf(pick, level[pick]);
+        --level[pick];
+        ++moved[pick];
+      }
+      for (size_t c = 0; c < n; ++c) {
+        if (!movable[c]) continue;
+        const std::string size = fixed1(out_.characters[c].view.heightPixels) + " px tall: ";
+        if (moved[c] < 0 || (level[c] > best[c] && moved[c] == 0))
+          out_.characters[c].reason = size + "below its best level to fit the budget of " + fixed1(budget) + " ms";
+        else if (moved[c] > 0)
+          out_.characters[c].reason =
+              size + "stepped up: the frame has room in the budget of " + fixed1(budget) + " ms";
+      }
     }
     out_.predictedMs = total;
+    out_.unscaledMs = total / scale_;
   }
 
   double wSum = 0, wErr = 0, wFull = 0;
   for (size_t c = 0; c < n; ++c) {
     LevelChoice& ch = out_.characters[c];
     ch.changed = !first_ && level[c] != current_[c];
-    if (first_ || ch.changed) lastChange_[c] = frame;
+    if (ch.changed) lastChange_[c] = frame;
     current_[c] = level[c];
     ch.level = level[c];
     const double w = ch.view.weight();

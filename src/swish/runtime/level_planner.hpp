@@ -17,8 +17,9 @@
 //     and largest keep their quality longest. The predicted cost is the sum of per-character costs per
 //     level (LevelCosts), calibrated on the device by the replay.
 //   - Hysteresis: a character keeps a level for at least holdFrames after a change (so it changes at most
-//     once per hold), and stepping a character down to a level it already holds costs half, so that
-//     characters of near-equal weight do not trade places from frame to frame.
+//     once per hold; the first frame's assignment is not a change), and stepping a character down to a
+//     level it already holds costs half, so that characters of near-equal weight do not trade places
+//     from frame to frame.
 //   - A level the scene fixes for a character (a host with its own LOD system) is kept as it is.
 #include <cstdint>
 #include <optional>
@@ -74,7 +75,8 @@ struct LevelChoice {
 
 struct PlannedLevels {
   std::vector<LevelChoice> characters;                            // in the planner's character order
-  double predictedMs = std::numeric_limits<double>::quiet_NaN();  // NaN without costs
+  double predictedMs = std::numeric_limits<double>::quiet_NaN();  // NaN without costs; scaled (setCostScale)
+  double unscaledMs = std::numeric_limits<double>::quiet_NaN();   // the same before the scale
   bool overBudget = false;  // the budget could not be met (levels held, fixed or at their cheapest)
   // Screen-weighted mean vertex error (mm) of the chosen levels and of full quality (ladder means; NaN
   // when the ladder is not measured or no character is in view).
@@ -91,6 +93,11 @@ class LevelPlanner {
 
   // Costs for the budget; without them a budget is not applied (the plan says so).
   void setCosts(LevelCosts costs);
+  // The GPU as it runs now against the costs: the replay feeds back each frame's measured GPU time over
+  // its unscaled prediction (a real GPU's clocks and a busy machine move both), and every cost is
+  // multiplied by this from the next plan on. 1 until set; must be positive and finite.
+  void setCostScale(double scale);
+  double costScale() const { return scale_; }
   const LevelCosts& costs() const { return costs_; }
   const LevelPlannerSettings& settings() const { return settings_; }
   size_t characters() const { return ladders_.size(); }
@@ -108,8 +115,9 @@ class LevelPlanner {
   std::vector<std::optional<uint32_t>> fixed_;
   LevelPlannerSettings settings_;
   LevelCosts costs_;
+  double scale_ = 1.0;
   std::vector<uint32_t> current_;
-  std::vector<uint64_t> lastChange_;
+  std::vector<std::optional<uint64_t>> lastChange_;  // none: not changed since the first plan
   bool first_ = true;
   PlannedLevels out_;
 };

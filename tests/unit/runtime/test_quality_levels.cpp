@@ -213,6 +213,17 @@ TEST(LevelPlanner, BudgetStepsDownSmallAndFarCharactersFirst) {
   EXPECT_LT(p.characters[0].level, p.characters[1].level) << "the near character keeps more quality";
   EXPECT_GT(p.weightedErrorMm, p.fullErrorMm);
   EXPECT_NEAR(p.fullErrorMm, 1.0, 1e-12);
+  // The GPU runs 4x slower than calibrated: the same budget buys less.
+  LevelPlanner slow({&ladder, &ladder}, {}, s);
+  slow.setCosts(costs);
+  slow.setCostScale(4.0);
+  const PlannedLevels& ps = slow.plan(0, roots);
+  EXPECT_NEAR(ps.predictedMs, 4.0 * ps.unscaledMs, 1e-12);
+  EXPECT_FALSE(ps.overBudget);
+  EXPECT_EQ(ps.characters[0].level, 3u);  // 2 x 0.5 ms x 4 = 4 ms is the only mix within 5 ms
+  EXPECT_EQ(ps.characters[1].level, 3u);
+  EXPECT_NEAR(ps.predictedMs, 4.0, 1e-12);
+  EXPECT_NE(test::errorOf([&] { slow.setCostScale(0.0); }).find("positive"), std::string::npos);
   // A budget nothing can meet: every character at its cheapest, and said so.
   LevelPlannerSettings tight = s;
   tight.frameBudgetMs = 0.1;
@@ -237,15 +248,19 @@ TEST(LevelPlanner, HoldsALevelAndKeepsFixedOnes) {
   std::vector<Eigen::Vector3d> roots = {{0, 1, 90}, {0, 1, 90}};  // 100 m: 20 mm is 0.1 px
   EXPECT_EQ(planner.plan(0, roots).characters[0].level, 3u);
   EXPECT_EQ(planner.last().characters[1].level, 1u);
-  roots[0] = {0, 1, 0};  // steps close: it wants level 2, but holds until frame 10
-  for (uint64_t f = 1; f < 10; ++f) {
+  roots[0] = {0, 1, 0};  // steps close: the first frame's assignment was no change, so it follows at once
+  EXPECT_EQ(planner.plan(1, roots).characters[0].level, 2u);
+  EXPECT_TRUE(planner.last().characters[0].changed);
+  roots[0] = {0, 1, 90};  // and back: held until frame 11
+  for (uint64_t f = 2; f < 11; ++f) {
     const PlannedLevels& p = planner.plan(f, roots);
-    EXPECT_EQ(p.characters[0].level, 3u) << f;
+    EXPECT_EQ(p.characters[0].level, 2u) << f;
     EXPECT_FALSE(p.characters[0].changed);
+    EXPECT_NE(p.characters[0].reason.find("held"), std::string::npos);
     EXPECT_EQ(p.characters[1].level, 1u);
   }
-  const PlannedLevels& p = planner.plan(10, roots);
-  EXPECT_EQ(p.characters[0].level, 2u);
+  const PlannedLevels& p = planner.plan(11, roots);
+  EXPECT_EQ(p.characters[0].level, 3u);
   EXPECT_TRUE(p.characters[0].changed);
   EXPECT_EQ(p.characters[1].reason, "fixed (the scene's level or --level)");
   EXPECT_NE(test::errorOf([&] { LevelPlanner bad({&ladder}, {7u}, s); }).find("level 7"), std::string::npos);
