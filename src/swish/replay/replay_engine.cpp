@@ -126,6 +126,9 @@ struct ReplayEngine::Impl {
   std::vector<std::vector<std::vector<double>>> levelTruthMm;  // [batch][level]: every vertex distance
   std::string levelCostsSource;
   std::vector<std::string> firstReasons;
+  bool costScaleSet = false;
+  std::vector<double> costRatios;  // the last kCostWindow frames' measured over predicted GPU time
+  static constexpr size_t kCostWindow = 15;
   // Penetration.
   std::vector<PenetrationSummary> penetrationPools;  // per scene character
   PenetrationSummary penetrationOverall;
@@ -135,6 +138,7 @@ struct ReplayEngine::Impl {
   void setUp();
   void setUpLevels();
   void calibrateLevels();
+  void calibrationFrame(Batch& B, const std::vector<Pose>& poses, const runtime::QualityLevel& level);
   void applyLevels(uint64_t frame, const std::vector<std::vector<Pose>>& poses, FrameRecord& rec);
   bool truthFrame(uint32_t index) const;
   FrameRecord runFrame(uint32_t index, ReplayResult& result);
@@ -262,6 +266,34 @@ void ReplayEngine::Impl::setUpLevels() {
 // that level (median of a few frames of the scene's first poses) shared out per character, so that a
 // frame's fixed cost is shared too. The calibration's frames are thrown away: filters start again (the
 // first real frame blends with alpha 1) and decoded maps are forgotten.
+// One frame of the batch with every character at `level`, submitted and waited on (calibration only).
+void ReplayEngine::Impl::calibrationFrame(Batch& B, const std::vector<Pose>& poses,
+                                          const runtime::QualityLevel& level) {
+  const uint32_t n = uint32_t(B.planned->characters.size());
+  for (uint32_t i = 0; i < n; ++i) {
+    B.frames->resetCharacter(i);
+    B.frames->setLevel(i, level);
+  }
+  const runtime::FrameOutput& o = B.frames->evaluate(std::span<const Pose>(poses), 0.f);
+  B.inputs.meshWeights = o.meshWeights;
+  B.inputs.meshComponents.assign(n, level.meshComponents);
+  B.inputs.selectedMaps.clear();
+  B.inputs.blendAlpha.clear();
+  if (B.frames->hasNormalMaps())
+    for (uint32_t i = 0; i < n; ++i) {
+      B.inputs.selectedMaps.push_back(o.blend[i].selectedMap);
+      B.inputs.blendAlpha.push_back(o.blend[i].alpha);
+    }
+  VkCommandBuffer cmd = ctx->beginOneTime();
+  try {
+    B.recorder->record(cmd, 0, B.inputs);
+  } catch (...) {
+    ctx->abandonOneTime(cmd);
+    throw;
+  }
+  ctx->endOneTimeAndWait(cmd);
+}
+
 void ReplayEngine::Impl::calibrateLevels() {
   if (!plan.gpuWork || !levelPlanner || !levelPlanner->settings().frameBudgetMs) return;
   constexpr int kRepeats = 5;
@@ -280,31 +312,14 @@ void ReplayEngine::Impl::calibrateLevels() {
       const auto mats = B.model->skeleton.skinningMatrices(poses.back());
       std::copy(mats.begin(), mats.end(), B.inputs.skinMatrices.begin() + i * jc);
     }
+    // A real GPU idles at low clocks: keep it busy at full quality for a quarter of a second (at least
+    // 10 frames) before measuring, as a game's steady state would.
+    const auto warmStart = Clock::now();
+    for (int r = 0; r < 10 || msSince(warmStart) < 250.0; ++r) calibrationFrame(B, poses, B.ladder[0]);
     for (uint32_t l = 0; l < B.ladder.size(); ++l) {
       std::vector<double> ms;
       for (int r = 0; r < kRepeats + 1; ++r) {
-        for (uint32_t i = 0; i < n; ++i) {
-          B.frames->resetCharacter(i);
-          B.frames->setLevel(i, B.ladder[l]);
-        }
-        const runtime::FrameOutput& o = B.frames->evaluate(std::span<const Pose>(poses), 0.f);
-        B.inputs.meshWeights = o.meshWeights;
-        B.inputs.meshComponents.assign(n, B.ladder[l].meshComponents);
-        B.inputs.selectedMaps.clear();
-        B.inputs.blendAlpha.clear();
-        if (B.frames->hasNormalMaps())
-          for (uint32_t i = 0; i < n; ++i) {
-            B.inputs.selectedMaps.push_back(o.blend[i].selectedMap);
-            B.inputs.blendAlpha.push_back(o.blend[i].alpha);
-          }
-        VkCommandBuffer cmd = ctx->beginOneTime();
-        try {
-          B.recorder->record(cmd, 0, B.inputs);
-        } catch (...) {
-          ctx->abandonOneTime(cmd);
-          throw;
-        }
-        ctx->endOneTimeAndWait(cmd);
+        calibrationFrame(B, poses, B.ladder[l]);
         // The first frame decodes its maps and warms caches up; the others are the steady state, in
         // which a frame decodes only the maps newly selected.
         if (r > 0) ms.push_back(B.recorder->stageTimes(0).totalMs);
@@ -466,6 +481,21 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
       t.gpuBlend = addMs(t.gpuBlend, s.normalBlendMs);
       t.gpuTotal = addMs(t.gpuTotal, s.totalMs);
     }
+    // The planner's costs follow the GPU as it runs (clocks, load): the median of the last frames'
+    // measured time over their unscaled prediction (a median, so that one slow frame moves nothing; the
+    // first frame, which decodes every map it selects, is left out).
+    const double unscaled = levelPlanner ? levelPlanner->last().unscaledMs : kNaN;
+    if (index > 0 && std::isfinite(unscaled) && unscaled > 0 && std::isfinite(t.gpuTotal) && t.gpuTotal > 0) {
+      costRatios.push_back(t.gpuTotal / unscaled);
+      if (costRatios.size() > kCostWindow) costRatios.erase(costRatios.begin());
+      if (costRatios.size() >= 3) {
+        std::vector<double> sorted = costRatios;
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        levelPlanner->setCostScale(sorted[sorted.size() / 2]);
+        costScaleSet = true;
+      }
+    }
+    rec.costScale = levelPlanner && costScaleSet ? levelPlanner->costScale() : kNaN;
     if (readBack) {
       rec.checked = check;
       for (size_t b = 0; b < batches.size(); ++b) {

@@ -131,6 +131,7 @@ struct FrameRecord {
   std::vector<uint8_t> levels;                    // per on-screen character, plan order: its quality level
   uint32_t levelChanges = 0;                      // characters whose level changed this frame
   double predictedGpuMs = 0;                      // the level planner's prediction (NaN: no costs)
+  double costScale = 0;                           // measured over calibrated GPU time after this frame (NaN: none)
   double weightedErrorMm = 0;                     // screen-weighted ladder error of the chosen levels (NaN: unmeasured)
   double fullErrorMm = 0;                         // the same at full quality
   double maxPositionErrorMm() const;

@@ -207,6 +207,7 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
       fj["levels"] = f.levels;
       fj["levelChanges"] = f.levelChanges;
       fj["predictedGpuMs"] = f.predictedGpuMs;
+      fj["costScale"] = f.costScale;
       fj["weightedErrorMm"] = f.weightedErrorMm;
     }
     if (f.checked)
@@ -318,7 +319,7 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
       for (const auto& [l, n] : counts) cj["framesPerLevel"][std::to_string(l)] = n;
       lv["characters"].push_back(cj);
     }
-    std::vector<double> predicted, measured, weighted, full;
+    std::vector<double> predicted, measured, weighted, full, scales;
     size_t over = 0;
     for (const auto& f : r.frames) {
       if (f.levels.empty()) continue;
@@ -326,11 +327,13 @@ json reportJson(const runtime::Scene& scene, const ModelLibrary& models, const R
       measured.push_back(f.times.gpuTotal);
       weighted.push_back(f.weightedErrorMm);
       full.push_back(f.fullErrorMm);
+      scales.push_back(f.costScale);
       if (r.frameBudgetMs && std::isfinite(f.times.gpuTotal) && f.times.gpuTotal > *r.frameBudgetMs) ++over;
     }
     lv["summary"] = {{"medianPredictedGpuMs", quantile(predicted, 0.5)},
                      {"medianGpuMs", quantile(measured, 0.5)},
                      {"framesOverBudget", over},
+                     {"medianCostScale", quantile(scales, 0.5)},
                      {"meanWeightedErrorMm", finiteMean(weighted)},
                      {"meanFullErrorMm", finiteMean(full)}};
     j["levels"] = lv;
