@@ -230,7 +230,9 @@ TEST_F(TangentFramesSpecialCases, NanPositionAffectsExactlyTheReferenceVertices)
 }
 
 // An axis-aligned flat grid with integer coordinates: every cross product, sum and norm is exact, so
-// normals (0,0,1) and tangents (1,0,0,+1) must come out bit for bit.
+// normals (0,0,1) and tangents (1,0,0,+1) come out exactly on lavapipe. A device may normalise with
+// its inversesqrt, which Vulkan allows 2 ULP (the SPIR-V environment's precision table): the NVIDIA
+// H100 gives 1 - 2^-24 for some unit components. So 2 ULP of 1 (2^-22), no more.
 TEST_F(TangentFramesSpecialCases, FlatIntegerGridIsExact) {
   Rng rng(1);
   test::RandomModelSpec spec;
@@ -247,8 +249,9 @@ TEST_F(TangentFramesSpecialCases, FlatIntegerGridIsExact) {
   for (bool twoPass : {false, true}) {
     const Frames gpu = runGpu(ctx(), m, pos, 1, true, twoPass);
     for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-    EXPECT_TRUE(test::matchesReference("normals", gpu.normals, ref.normals, [](size_t) { return 0.0; }));
-    EXPECT_TRUE(test::matchesReference("tangents", gpu.tangents, ref.tangents, [](size_t) { return 0.0; }));
+    constexpr double kTwoUlpOfOne = 1.0 / (1 << 22);
+    EXPECT_TRUE(test::matchesReference("normals", gpu.normals, ref.normals, [](size_t) { return kTwoUlpOfOne; }));
+    EXPECT_TRUE(test::matchesReference("tangents", gpu.tangents, ref.tangents, [](size_t) { return kTwoUlpOfOne; }));
   }
   EXPECT_EQ(std::abs(ref.normals[2]), 1.f);  // the case really is the flat one
 }

@@ -220,6 +220,9 @@ TEST_F(PreviewRender, NormalMapOffChangesShadingInsideTheJerseyOnly) {
           std::abs(on[0] - off[0]) + std::abs(on[1] - off[1]) + std::abs(on[2] - off[2]) > 0 || on[3] != off[3];
       jersey += inJersey;
       (inJersey ? changedInside : changedOutside) += changed;
+      if (changed && !inJersey)
+        std::printf("changed outside the jersey at (%u, %u): map on %d %d %d %d, off %d %d %d %d\n", x, y, on[0], on[1],
+                    on[2], on[3], off[0], off[1], off[2], off[3]);
     }
   std::printf("jersey pixels %zu, changed by the normal map: %zu inside, %zu outside\n", jersey, changedInside,
               changedOutside);
