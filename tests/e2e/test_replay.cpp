@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 
+#include "support/error_message.hpp"
 #include "support/gpu_test.hpp"
 #include "support/paths.hpp"
 #include "support/random_model.hpp"
@@ -23,6 +24,7 @@
 #include "swish/replay/replay_job.hpp"
 #include "swish/replay/report_writer.hpp"
 #include "swish/runtime/planner.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
 
 namespace {
@@ -137,6 +139,56 @@ TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
                         "plots/error_per_frame.svg", "plots/error_vs_time.svg"})
     EXPECT_TRUE(fs::exists(dir_ / "out" / f)) << f;
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".partial-"), std::string::npos);
+  EXPECT_EQ(ctx().validationMessageCount(), 0u);
+}
+
+// Quality levels: every character at a fixed level passes the GPU-vs-CPU checks and reads no more
+// than its components; a budget below every level's cost steps everyone to the cheapest and says so;
+// the report carries the ladder, the levels per frame and the characters' changes.
+TEST_F(ReplayE2E, QualityLevelsFixedAndBudgeted) {
+  const runtime::QualityLadder ladder = runtime::ladderOf(model_);
+  ASSERT_GE(ladder.size(), 3u);
+  for (size_t l = 0; l < ladder.size(); ++l) {
+    runtime::Scene s = scene(sceneJson({"walk.json", "walk.json", "walk.json"}));
+    s.outputs.directory = dir_ / ("level" + std::to_string(l));
+    auto o = jobOptions();
+    o.engine.fixedLevel = ladder[l].name;
+    const auto r = replay::runReplayJob(s, o);
+    EXPECT_FALSE(r.result.failed()) << ladder[l].name << ": "
+                                    << (r.result.failures.empty() ? "" : r.result.failures[0]);
+    for (const auto& f : r.result.frames) {
+      ASSERT_EQ(f.levels.size(), 3u);
+      for (uint8_t v : f.levels) EXPECT_EQ(v, l);
+      EXPECT_EQ(f.levelChanges, 0u);
+      if (!ladder[l].normalMaps) EXPECT_LE(f.gpuDispatches, 3u) << "no decode or blend without maps";
+    }
+  }
+  runtime::Scene s = scene(sceneJson({"walk.json", "walk.json", "walk.json"}));
+  s.levels.frameBudgetMs = 1e-6;  // below anything: everyone at the cheapest level
+  s.outputs.directory = dir_ / "budget";
+  const auto r = replay::runReplayJob(s, jobOptions());
+  EXPECT_FALSE(r.result.failed()) << (r.result.failures.empty() ? "" : r.result.failures[0]);
+  ASSERT_EQ(r.result.levels.size(), 1u);
+  EXPECT_NE(r.result.levelCostsSource.find("calibrated on"), std::string::npos) << r.result.levelCostsSource;
+  ASSERT_EQ(r.result.levels[0].calibratedMsPerCharacter.size(), ladder.size());
+  for (size_t f = 1; f < r.result.frames.size(); ++f)
+    for (uint8_t v : r.result.frames[f].levels) EXPECT_EQ(v, ladder.size() - 1) << "frame " << f;
+  std::ifstream in(dir_ / "budget/report.json");
+  const json rep = json::parse(in);
+  ASSERT_TRUE(rep.contains("levels"));
+  EXPECT_EQ(rep["levels"]["models"][0]["ladder"]["levels"].size(), ladder.size());
+  EXPECT_EQ(rep["levels"]["characters"].size(), 3u);
+  EXPECT_LE(rep["levels"]["characters"][0]["maxChangesPerSecond"].get<int>(), 1);
+  EXPECT_TRUE(rep["frames"][1]["levels"].is_array());
+  EXPECT_TRUE(fs::exists(dir_ / "budget/plots/levels_per_frame.svg"));
+  std::ifstream md(dir_ / "budget/report.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("## Quality levels"), std::string::npos);
+  EXPECT_NE(text.find("frame budget of 1e-06 GPU ms"), std::string::npos) << text.substr(text.find("## Quality"), 400);
+  runtime::Scene bad = scene(sceneJson({"walk.json"}));
+  auto o = jobOptions();
+  o.engine.fixedLevel = "k999";
+  EXPECT_NE(test::errorOf([&] { replay::runReplayJob(bad, o); }).find("no level 'k999'"), std::string::npos);
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }
 

@@ -16,6 +16,7 @@
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
 #include "swish/runtime/frame_evaluator.hpp"
+#include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_frame.hpp"
 
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"  // Vulkan structs: other members zero on purpose
@@ -207,6 +208,71 @@ TEST(ApiHostDevice, RecordsIntoHostCommandBuffersAcrossFramesInFlight) {
     }
   // Older frames are no longer held.
   EXPECT_THROW(batch.outputs(0), api::Error);
+  test::expectNoValidationMessages(*device);
+}
+
+// Quality levels through the API: the model's ladder in ModelInfo, a host's own level per character
+// (the mesh is the CPU reference's at that level), swish's own choice from the camera, range errors.
+TEST(ApiHostDevice, QualityLevelsSetByTheHostOrPlannedBySwish) {
+  SWISH_HOST_DEVICE_OR_SKIP(device);
+  const Model model = randomModel(0x1E7, 60);
+  api::Runtime rt = api::Runtime::adopt(device->handles());
+  api::Model m = rt.loadModelFromMemory(serializeModel(model), "levels");
+  const runtime::QualityLadder ladder = runtime::ladderOf(model);
+  ASSERT_EQ(m.info().qualityLevels.size(), ladder.size());
+  for (size_t l = 0; l < ladder.size(); ++l) {
+    EXPECT_EQ(m.info().qualityLevels[l].name, ladder[l].name);
+    EXPECT_EQ(m.info().qualityLevels[l].meshComponents, ladder[l].meshComponents);
+  }
+  const uint32_t characters = 3, skinned = uint32_t(ladder.size() - 1);
+  api::CharacterBatch batch = m.createBatch({characters, 1, true});
+  batch.setQualityLevel(1, skinned);
+  EXPECT_EQ(batch.qualityLevel(1), skinned);
+  EXPECT_EQ(batch.qualityLevel(0), 0u);
+  HostFrames host(device->device(), device->queueFamily(), 1);
+  Rng rng(5);
+  HostPoses poses = randomPoses(rng, model, characters);
+  VkCommandBuffer cmd = host.begin(0);
+  const api::FrameReport report = batch.recordFrame(cmd, 0, poses.poses);
+  host.submit(device->queue(), 0);
+  host.waitAll();
+  batch.retireFrame(0);
+  EXPECT_EQ(report.qualityLevels, (std::vector<uint32_t>{0, skinned, 0}));
+  // Character 1 at the skinned level: the mean shape, skinned, whatever the network says.
+  runtime::FrameKernelInputs in;
+  in.instanceCount = 1;
+  in.meshWeights.assign(size_t(model.meshComponents()), 0.f);
+  for (const Mat4f& sm : model.skeleton.skinningMatrices(poses.internal[1]))
+    in.skinMatrices.push_back(poses.worlds[1] * sm);
+  const Points3f ref = runtime::referencePositions(model, in, 0, true);
+  const api::DeformedMesh mesh = batch.readBackMesh(0, 1);
+  expectClose(mesh.positions, ref.data(), size_t(ref.size()), 1e-4, 1e-5, "skinned level positions");
+  // swish plans: a character behind the camera runs at the cheapest level, the others where the
+  // tolerance puts them (this model's ladder is not measured, so at full quality).
+  api::LevelPlanning plan;
+  plan.cameraPosition = {0, 1.5f, -100};
+  plan.cameraTarget = {0, 1, 0};
+  api::CharacterBatch planned = m.createBatch({characters, 1, true});
+  planned.planQualityLevels(plan);
+  poses.worlds[2].topRightCorner<3, 1>() = Vec3f(0, 0, -200);  // behind the camera
+  std::memcpy(poses.poses[2].characterToWorld.data(), poses.worlds[2].data(), 64);
+  for (uint32_t c = 0; c < 2; ++c) {
+    poses.worlds[c].topRightCorner<3, 1>() = Vec3f(float(c), 0, 0);
+    std::memcpy(poses.poses[c].characterToWorld.data(), poses.worlds[c].data(), 64);
+  }
+  cmd = host.begin(0);
+  const api::FrameReport r2 = planned.recordFrame(cmd, 0, poses.poses);
+  host.submit(device->queue(), 0);
+  host.waitAll();
+  planned.retireFrame(0);
+  EXPECT_EQ(r2.qualityLevels, (std::vector<uint32_t>{0, 0, skinned}));
+  try {
+    batch.setQualityLevel(0, uint32_t(ladder.size()));
+    ADD_FAILURE() << "a level beyond the ladder was accepted";
+  } catch (const api::Error& e) {
+    EXPECT_EQ(e.code(), api::ErrorCode::InvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("of a ladder of"), std::string::npos) << e.what();
+  }
   test::expectNoValidationMessages(*device);
 }
 

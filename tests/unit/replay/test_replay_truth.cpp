@@ -198,6 +198,15 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
         EXPECT_EQ(c.comparedWithout, proxy) << "frame " << f.frame;
       }
   }
+  // Every level of the model's ladder against the same truth: the full level is the run time's own
+  // output (the CPU reference of the GPU's frame, within the GPU check's tolerance), and the mean shape
+  // skinned is far worse.
+  ASSERT_EQ(r.levels.size(), 1u);
+  ASSERT_EQ(r.levels[0].truth.size(), r.levels[0].ladder.size());
+  EXPECT_NEAR(r.levels[0].truth[0].meanMm, r.truthOverall.meanMm, replay::kPositionToleranceMm);
+  EXPECT_GT(r.levels[0].truth.back().meanMm, 2.0 * r.levels[0].truth[0].meanMm);
+  EXPECT_EQ(r.levels[0].truth[0].samples, r.levels[0].truth.back().samples);
+  EXPECT_TRUE(rep["levels"]["models"][0]["truth"][0]["meanMm"].is_number());
   EXPECT_EQ(r.penetrationOverall.model.frames, 10u);
   EXPECT_TRUE(rep["penetration"]["overall"]["model"]["deepestMm"].is_number());
   EXPECT_TRUE(rep["frames"][0]["penetration"][0]["model"]["inside"].is_number());

@@ -195,3 +195,48 @@ TEST(DefaultScene, FootballPlayParses) {
 }
 
 }  // namespace
+
+TEST_F(SceneFileTest, CameraLevelsAndAFixedLevel) {
+  json j = valid();
+  j["camera"] = {{"position", {0, 12, -45}}, {"target", {0, 1, 0}}, {"fovDegrees", 40}, {"imageHeight", 720}};
+  j["levels"] = {{"frameBudgetMs", 6.5}, {"tolerancePixels", 0.5}, {"holdSeconds", 2}};
+  j["characters"][0]["level"] = "k64";
+  j["characters"][1]["level"] = 3;
+  const auto s = parseScene(j, source());
+  ASSERT_TRUE(s.cameraTarget.has_value());
+  EXPECT_DOUBLE_EQ(s.cameraTarget->y(), 1.0);
+  EXPECT_DOUBLE_EQ(s.cameraFovDegrees, 40.0);
+  EXPECT_DOUBLE_EQ(s.imageHeightPixels, 720.0);
+  EXPECT_DOUBLE_EQ(*s.levels.frameBudgetMs, 6.5);
+  EXPECT_DOUBLE_EQ(*s.levels.tolerancePixels, 0.5);
+  EXPECT_DOUBLE_EQ(s.levels.holdSeconds, 2.0);
+  EXPECT_EQ(s.characters[0].level, "k64");
+  EXPECT_EQ(s.characters[1].level, "3");
+  const auto cam = s.levelCamera();
+  EXPECT_DOUBLE_EQ(cam.verticalFovDegrees, 40.0);
+  EXPECT_DOUBLE_EQ(cam.target.y(), 1.0);
+  const auto again = parseScene(swish::runtime::sceneToJson(s), source());
+  EXPECT_DOUBLE_EQ(*again.levels.frameBudgetMs, 6.5);
+  EXPECT_EQ(again.characters[1].level, "3");
+  EXPECT_DOUBLE_EQ(again.cameraFovDegrees, 40.0);
+  // Without a target the camera looks at the characters' mean, 1 m up.
+  const auto plain = parseScene(valid(), source()).levelCamera();
+  EXPECT_DOUBLE_EQ(plain.target.x(), 5000.0);
+  EXPECT_DOUBLE_EQ(plain.target.y(), 1.0);
+
+  json bad = j;
+  bad["levels"]["frameBudgetMs"] = -1;
+  EXPECT_NE(errorOf(bad).find("levels.frameBudgetMs"), std::string::npos);
+  bad = j;
+  bad["levels"]["budget"] = 1;
+  EXPECT_NE(errorOf(bad).find("levels.budget: unknown key"), std::string::npos);
+  bad = j;
+  bad["camera"]["fovDegrees"] = 179;
+  EXPECT_NE(errorOf(bad).find("camera.fovDegrees"), std::string::npos);
+  bad = j;
+  bad["camera"]["target"] = {0, 12, -45};
+  EXPECT_NE(errorOf(bad).find("camera.target: must differ from the position"), std::string::npos);
+  bad = j;
+  bad["characters"][0]["level"] = "";
+  EXPECT_NE(errorOf(bad).find("characters[0].level"), std::string::npos);
+}
