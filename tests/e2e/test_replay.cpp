@@ -5,6 +5,7 @@
 // leaves no partial outputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -171,14 +172,22 @@ TEST_F(ReplayE2E, QualityLevelsFixedAndBudgeted) {
   ASSERT_EQ(r.result.levels.size(), 1u);
   EXPECT_NE(r.result.levelCostsSource.find("calibrated on"), std::string::npos) << r.result.levelCostsSource;
   ASSERT_EQ(r.result.levels[0].calibratedMsPerCharacter.size(), ladder.size());
+  // Everyone steps down to the cheapest level the calibration tells apart from the others (levels that
+  // measured no cheaper than the one before them save nothing), and every frame is over the budget.
+  const auto& costs = r.result.levels[0].calibratedMsPerCharacter;
+  const double cheapest = *std::min_element(costs.begin(), costs.end());
   for (size_t f = 1; f < r.result.frames.size(); ++f)
-    for (uint8_t v : r.result.frames[f].levels) EXPECT_EQ(v, ladder.size() - 1) << "frame " << f;
+    for (uint8_t v : r.result.frames[f].levels) {
+      EXPECT_GE(v, 1u) << "frame " << f;
+      EXPECT_LE(*std::min_element(costs.begin(), costs.begin() + v + 1), cheapest) << "frame " << f;
+    }
   std::ifstream in(dir_ / "budget/report.json");
   const json rep = json::parse(in);
   ASSERT_TRUE(rep.contains("levels"));
   EXPECT_EQ(rep["levels"]["models"][0]["ladder"]["levels"].size(), ladder.size());
   EXPECT_EQ(rep["levels"]["characters"].size(), 3u);
   EXPECT_LE(rep["levels"]["characters"][0]["maxChangesPerSecond"].get<int>(), 1);
+  EXPECT_EQ(rep["levels"]["summary"]["framesOverBudget"], r.result.frames.size());
   EXPECT_TRUE(rep["frames"][1]["levels"].is_array());
   EXPECT_TRUE(fs::exists(dir_ / "budget/plots/levels_per_frame.svg"));
   std::ifstream md(dir_ / "budget/report.md");

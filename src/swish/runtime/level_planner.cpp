@@ -88,6 +88,10 @@ void LevelPlanner::setCosts(LevelCosts costs) {
       if (costs.msPerCharacter[c].size() != ladders_[c]->size())
         throw Error("level planner: costs of character " + std::to_string(c) + " do not cover its ladder");
   }
+  // A cheaper level does no more work than the one before it: measured costs that say otherwise are
+  // noise, and would stop the budget's descent at a level that seems to save nothing.
+  for (auto& perLevel : costs.msPerCharacter)
+    for (size_t l = 1; l < perLevel.size(); ++l) perLevel[l] = std::min(perLevel[l], perLevel[l - 1]);
   costs_ = std::move(costs);
 }
 
@@ -172,19 +176,23 @@ const PlannedLevels& LevelPlanner::plan(uint64_t frame, std::span<const Eigen::V
       while (total > budget) {
         size_t pick = n;
         double pickScore = std::numeric_limits<double>::infinity();
+        uint32_t pickTo = 0;
         for (size_t c = 0; c < n; ++c) {
-          if (!movable[c] || level[c] + 1 >= ladders_[c]->size()) continue;
-          const double saved = costOf(c, level[c]) - costOf(c, level[c] + 1);
-          if (!(saved > 0.0)) continue;
-          const double score = std::max(addedError(c, level[c], level[c] + 1), 0.0) / saved;
-          if (score < pickScore) pickScore = score, pick = c;
+          if (!movable[c]) continue;
+          // The next level that costs less (levels of equal cost are passed over: they save nothing).
+          uint32_t to = level[c] + 1;
+          while (to < ladders_[c]->size() && !(costOf(c, to) < costOf(c, level[c]))) ++to;
+          if (to >= ladders_[c]->size()) continue;
+          const double saved = costOf(c, level[c]) - costOf(c, to);
+          const double score = std::max(addedError(c, level[c], to), 0.0) / saved;
+          if (score < pickScore) pickScore = score, pick = c, pickTo = to;
         }
         if (pick == n) {
           out_.overBudget = true;
           break;
         }
-        total -= costOf(pick, level[pick]) - costOf(pick, level[pick] + 1);
-        ++level[pick];
+        total -= costOf(pick, level[pick]) - costOf(pick, pickTo);
+        level[pick] = pickTo;
         --moved[pick];
       }
       while (!first_ && !out_.overBudget) {
