@@ -218,8 +218,15 @@ TEST_F(PreviewRender, NormalMapOffChangesShadingInsideTheJerseyOnly) {
       const bool inJersey = pixel(img, o.width, 2, x, y)[3] > 0;
       const bool changed =
           std::abs(on[0] - off[0]) + std::abs(on[1] - off[1]) + std::abs(on[2] - off[2]) > 0 || on[3] != off[3];
+      // Outside the jersey only the body and the background are drawn, by the same draws in both panels,
+      // but at another viewport offset (the panels sit side by side): Vulkan does not make attribute
+      // interpolation invariant under a viewport translation, and an NVIDIA H100 shaded one body pixel
+      // (of 32000) 1 step darker in one panel. One step per channel is that rounding; the normal map's
+      // own effect is far larger.
+      const bool changedBeyondRounding = std::abs(on[0] - off[0]) > 1 || std::abs(on[1] - off[1]) > 1 ||
+                                         std::abs(on[2] - off[2]) > 1 || on[3] != off[3];
       jersey += inJersey;
-      (inJersey ? changedInside : changedOutside) += changed;
+      (inJersey ? changedInside : changedOutside) += inJersey ? changed : changedBeyondRounding;
       if (changed && !inJersey)
         std::printf("changed outside the jersey at (%u, %u): map on %d %d %d %d, off %d %d %d %d\n", x, y, on[0], on[1],
                     on[2], on[3], off[0], off[1], off[2], off[3]);
