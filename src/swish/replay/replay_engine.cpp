@@ -77,7 +77,7 @@ struct Batch {
 
 // Instance i of the batch at every level of its ladder (the CPU reference), from the network's whole
 // output for its pose: what each level would have shown on this frame.
-std::vector<Points3f> levelPositions(Batch& B, uint32_t i) {
+static std::vector<Points3f> levelPositions(Batch& B, uint32_t i) {
   const runtime::FrameOutput& o = B.probe->evaluate(std::span<const Pose>(&B.poses[i], 1), 0.f);
   const size_t jc = B.model->skeleton.size(), k = size_t(B.model->meshComponents());
   runtime::FrameKernelInputs in;
@@ -138,7 +138,7 @@ struct ReplayEngine::Impl {
   void setUp();
   void setUpLevels();
   void calibrateLevels();
-  void calibrationFrame(Batch& B, const std::vector<Pose>& poses, const runtime::QualityLevel& level);
+  void calibrationFrame(Batch& B, const std::vector<Pose>& poses, uint32_t level);
   void applyLevels(uint64_t frame, const std::vector<std::vector<Pose>>& poses, FrameRecord& rec);
   bool truthFrame(uint32_t index) const;
   FrameRecord runFrame(uint32_t index, ReplayResult& result);
@@ -266,17 +266,13 @@ void ReplayEngine::Impl::setUpLevels() {
 // that level (median of a few frames of the scene's first poses) shared out per character, so that a
 // frame's fixed cost is shared too. The calibration's frames are thrown away: filters start again (the
 // first real frame blends with alpha 1) and decoded maps are forgotten.
-// One frame of the batch with every character at `level`, submitted and waited on (calibration only).
-void ReplayEngine::Impl::calibrationFrame(Batch& B, const std::vector<Pose>& poses,
-                                          const runtime::QualityLevel& level) {
+// The CPU frame's output as the GPU passes' inputs: mesh weights, each instance's components (its
+// level), and with maps the selected map and blend factor of each character (kNoMap without).
+static void setKernelInputs(Batch& B, const runtime::FrameOutput& o) {
   const uint32_t n = uint32_t(B.planned->characters.size());
-  for (uint32_t i = 0; i < n; ++i) {
-    B.frames->resetCharacter(i);
-    B.frames->setLevel(i, level);
-  }
-  const runtime::FrameOutput& o = B.frames->evaluate(std::span<const Pose>(poses), 0.f);
   B.inputs.meshWeights = o.meshWeights;
-  B.inputs.meshComponents.assign(n, level.meshComponents);
+  B.inputs.meshComponents.resize(n);
+  for (uint32_t i = 0; i < n; ++i) B.inputs.meshComponents[i] = B.ladder[B.levelOf[i]].meshComponents;
   B.inputs.selectedMaps.clear();
   B.inputs.blendAlpha.clear();
   if (B.frames->hasNormalMaps())
@@ -284,6 +280,17 @@ void ReplayEngine::Impl::calibrationFrame(Batch& B, const std::vector<Pose>& pos
       B.inputs.selectedMaps.push_back(o.blend[i].selectedMap);
       B.inputs.blendAlpha.push_back(o.blend[i].alpha);
     }
+}
+
+// One frame of the batch with every character at `level`, submitted and waited on (calibration only).
+void ReplayEngine::Impl::calibrationFrame(Batch& B, const std::vector<Pose>& poses, uint32_t level) {
+  const uint32_t n = uint32_t(B.planned->characters.size());
+  for (uint32_t i = 0; i < n; ++i) {
+    B.frames->resetCharacter(i);
+    B.frames->setLevel(i, B.ladder[level]);
+  }
+  B.levelOf.assign(n, level);
+  setKernelInputs(B, B.frames->evaluate(std::span<const Pose>(poses), 0.f));
   VkCommandBuffer cmd = ctx->beginOneTime();
   try {
     B.recorder->record(cmd, 0, B.inputs);
@@ -315,11 +322,11 @@ void ReplayEngine::Impl::calibrateLevels() {
     // A real GPU idles at low clocks: keep it busy at full quality for a quarter of a second (at least
     // 10 frames) before measuring, as a game's steady state would.
     const auto warmStart = Clock::now();
-    for (int r = 0; r < 10 || msSince(warmStart) < 250.0; ++r) calibrationFrame(B, poses, B.ladder[0]);
+    for (int r = 0; r < 10 || msSince(warmStart) < 250.0; ++r) calibrationFrame(B, poses, 0);
     for (uint32_t l = 0; l < B.ladder.size(); ++l) {
       std::vector<double> ms;
       for (int r = 0; r < kRepeats + 1; ++r) {
-        calibrationFrame(B, poses, B.ladder[l]);
+        calibrationFrame(B, poses, l);
         // The first frame decodes its maps and warms caches up; the others are the steady state, in
         // which a frame decodes only the maps newly selected.
         if (r > 0) ms.push_back(B.recorder->stageTimes(0).totalMs);
@@ -331,6 +338,7 @@ void ReplayEngine::Impl::calibrateLevels() {
       B.frames->resetCharacter(i);
       B.frames->setLevel(i, B.ladder[0]);
     }
+    B.levelOf.assign(n, 0);
     B.recorder->forgetDecodedMaps();
   }
   runtime::LevelCosts costs;
@@ -432,16 +440,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
       for (uint32_t i = 0; i < n; ++i)
         rec.novelty.push_back(
             {B.planned->characters[i], o.novelty[i], o.guardBlend[i], !(o.novelty[i] <= m.noveltyGuard.flagAbove)});
-    B.inputs.meshWeights = o.meshWeights;
-    B.inputs.meshComponents.resize(n);
-    for (uint32_t i = 0; i < n; ++i) B.inputs.meshComponents[i] = B.ladder[B.levelOf[i]].meshComponents;
-    B.inputs.selectedMaps.clear();
-    B.inputs.blendAlpha.clear();
-    if (B.frames->hasNormalMaps())
-      for (uint32_t i = 0; i < n; ++i) {
-        B.inputs.selectedMaps.push_back(o.blend[i].selectedMap);
-        B.inputs.blendAlpha.push_back(o.blend[i].alpha);
-      }
+    setKernelInputs(B, o);
   }
 
   const bool check = plan.gpuWork && index % scene.outputs.gpuCheckEvery == 0;
