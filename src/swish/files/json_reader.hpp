@@ -5,14 +5,23 @@
 //   <source>: <json.path>: <problem>       e.g.  "shot.json: characters[3].model: must be a string, is number"
 //
 // <source> names the document (usually its file; with an empty source the message starts at the
-// path), <json.path> is the node's path from the top ("frames.count", "characters[0].placement";
+// path: "model metadata dataset_settings.simulation.substeps: ..." when the path starts with a name), <json.path> is
+// the node's path from the top ("frames.count", "characters[0].placement";
 // "(top level)" for the document itself), and <problem> says what is wrong with the value found there.
 // Errors are swish::Error. A reader refers to the JSON it reads (it keeps no copy): the document must
 // outlive it. A missing key reads as null, so child("x").string() of a missing "x" says
 // "x: must be a string, is null"; required("x") says "x: is required".
+//
+// The getters without a key read the node itself; those with a key and a fallback read an optional
+// member of an object (the fallback when it is missing, an error at "<path>.<key>" when it is wrong).
+// Type errors say what was found ("must be a number, is string"). Ranges have two phrasings, both
+// kept from the readers that had them: integer(lo, hi) for counts and indices says
+// "must be <lo> to <hi>, is <value>"; number(lo, hi) and wholeNumber(lo, hi) say
+// "<value> is outside <lo>..<hi>".
 #include <cstdint>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,6 +50,8 @@ class JsonReader {
   JsonReader at(size_t i) const;
   // Like child(), but a missing key is the error "is required".
   JsonReader required(const char* key) const;
+  // An optional object member checked with requireObject(allowed); an empty object when missing.
+  JsonReader section(const std::string& key, std::initializer_list<const char*> allowed) const;
 
   std::string string() const;  // "must be a string, is <type>"
   bool boolean() const;        // "must be true or false, is <type>"
@@ -49,6 +60,22 @@ class JsonReader {
   // "must be <lo> to <hi>, is <value>".
   uint32_t integer(uint64_t lo, uint64_t hi) const;
   Eigen::Vector3d vec3() const;  // "must be an array of 3 numbers"
+  // A number in [lo, hi]: "<value> is outside <lo>..<hi>".
+  double number(double lo, double hi) const;
+  // A whole number in [lo, hi], as a double (seeds up to 2^53): "must be an integer, is a fraction",
+  // "<value> is outside <lo>..<hi>".
+  double wholeNumber(double lo, double hi) const;
+  std::string nonEmptyString() const;  // "must be a non-empty string"
+  // A non-empty array of non-empty strings: "must be a non-empty array of strings",
+  // "must hold non-empty strings only".
+  std::vector<std::string> strings() const;
+
+  // Optional members of an object.
+  double number(const char* key, double lo, double hi, double fallback) const;
+  double wholeNumber(const char* key, double lo, double hi, double fallback) const;
+  bool boolean(const char* key, bool fallback) const;
+  std::string nonEmptyString(const char* key, const std::string& fallback) const;
+  std::vector<std::string> strings(const char* key, std::vector<std::string> fallback) const;
 
  private:
   const nlohmann::json& j_;
