@@ -8,6 +8,7 @@
 #include "swish/core/error.hpp"
 #include "swish/files/atomic_write.hpp"
 #include "swish/files/json_file.hpp"
+#include "swish/files/json_reader.hpp"
 
 namespace swish::replay {
 
@@ -16,10 +17,11 @@ namespace {
 using nlohmann::json;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-float component(const json& v, const std::string& where) {
-  if (v.is_null()) return kNaN;
-  if (!v.is_number()) throw Error(where + ": must be a number or null");
-  return v.get<float>();
+// A coordinate: a number, or null for a value the source did not have (NaN).
+float component(const JsonReader& r) {
+  if (r.value().is_null()) return kNaN;
+  if (!r.value().is_number()) r.fail("must be a number or null");
+  return r.value().get<float>();
 }
 
 json number(float f) { return std::isfinite(f) ? json(f) : json(nullptr); }
@@ -27,46 +29,47 @@ json number(float f) { return std::isfinite(f) ? json(f) : json(nullptr); }
 }  // namespace
 
 PoseStream readPoseStream(const std::filesystem::path& file) {
-  const std::string src = file.string();
   const json j = readJsonFile(file, "pose stream");
-  if (!j.is_object() || j.value("format", "") != "swish-pose-stream")
-    throw Error(src + ": format: must be \"swish-pose-stream\"");
-  if (j.value("version", 0) != 1) throw Error(src + ": version: only version 1 is supported");
+  const JsonReader root(j, file.string());
+  const JsonReader format = root.child("format");
+  if (!j.is_object() || !format.value().is_string() || format.value().get<std::string>() != "swish-pose-stream")
+    format.fail("must be \"swish-pose-stream\"");
+  // As before the reader was shared: a number whose whole part is 1 (or true) reads as version 1.
+  const JsonReader version = root.child("version");
+  if (!(version.value().is_number() || version.value().is_boolean()) || version.value().get<int>() != 1)
+    version.fail("only version 1 is supported");
   PoseStream s;
   s.name = file.stem().string();
-  if (j.contains("framesPerSecond")) {
-    if (!j["framesPerSecond"].is_number() || !(j["framesPerSecond"].get<double>() > 0))
-      throw Error(src + ": framesPerSecond: must be a positive number");
-    s.framesPerSecond = j["framesPerSecond"].get<double>();
+  if (root.has("framesPerSecond")) {
+    const JsonReader fps = root.child("framesPerSecond");
+    if (!fps.value().is_number() || !(fps.value().get<double>() > 0)) fps.fail("must be a positive number");
+    s.framesPerSecond = fps.value().get<double>();
   }
-  if (!j.contains("joints") || !j["joints"].is_array() || j["joints"].empty())
-    throw Error(src + ": joints: must be a non-empty array of names");
-  for (size_t i = 0; i < j["joints"].size(); ++i) {
-    if (!j["joints"][i].is_string()) throw Error(src + ": joints[" + std::to_string(i) + "]: must be a string");
-    s.joints.push_back(j["joints"][i].get<std::string>());
-  }
-  if (!j.contains("frames") || !j["frames"].is_array() || j["frames"].empty())
-    throw Error(src + ": frames: must be a non-empty array");
-  for (size_t f = 0; f < j["frames"].size(); ++f) {
-    const json& fj = j["frames"][f];
-    const std::string at = src + ": frames[" + std::to_string(f) + "]";
-    if (!fj.is_object()) throw Error(at + ": must be an object");
+  const JsonReader joints = root.child("joints");
+  if (!joints.value().is_array() || joints.value().empty()) joints.fail("must be a non-empty array of names");
+  for (size_t i = 0; i < joints.value().size(); ++i) s.joints.push_back(joints.at(i).string());
+  const JsonReader frames = root.child("frames");
+  if (!frames.value().is_array() || frames.value().empty()) frames.fail("must be a non-empty array");
+  for (size_t f = 0; f < frames.value().size(); ++f) {
+    const JsonReader fr = frames.at(f);
+    if (!fr.value().is_object()) fr.fail("must be an object");
     PoseStreamFrame frame;
     frame.rotations.assign(s.joints.size(), Quatf::Identity());
     frame.present.assign(s.joints.size(), false);
-    if (fj.contains("root")) {
-      if (!fj["root"].is_array() || fj["root"].size() != 3) throw Error(at + ".root: must be an array of 3 numbers");
-      for (int k = 0; k < 3; ++k) frame.root[k] = component(fj["root"][size_t(k)], at + ".root");
+    if (fr.has("root")) {
+      const JsonReader rootPosition = fr.child("root");
+      if (!rootPosition.value().is_array() || rootPosition.value().size() != 3)
+        rootPosition.fail("must be an array of 3 numbers");
+      for (size_t k = 0; k < 3; ++k) frame.root[Eigen::Index(k)] = component(rootPosition.at(k));
     }
-    if (!fj.contains("rotations") || !fj["rotations"].is_array()) throw Error(at + ".rotations: must be an array");
-    const json& rj = fj["rotations"];
-    if (rj.size() > s.joints.size()) throw Error(at + ".rotations: more rotations than joints");
-    for (size_t r = 0; r < rj.size(); ++r) {
-      if (rj[r].is_null()) continue;
-      const std::string ra = at + ".rotations[" + std::to_string(r) + "]";
-      if (!rj[r].is_array() || rj[r].size() != 4) throw Error(ra + ": must be [x, y, z, w] or null");
-      frame.rotations[r] =
-          Quatf(component(rj[r][3], ra), component(rj[r][0], ra), component(rj[r][1], ra), component(rj[r][2], ra));
+    const JsonReader rotations = fr.child("rotations");
+    if (!rotations.value().is_array()) rotations.fail("must be an array");
+    if (rotations.value().size() > s.joints.size()) rotations.fail("more rotations than joints");
+    for (size_t r = 0; r < rotations.value().size(); ++r) {
+      const JsonReader q = rotations.at(r);
+      if (q.value().is_null()) continue;
+      if (!q.value().is_array() || q.value().size() != 4) q.fail("must be [x, y, z, w] or null");
+      frame.rotations[r] = Quatf(component(q.at(3)), component(q.at(0)), component(q.at(1)), component(q.at(2)));
       frame.present[r] = true;
     }
     s.frames.push_back(std::move(frame));

@@ -1,12 +1,11 @@
 #include "swish/runtime/scene_file.hpp"
 
-#include <cmath>
-#include <initializer_list>
 #include <set>
 #include <sstream>
 
 #include "swish/core/error.hpp"
 #include "swish/files/json_file.hpp"
+#include "swish/files/json_reader.hpp"
 
 namespace swish::runtime {
 
@@ -14,91 +13,22 @@ namespace {
 
 using nlohmann::json;
 
-// Walks the JSON with the path of the current node, so that every error says where it is.
-class Reader {
- public:
-  Reader(const json& j, std::string source, std::string path)
-      : j_(j), source_(std::move(source)), path_(std::move(path)) {}
-
-  [[noreturn]] void fail(const std::string& problem) const {
-    throw Error(source_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " + problem);
-  }
-  const json& value() const { return j_; }
-  const std::string& path() const { return path_; }
-  const std::string& source() const { return source_; }
-
-  void requireObject(std::initializer_list<const char*> allowed) const {
-    if (!j_.is_object()) fail("must be an object, is " + std::string(j_.type_name()));
-    const std::set<std::string> ok(allowed.begin(), allowed.end());
-    for (const auto& [key, v] : j_.items())
-      if (!ok.count(key)) {
-        std::string list;
-        for (const auto& k : ok) list += (list.empty() ? "" : ", ") + k;
-        child(key).fail("unknown key (allowed here: " + list + ")");
-      }
-  }
-  bool has(const char* key) const { return j_.contains(key); }
-  Reader child(const std::string& key) const {
-    static const json null;
-    const json& v = j_.contains(key) ? j_.at(key) : null;
-    return Reader(v, source_, path_.empty() ? key : path_ + "." + key);
-  }
-  Reader at(size_t i) const { return Reader(j_.at(i), source_, path_ + "[" + std::to_string(i) + "]"); }
-  Reader required(const char* key) const {
-    if (!j_.contains(key)) child(key).fail("is required");
-    return child(key);
-  }
-
-  std::string string() const {
-    if (!j_.is_string()) fail("must be a string, is " + std::string(j_.type_name()));
-    return j_.get<std::string>();
-  }
-  bool boolean() const {
-    if (!j_.is_boolean()) fail("must be true or false, is " + std::string(j_.type_name()));
-    return j_.get<bool>();
-  }
-  double number() const {
-    if (!j_.is_number()) fail("must be a number, is " + std::string(j_.type_name()));
-    const double v = j_.get<double>();
-    if (!std::isfinite(v)) fail("must be finite");
-    return v;
-  }
-  uint32_t integer(uint64_t lo, uint64_t hi) const {
-    if (!j_.is_number_integer() && !(j_.is_number_float() && j_.get<double>() == std::floor(j_.get<double>())))
-      fail("must be an integer, is " + std::string(j_.is_number() ? "a fraction" : j_.type_name()));
-    const double v = j_.get<double>();
-    if (v < double(lo) || v > double(hi))
-      fail("must be " + std::to_string(lo) + " to " + std::to_string(hi) + ", is " + j_.dump());
-    return uint32_t(v);
-  }
-  Eigen::Vector3d vec3() const {
-    if (!j_.is_array() || j_.size() != 3) fail("must be an array of 3 numbers");
-    Eigen::Vector3d v;
-    for (size_t i = 0; i < 3; ++i) v[Eigen::Index(i)] = at(i).number();
-    return v;
-  }
-
- private:
-  const json& j_;
-  std::string source_, path_;
-};
-
 std::filesystem::path resolve(const std::filesystem::path& base, const std::string& p) {
   const std::filesystem::path path(p);
   return path.is_absolute() ? path : (base / path).lexically_normal();
 }
 
-void requireFile(const Reader& r, const std::filesystem::path& file) {
+void requireFile(const JsonReader& r, const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     r.fail("file '" + file.string() + "' does not exist or is not a file");
 }
 
-SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base, bool checkFiles) {
+SceneCharacter parseCharacter(const JsonReader& r, const std::filesystem::path& base, bool checkFiles) {
   r.requireObject({"name", "model", "animation", "poseStream", "placement", "visible", "level"});
   SceneCharacter c;
   c.name = r.required("name").string();
-  const Reader model = r.required("model");
+  const JsonReader model = r.required("model");
   c.model = model.string();
   if (c.model != kDefaultModelName) {
     c.model = resolve(base, c.model).string();
@@ -106,10 +36,10 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
   }
   if (r.has("animation") == r.has("poseStream")) r.fail("needs exactly one of \"animation\" and \"poseStream\"");
   if (r.has("animation")) {
-    const Reader a = r.child("animation");
+    const JsonReader a = r.child("animation");
     a.requireObject({"file", "clip", "timeOffset", "speed", "jointMap"});
     SceneClip clip;
-    const Reader file = a.required("file");
+    const JsonReader file = a.required("file");
     clip.file = resolve(base, file.string());
     if (checkFiles) requireFile(file, clip.file);
     if (a.has("clip")) clip.clipName = a.child("clip").string();
@@ -119,7 +49,7 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
       if (!(clip.speed > 0.0 && clip.speed <= 100.0)) a.child("speed").fail("must be in (0, 100]");
     }
     if (a.has("jointMap")) {
-      const Reader m = a.child("jointMap");
+      const JsonReader m = a.child("jointMap");
       if (m.value().is_string()) {
         clip.jointMapFile = resolve(base, m.string());
         if (checkFiles) {
@@ -136,12 +66,12 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
     }
     c.clip = clip;
   } else {
-    const Reader s = r.child("poseStream");
+    const JsonReader s = r.child("poseStream");
     c.poseStream = resolve(base, s.string());
     if (checkFiles) requireFile(s, *c.poseStream);
   }
   if (r.has("placement")) {
-    const Reader p = r.child("placement");
+    const JsonReader p = r.child("placement");
     p.requireObject({"translation", "yawDegrees"});
     if (p.has("translation")) {
       c.placement.translation = p.child("translation").vec3();
@@ -151,7 +81,7 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
   }
   if (r.has("visible")) c.visible = r.child("visible").boolean();
   if (r.has("level")) {
-    const Reader l = r.child("level");
+    const JsonReader l = r.child("level");
     if (l.value().is_number_integer())
       c.level = std::to_string(l.integer(0, 255));
     else
@@ -164,14 +94,14 @@ SceneCharacter parseCharacter(const Reader& r, const std::filesystem::path& base
 }  // namespace
 
 Scene parseScene(const json& j, const std::filesystem::path& source, bool checkFiles) {
-  const Reader root(j, source.string(), "");
+  const JsonReader root(j, source.string(), "");
   root.requireObject({"name", "frames", "camera", "cullDistance", "levels", "outputs", "characters"});
   const std::filesystem::path base = source.has_parent_path() ? source.parent_path() : std::filesystem::path(".");
   Scene s;
   s.source = source;
   s.name = root.has("name") ? root.child("name").string() : source.stem().string();
 
-  const Reader frames = root.required("frames");
+  const JsonReader frames = root.required("frames");
   frames.requireObject({"start", "count", "rate"});
   if (frames.has("start")) s.firstFrame = frames.child("start").integer(0, 100'000'000);
   s.frameCount = frames.required("count").integer(1, 10'000'000);
@@ -181,7 +111,7 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
   }
 
   if (root.has("camera")) {
-    const Reader cam = root.child("camera");
+    const JsonReader cam = root.child("camera");
     cam.requireObject({"position", "target", "fovDegrees", "imageHeight"});
     s.camera = cam.required("position").vec3();
     if (cam.has("target")) s.cameraTarget = cam.child("target").vec3();
@@ -189,7 +119,7 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
     if (cam.has("imageHeight")) s.imageHeightPixels = cam.child("imageHeight").integer(16, 65536);
   }
   if (root.has("levels")) {
-    const Reader lv = root.child("levels");
+    const JsonReader lv = root.child("levels");
     lv.requireObject({"frameBudgetMs", "tolerancePixels", "holdSeconds"});
     if (lv.has("frameBudgetMs")) s.levels.frameBudgetMs = lv.child("frameBudgetMs").number();
     if (lv.has("tolerancePixels")) s.levels.tolerancePixels = lv.child("tolerancePixels").number();
@@ -202,7 +132,7 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
   }
 
   if (root.has("outputs")) {
-    const Reader o = root.child("outputs");
+    const JsonReader o = root.child("outputs");
     o.requireObject({"directory", "report", "render", "meshes", "normalMaps", "gpuCheckEvery"});
     if (o.has("directory"))
       s.outputs.directory = resolve(base, o.child("directory").string());
@@ -217,7 +147,7 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
     s.outputs.directory = resolve(base, s.outputs.directory.string());
   }
 
-  const Reader chars = root.required("characters");
+  const JsonReader chars = root.required("characters");
   if (!chars.value().is_array()) chars.fail("must be an array, is " + std::string(chars.value().type_name()));
   if (chars.value().empty()) chars.fail("a scene needs at least one character");
   std::set<std::string> names;
