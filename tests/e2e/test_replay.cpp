@@ -172,15 +172,15 @@ TEST_F(ReplayE2E, QualityLevelsFixedAndBudgeted) {
   ASSERT_EQ(r.result.levels.size(), 1u);
   EXPECT_NE(r.result.levelCostsSource.find("calibrated on"), std::string::npos) << r.result.levelCostsSource;
   ASSERT_EQ(r.result.levels[0].calibratedMsPerCharacter.size(), ladder.size());
-  // Everyone steps down to the cheapest level the calibration tells apart from the others (levels that
-  // measured no cheaper than the one before them save nothing), and every frame is over the budget.
+  // Everyone steps down to the first level with the cheapest calibrated cost (levels that measured no
+  // cheaper than one before them save nothing: on this tiny model, under a loaded machine, that may be
+  // level 0 itself; the planner's own tests hold the descent to exact costs), and every frame is over
+  // the budget.
   const auto& costs = r.result.levels[0].calibratedMsPerCharacter;
   const double cheapest = *std::min_element(costs.begin(), costs.end());
   for (size_t f = 1; f < r.result.frames.size(); ++f)
-    for (uint8_t v : r.result.frames[f].levels) {
-      EXPECT_GE(v, 1u) << "frame " << f;
+    for (uint8_t v : r.result.frames[f].levels)
       EXPECT_LE(*std::min_element(costs.begin(), costs.begin() + v + 1), cheapest) << "frame " << f;
-    }
   std::ifstream in(dir_ / "budget/report.json");
   const json rep = json::parse(in);
   ASSERT_TRUE(rep.contains("levels"));
