@@ -20,14 +20,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "swish/bake/pipeline/bake_config.hpp"
-#include "swish/bake/pipeline/part1_dataset.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/bake/poses/clip_list.hpp"
 #include "swish/bake/report/quality_ladder.hpp"
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
-#include "swish/core/skinning.hpp"
 #include "swish/files/atomic_write.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/replay/truth_simulation.hpp"
@@ -83,36 +80,17 @@ int runLevels(const LevelsCliOptions& o) {
   Model& model = entry.model;
   const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
 
-  // The bake's source simulation, as `swish replay --truth-every` rebuilds it.
+  // The bake's source simulation, as `swish replay --truth-every` rebuilds it (replay::ModelTruth).
   const json meta = json::parse(model.metadata, nullptr, false);
   const json ds = meta.is_object() && meta.contains("dataset_settings") && meta["dataset_settings"].is_object()
                       ? meta["dataset_settings"]
                       : json::object();
-  if (ds.contains("simulation") && ds["simulation"].is_object() && ds["simulation"].value("source", "") == "external")
-    throw Error(o.model +
-                ": the model was baked from an external cloth tool's shapes; swish's own solver is not its source "
-                "simulation, so there is no truth to measure the levels against");
-  std::string note, how;
-  const std::unique_ptr<Character> character = replay::rebuildBakeCharacter(entry, note, &how);
-  if (!character) throw Error(o.model + ": no truth to measure the levels against: " + note);
-  bake::PoseShapeSettings ps = bake::poseShapeSettingsFromJson(ds, o.model + ": metadata dataset_settings");
-  std::string overridden;
-  if (o.truthVertices) ps.simulationVertices = *o.truthVertices, overridden += " simulation vertices";
-  if (o.truthSubsteps) ps.simulation.substeps = *o.truthSubsteps, overridden += " substeps";
-  const bake::PoseShapeSimulator simulator(*character, ps);
-  bool truthMaps = true;
-  std::string mapNote;
-  if (!model.normalMaps.empty() && (ps.transfer.normalMap.width != model.normalMaps.width ||
-                                    ps.transfer.normalMap.height != model.normalMaps.height)) {
-    truthMaps = false;
-    mapNote = "; normal maps not measured: the bake's are " + std::to_string(ps.transfer.normalMap.width) +
-              " px, the model's " + std::to_string(model.normalMaps.width);
-  }
-  const std::string truth = "the bake's source simulation of '" + character->name + "' (" + how + "), " +
-                            std::to_string(simulator.solver().mesh().vertexCount()) + " simulation vertices, " +
-                            std::to_string(ps.simulation.substeps) + " substeps" +
-                            (overridden.empty() ? std::string() : " (overridden, not the bake's:" + overridden + ")") +
-                            mapNote;
+  replay::TruthOptions to;
+  to.simulationVertices = o.truthVertices;
+  to.substeps = o.truthSubsteps;
+  const replay::ModelTruth simulator(entry, to);
+  if (!simulator.available()) throw Error(o.model + ": no truth to measure the levels against: " + simulator.note());
+  const std::string& truth = simulator.note();
 
   // Clips: those given, else the model's own (its bake's part1.clips, as the metadata names them).
   std::vector<bake::ClipSource> sources;
@@ -170,16 +148,14 @@ int runLevels(const LevelsCliOptions& o) {
   const auto tSim = Clock::now();
   const auto one = [&](size_t i) {
     const Pose& pose = clips[frames[i].clip].frames[frames[i].frame];
-    const bake::PoseShape shape = simulator.simulate(bake::canonicalPose(character->skeleton, pose));
+    const bake::PoseShape shape = simulator.simulate(pose);
     if (shape.ok) {
       bake::DatasetPose p;
       p.id = uint32_t(i);
       p.pose = pose;
       p.gameMeshPreSkin = shape.gameMeshPreSkin;
-      // Skinned as the run time skins the prediction: the model's weights, the whole pose (root included).
-      p.gameMeshWorld =
-          skinPositions(shape.gameMeshPreSkin, model.gameMesh.skin, model.skeleton.skinningMatrices(pose));
-      if (truthMaps) p.normalMap = shape.normalMap;
+      p.gameMeshWorld = shape.gameMeshWorld;
+      p.normalMap = shape.normalMap;
       truths[i] = std::move(p);
     } else {
       failures[i] = shape.failure;

@@ -182,12 +182,22 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
 
 ModelTruth::~ModelTruth() = default;
 
+bake::PoseShape ModelTruth::simulate(const Pose& pose) const {
+  bake::PoseShape shape = simulator_->simulate(bake::canonicalPose(character_->skeleton, pose));
+  if (!shape.ok) return shape;
+  // Skinned as the run time skins the prediction: the model's skeleton and weights, the whole pose.
+  shape.gameMeshWorld =
+      skinPositions(shape.gameMeshPreSkin, model_->gameMesh.skin, model_->skeleton.skinningMatrices(pose));
+  if (!normalMaps_) shape.normalMap = bake::NormalMapImage{};
+  return shape;
+}
+
 TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions,
                                      const runtime::BlendedNormalMap* normalMap, const Points3f* without) const {
   const auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = threadCpuSeconds();
   TruthMeasurement m;
-  const bake::PoseShape shape = simulator_->simulate(bake::canonicalPose(character_->skeleton, pose));
+  const bake::PoseShape shape = simulate(pose);
   m.summary.limbCorrections = uint32_t(shape.corrections.size());
   if (!shape.ok) {
     m.summary.failure = shape.failure;
@@ -195,9 +205,7 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
     m.summary.failure = "the run time output has " + std::to_string(positions.rows()) + " vertices, the truth " +
                         std::to_string(shape.gameMeshPreSkin.rows());
   } else {
-    // Skinned as the run time skins the prediction: the model's skeleton and weights, the whole pose.
-    const Points3f truth =
-        skinPositions(shape.gameMeshPreSkin, model_->gameMesh.skin, model_->skeleton.skinningMatrices(pose));
+    const Points3f& truth = shape.gameMeshWorld;
     auto distances = [&](const Points3f& p) {
       std::vector<double> mm(size_t(truth.rows()));
       for (Eigen::Index v = 0; v < truth.rows(); ++v) {

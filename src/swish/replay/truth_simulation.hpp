@@ -100,6 +100,10 @@ class ModelTruth {
   const std::string& note() const { return note_; }
   bool normalMaps() const { return normalMaps_; }
 
+  // The truth of `pose` (on the model's skeleton, as the run time posed the character): the bake's
+  // PoseShape of it, with gameMeshWorld the truth's game mesh skinned as the run time skins (the model's
+  // weights, the whole pose) and normalMap empty unless normalMaps(). Thread-safe; only when available().
+  bake::PoseShape simulate(const Pose& pose) const;
   // Simulates `pose` (on the model's skeleton, as the run time posed the character) and measures the
   // run time's output of it: `positions` (character space) and `normalMap` (null: not measured);
   // `withoutPushOut` (optional): the same frame's positions without the push-out, measured beside them.
