@@ -15,12 +15,12 @@
 #include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/io/svg_plot.hpp"
+#include "swish/runtime/frame_evaluator.hpp"
 #include "swish/runtime/mlp_evaluator.hpp"
 #include "swish/runtime/nearest_code.hpp"
 #include "swish/runtime/novelty_guard.hpp"
 #include "swish/runtime/reference_pca.hpp"
 #include "swish/runtime/reference_skinning.hpp"
-#include "swish/runtime/temporal_filter.hpp"
 #include "swish/runtime/theta.hpp"
 
 namespace swish::bake {
@@ -75,14 +75,10 @@ QualityLadder measureLadder(const Model& model, const std::vector<const DatasetP
     search = std::make_unique<runtime::NearestCodeSearch>(model.normalMaps.keys);
     for (uint32_t m = 0; m < model.normalMaps.mapCount(); ++m) decoded.push_back(decodeVqMap(model.normalMaps, m));
   }
-  Points3f meanShape(Eigen::Index(n), 3);
-  for (size_t v = 0; v < n; ++v)
-    for (int a = 0; a < 3; ++a) meanShape(Eigen::Index(v), a) = model.meshPca.mean[Eigen::Index(3 * v + size_t(a))];
 
   std::vector<LevelErrors> acc(ladder.size());
   for (LevelErrors& e : acc) e.vertexMm.reserve(n * poses.size());
   std::vector<float> lambda(size_t(mlp.outputSize()));
-  std::vector<float> weights(static_cast<size_t>(K));
   for (const DatasetPose* p : poses) {
     const std::string pose = "quality levels: pose " + std::to_string(p->id);
     if (size_t(p->gameMeshWorld.rows()) != n)
@@ -110,14 +106,9 @@ QualityLadder measureLadder(const Model& model, const std::vector<const DatasetP
     std::optional<AngularErrorAccumulator> mapped, flat;
     for (size_t li = 0; li < ladder.size(); ++li) {
       const QualityLevel& l = ladder.levels[li];
-      Points3f shape;
-      if (l.meshComponents == 0) {
-        shape = meanShape;
-      } else {
-        std::fill(weights.begin(), weights.end(), 0.f);
-        std::copy_n(lambda.begin(), l.meshComponents, weights.begin());
-        shape = runtime::referencePcaReconstruct(model.meshPca, weights);
-      }
+      // The first k weights (k = 0: the mean shape; lambda is not read then, nor computed).
+      const Points3f shape = runtime::referencePcaReconstruct(
+          model.meshPca, std::span<const float>(lambda.data(), size_t(K)), l.meshComponents);
       const Points3f predicted = runtime::referenceSkin(shape, model.gameMesh.skin, mats);
       for (size_t v = 0; v < n; ++v)
         acc[li].vertexMm.push_back(
@@ -181,50 +172,37 @@ void timeLadderCpu(const Model& model, const std::vector<const Pose*>& poses, Qu
   if (poses.empty()) throw Error("quality levels: no pose to time the levels on");
   const uint32_t C = std::max<uint32_t>(1, options.characters);
   const uint32_t repeats = std::max<uint32_t>(1, options.repeats);
-  const runtime::MlpEvaluator mlp(model);
-  const runtime::NoveltyGuardEvaluator guard(model);
-  const size_t D = size_t(model.thetaSize()), K = size_t(model.meshComponents()), cd = size_t(mlp.normalCodeDims());
-  std::unique_ptr<runtime::NearestCodeSearch> search;
-  if (!model.normalMaps.empty()) search = std::make_unique<runtime::NearestCodeSearch>(model.normalMaps.keys);
-  std::vector<float> theta(C * D), weights(C * K), codes(C * cd), novelty(C);
-  std::vector<runtime::TemporalFilter> filters(C, runtime::TemporalFilter(model.temporalFilter.timeConstantSeconds));
-  std::vector<uint32_t> selected(C, 0);
-  std::vector<runtime::ThetaJointIssue> issues;
-  volatile uint32_t sink = 0;  // keeps the work from being optimised away
-  size_t next = 0;             // the poses in turn, batch after batch
-
-  // One batch of C characters at a level of this kind, as runtime::FrameEvaluator runs it.
-  const auto batch = [&](bool maps) {
-    for (uint32_t c = 0; c < C; ++c) {
-      const Pose& pose = *poses[next++ % poses.size()];
-      issues.clear();
-      runtime::computeTheta(model.inputJoints, pose.local, std::span<float>(theta.data() + c * D, D), &issues);
-    }
-    mlp.evaluateBatchSplit(theta, weights, codes, C);
-    if (guard.active()) {
-      guard.measure(theta, C, novelty);
-      for (uint32_t c = 0; c < C; ++c) guard.apply(novelty[c], std::span<float>(weights.data() + c * K, K));
-    }
-    if (maps && search) {
-      for (uint32_t c = 0; c < C; ++c)
-        selected[c] = search->find(std::span<const float>(codes.data() + c * cd, cd), selected[c]).index;
-      for (uint32_t c = 0; c < C; ++c) sink = sink + filters[c].step(1.f / 60.f, selected[c]).selectedMap;
-    }
-    sink = sink + uint32_t(weights[0] > 0.f);
+  // The run time's own CPU frame (runtime::FrameEvaluator) for C characters all at a level of each kind
+  // that runs anything: the network alone (every weight; the CPU work does not depend on k), and the
+  // network with the lookup and filter. The batches take the poses in turn, made before timing.
+  QualityLevel network;
+  network.meshComponents = uint32_t(model.meshComponents());
+  network.normalMaps = false;
+  QualityLevel mapped = network;
+  mapped.normalMaps = true;
+  const bool anyMaps = !model.normalMaps.empty() && std::any_of(ladder.levels.begin(), ladder.levels.end(),
+                                                                [](const QualityLevel& l) { return l.normalMaps; });
+  runtime::FrameEvaluator networkFrames(model, C), mappedFrames(model, C);
+  for (uint32_t c = 0; c < C; ++c)
+    networkFrames.setLevel(c, network), mappedFrames.setLevel(c, anyMaps ? mapped : network);
+  std::vector<std::vector<Pose>> batches(poses.size());
+  for (size_t b = 0; b < batches.size(); ++b)
+    for (uint32_t c = 0; c < C; ++c) batches[b].push_back(*poses[(b * C + c) % poses.size()]);
+  size_t next = 0;
+  const auto batch = [&](runtime::FrameEvaluator& frames) {
+    frames.evaluate(std::span<const Pose>(batches[next++ % batches.size()]), 1.f / 60.f);
   };
   using Clock = std::chrono::steady_clock;
-  // The two kinds of level that run anything, timed in alternation so that both see the same machine.
+  // The two kinds timed in alternation so that both see the same machine.
   std::vector<double> networkOnly, withMaps;
-  const bool anyMaps = search && std::any_of(ladder.levels.begin(), ladder.levels.end(),
-                                             [](const QualityLevel& l) { return l.normalMaps; });
-  for (uint32_t w = 0; w < options.warmup; ++w) batch(anyMaps);
+  for (uint32_t w = 0; w < options.warmup; ++w) batch(anyMaps ? mappedFrames : networkFrames);
   for (uint32_t r = 0; r < repeats; ++r) {
     auto t0 = Clock::now();
-    batch(false);
+    batch(networkFrames);
     networkOnly.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / C);
     if (anyMaps) {
       t0 = Clock::now();
-      batch(true);
+      batch(mappedFrames);
       withMaps.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / C);
     }
   }
@@ -236,8 +214,8 @@ void timeLadderCpu(const Model& model, const std::vector<const Pose*>& poses, Qu
   const double usNetwork = median(networkOnly), usMaps = median(withMaps);
   for (QualityLevel& l : ladder.levels)
     l.cpuUsPerCharacter = !l.needsNetwork() ? 0.0 : l.normalMaps ? usMaps : usNetwork;
-  ladder.timedOn = cpuDescription() + ", MLP kernel " + runtime::toString(mlp.kernel()) + ", batches of " +
-                   std::to_string(C) + " characters, median of " + std::to_string(repeats);
+  ladder.timedOn = cpuDescription() + ", MLP kernel " + runtime::toString(networkFrames.mlp().kernel()) +
+                   ", batches of " + std::to_string(C) + " characters, median of " + std::to_string(repeats);
 }
 
 std::vector<std::string> ladderProblems(const QualityLadder& ladder) {

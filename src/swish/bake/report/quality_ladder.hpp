@@ -15,10 +15,11 @@
 //           degrees, mean over every texel of every pose: with maps, the database map nearest the
 //           predicted code, VQ-decoded (the evaluation's "total"); without, the mesh's own normal, i.e.
 //           the flat tangent-space map (0, 0, 1). NaN when the poses carry no truth maps.
-// CPU time per character (timeLadderCpu): the run-time CPU work of a level for a batch of characters
-// all at that level, as runtime::FrameEvaluator does it: Theta + MLP batch + novelty guard when the
-// level needs the network, plus the nearest-code lookup and the temporal filter step when it has maps;
-// nothing for the mean shape skinned. The median over repetitions of the batch's time, divided by the
+// CPU time per character (timeLadderCpu): runtime::FrameEvaluator itself, timed on a batch of
+// characters all at a level of the kind: Theta + MLP batch + novelty guard when the level needs the
+// network, plus the nearest-code lookup and the temporal filter step when it has maps; 0 for the mean
+// shape skinned (the evaluator still converts its Theta and measures its novelty for the reports: that
+// small share is not counted). The median over repetitions of the batch's time, divided by the
 // batch size. The CPU work does not depend on k (the network always predicts every weight): levels of
 // the same kind are timed together. GPU time is not measured here (NaN).
 //
