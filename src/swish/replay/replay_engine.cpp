@@ -84,10 +84,10 @@ static std::vector<Points3f> levelPositions(Batch& B, uint32_t i) {
   in.instanceCount = 1;
   in.pushOut = B.inputs.pushOut;
   in.skinMatrices.assign(B.inputs.skinMatrices.begin() + i * jc, B.inputs.skinMatrices.begin() + (i + 1) * jc);
+  in.meshWeights.assign(o.meshWeights.begin(), o.meshWeights.begin() + k);
   std::vector<Points3f> out;
   for (const runtime::QualityLevel& l : B.ladder.levels) {
-    in.meshWeights.assign(o.meshWeights.begin(), o.meshWeights.begin() + k);
-    std::fill(in.meshWeights.begin() + l.meshComponents, in.meshWeights.end(), 0.f);
+    in.meshComponents = {l.meshComponents};  // the reference reads the first k weights only
     out.push_back(runtime::referencePositions(B.uploaded(), in, 0, in.pushOut));
   }
   return out;
@@ -123,6 +123,7 @@ struct ReplayEngine::Impl {
   // Quality levels: the planner over every on-screen character, in plan order (batch, instance).
   std::optional<runtime::LevelPlanner> levelPlanner;
   std::vector<std::pair<size_t, uint32_t>> levelSlots;
+  std::vector<Eigen::Vector3d> levelRoots;                     // per frame scratch: each slot's root in the world
   std::vector<std::vector<std::vector<double>>> levelTruthMm;  // [batch][level]: every vertex distance
   std::string levelCostsSource;
   std::vector<std::string> firstReasons;
@@ -139,7 +140,7 @@ struct ReplayEngine::Impl {
   void setUpLevels();
   void calibrateLevels();
   void calibrationFrame(Batch& B, const std::vector<Pose>& poses, uint32_t level);
-  void applyLevels(uint64_t frame, const std::vector<std::vector<Pose>>& poses, FrameRecord& rec);
+  void applyLevels(uint64_t frame, FrameRecord& rec);
   bool truthFrame(uint32_t index) const;
   FrameRecord runFrame(uint32_t index, ReplayResult& result);
   void measurePenetration(FrameRecord& rec);
@@ -356,15 +357,13 @@ void ReplayEngine::Impl::calibrateLevels() {
 
 // Plans this frame's levels from each on-screen character's root in the world and hands them to the
 // evaluators and the GPU inputs.
-void ReplayEngine::Impl::applyLevels(uint64_t frame, const std::vector<std::vector<Pose>>& poses, FrameRecord& rec) {
-  std::vector<Eigen::Vector3d> roots;
-  roots.reserve(levelSlots.size());
+void ReplayEngine::Impl::applyLevels(uint64_t frame, FrameRecord& rec) {
+  levelRoots.clear();
   for (const auto& [b, i] : levelSlots) {
     const runtime::SceneCharacter& ch = scene.characters[batches[b].planned->characters[i]];
-    const Pose& p = poses[b][i];
-    roots.push_back(ch.placement.apply(p.rootTranslation));
+    levelRoots.push_back(ch.placement.apply(batches[b].poses[i].rootTranslation));
   }
-  const runtime::PlannedLevels& planned = levelPlanner->plan(frame, roots);
+  const runtime::PlannedLevels& planned = levelPlanner->plan(frame, levelRoots);
   for (size_t s = 0; s < levelSlots.size(); ++s) {
     const auto& [b, i] = levelSlots[s];
     Batch& B = batches[b];
@@ -418,9 +417,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
   }
   {
     auto t0 = Clock::now();
-    std::vector<std::vector<Pose>> poses;
-    for (const Batch& B : batches) poses.push_back(B.poses);
-    applyLevels(rec.frame, poses, rec);
+    applyLevels(rec.frame, rec);
     t.pose += msSince(t0);
   }
 
