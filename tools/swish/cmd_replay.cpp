@@ -60,9 +60,7 @@ void printPlannedLevels(const swish::runtime::Scene& scene, swish::replay::Model
   std::vector<uint32_t> characters;
   ladders.reserve(plan.batches.size());
   for (const runtime::PlannedBatch& b : plan.batches) {
-    ladders.push_back(runtime::ladderOf(models.at(b.model).model));
-    if (!b.normalMaps)
-      for (runtime::QualityLevel& l : ladders.back().levels) l.normalMaps = false;
+    ladders.push_back(runtime::ladderOf(models.at(b.model).model, b.normalMaps));
   }
   runtime::LevelCosts costs;
   bool timed = true;
@@ -82,11 +80,7 @@ void printPlannedLevels(const swish::runtime::Scene& scene, swish::replay::Model
       costs.msPerCharacter.push_back(ms);
     }
   if (per.empty()) return;
-  runtime::LevelPlannerSettings ls;
-  ls.camera = scene.levelCamera();
-  ls.frameBudgetMs = o.frameBudgetMs ? o.frameBudgetMs : scene.levels.frameBudgetMs;
-  ls.tolerancePixels = o.tolerancePixels ? o.tolerancePixels : scene.levels.tolerancePixels;
-  ls.holdFrames = uint32_t(std::lround(scene.levels.holdSeconds * scene.framesPerSecond));
+  const runtime::LevelPlannerSettings ls = scene.levelPlannerSettings(o.frameBudgetMs, o.tolerancePixels);
   runtime::LevelPlanner planner(per, fixed, ls);
   if (timed) planner.setCosts(costs);
   const runtime::PlannedLevels& p = planner.plan(scene.firstFrame, roots);

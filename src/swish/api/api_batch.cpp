@@ -33,9 +33,7 @@ uint32_t retiredSlot(const BatchImpl& b, uint64_t frameIndex, uint32_t character
 
 void ensureLadder(BatchImpl& b) {
   if (!b.levels.empty()) return;
-  b.ladder = runtime::ladderOf(b.model->model);
-  if (!b.normalMaps)
-    for (runtime::QualityLevel& l : b.ladder.levels) l.normalMaps = false;
+  b.ladder = runtime::ladderOf(b.model->model, b.normalMaps);
   b.levels.assign(b.characters, 0);
   b.hostLevel.assign(b.characters, false);
 }

@@ -229,9 +229,7 @@ void ReplayEngine::Impl::setUpLevels() {
   std::vector<std::optional<uint32_t>> fixed;
   for (size_t b = 0; b < batches.size(); ++b) {
     Batch& B = batches[b];
-    B.ladder = runtime::ladderOf(*B.model);
-    if (!B.planned->normalMaps)  // the plan uploads no maps: levels keep their components, without maps
-      for (runtime::QualityLevel& l : B.ladder.levels) l.normalMaps = false;
+    B.ladder = runtime::ladderOf(*B.model, B.planned->normalMaps);
     B.levelOf.assign(B.planned->characters.size(), 0);
     if (options.truth.every > 0) {
       runtime::FrameEvaluatorOptions eo;
@@ -252,11 +250,7 @@ void ReplayEngine::Impl::setUpLevels() {
   }
   for (Batch& B : batches)
     for (size_t i = 0; i < B.planned->characters.size(); ++i) ladders.push_back(&B.ladder);
-  runtime::LevelPlannerSettings ls;
-  ls.camera = scene.levelCamera();
-  ls.frameBudgetMs = options.frameBudgetMs ? options.frameBudgetMs : scene.levels.frameBudgetMs;
-  ls.tolerancePixels = options.tolerancePixels ? options.tolerancePixels : scene.levels.tolerancePixels;
-  ls.holdFrames = uint32_t(std::lround(scene.levels.holdSeconds * scene.framesPerSecond));
+  const runtime::LevelPlannerSettings ls = scene.levelPlannerSettings(options.frameBudgetMs, options.tolerancePixels);
   levelPlanner.emplace(std::move(ladders), std::move(fixed), ls);
   levelTruthMm.resize(batches.size());
   for (size_t b = 0; b < batches.size(); ++b) levelTruthMm[b].resize(batches[b].ladder.size());

@@ -62,6 +62,13 @@ QualityLadder ladderOf(const Model& model) {
   return ladderFromJson(meta.at(kQualityLevelsKey), model, "model metadata quality_levels");
 }
 
+QualityLadder ladderOf(const Model& model, bool normalMaps) {
+  QualityLadder ladder = ladderOf(model);
+  if (!normalMaps)
+    for (QualityLevel& l : ladder.levels) l.normalMaps = false;
+  return ladder;
+}
+
 json toJson(const QualityLadder& ladder) {
   json levels = json::array();
   for (const QualityLevel& l : ladder.levels)

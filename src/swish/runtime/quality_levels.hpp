@@ -67,6 +67,9 @@ QualityLadder defaultLadder(const Model& model);
 // Error naming the level when a level asks for more components than K or for maps the model lacks),
 // else defaultLadder(model).
 QualityLadder ladderOf(const Model& model);
+// The same as run with the normal maps left out (normalMaps false: a plan or batch that uploads no
+// database): every level keeps its components and draws without maps.
+QualityLadder ladderOf(const Model& model, bool normalMaps);
 
 nlohmann::json toJson(const QualityLadder& ladder);
 // Throws Error naming `what` and the field on a malformed ladder (missing keys, wrong types, k > K,

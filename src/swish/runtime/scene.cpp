@@ -36,6 +36,16 @@ LevelCamera Scene::levelCamera() const {
   return c;
 }
 
+LevelPlannerSettings Scene::levelPlannerSettings(std::optional<double> frameBudgetMs,
+                                                 std::optional<double> tolerancePixels) const {
+  LevelPlannerSettings s;
+  s.camera = levelCamera();
+  s.frameBudgetMs = frameBudgetMs ? frameBudgetMs : levels.frameBudgetMs;
+  s.tolerancePixels = tolerancePixels ? tolerancePixels : levels.tolerancePixels;
+  s.holdFrames = uint32_t(std::lround(levels.holdSeconds * framesPerSecond));
+  return s;
+}
+
 void Scene::validate() const {
   const std::string where = source.empty() ? std::string("scene") : source.string();
   auto fail = [&](const std::string& path, const std::string& problem) {

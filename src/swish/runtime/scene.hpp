@@ -99,6 +99,10 @@ struct Scene {
   bool onScreen(size_t c) const;
   // The camera as the level planner sees it (cameraTarget or its default filled in).
   LevelCamera levelCamera() const;
+  // The level planner's settings from the scene: its camera, its "levels" (a budget or tolerance given
+  // here, e.g. on the command line, replaces the scene's) and the hold in frames.
+  LevelPlannerSettings levelPlannerSettings(std::optional<double> frameBudgetMs = std::nullopt,
+                                            std::optional<double> tolerancePixels = std::nullopt) const;
   // Checks values (counts, ranges, names) and throws Error naming the scene and the field. Does not
   // touch files: scene_file.cpp checks those.
   void validate() const;

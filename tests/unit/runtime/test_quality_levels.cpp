@@ -55,6 +55,12 @@ TEST(QualityLadder, DefaultGoesFromFullToTheMeanShapeSkinned) {
   EXPECT_EQ(l[4].name, "skinned");
   EXPECT_FALSE(l[4].needsNetwork());
   EXPECT_FALSE(l.measured());
+  const QualityLadder noMaps = ladderOf(m, false);  // as run without the database: same components, no maps
+  ASSERT_EQ(noMaps.size(), l.size());
+  for (size_t i = 0; i < l.size(); ++i) {
+    EXPECT_EQ(noMaps[i].meshComponents, l[i].meshComponents);
+    EXPECT_FALSE(noMaps[i].normalMaps);
+  }
   // Small K and no maps: no level repeats another.
   const QualityLadder small = defaultLadder(modelWith(3, 0));
   ASSERT_EQ(small.size(), 3u);  // 3, 3/2 = 1, then 3/4 = 3/8 = 0 once

@@ -212,6 +212,11 @@ TEST_F(SceneFileTest, CameraLevelsAndAFixedLevel) {
   EXPECT_DOUBLE_EQ(s.levels.holdSeconds, 2.0);
   EXPECT_EQ(s.characters[0].level, "k64");
   EXPECT_EQ(s.characters[1].level, "3");
+  const auto settings = s.levelPlannerSettings();
+  EXPECT_DOUBLE_EQ(*settings.frameBudgetMs, 6.5);
+  EXPECT_EQ(settings.holdFrames, 48u);                                // 2 s at 24 fps
+  EXPECT_DOUBLE_EQ(*s.levelPlannerSettings(3.0).frameBudgetMs, 3.0);  // a budget given here replaces the scene's
+  EXPECT_DOUBLE_EQ(*s.levelPlannerSettings(3.0).tolerancePixels, 0.5);
   const auto cam = s.levelCamera();
   EXPECT_DOUBLE_EQ(cam.verticalFovDegrees, 40.0);
   EXPECT_DOUBLE_EQ(cam.target.y(), 1.0);
