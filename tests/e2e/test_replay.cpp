@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <optional>
 
 #include "support/error_message.hpp"
@@ -19,12 +20,13 @@
 #include "support/random_model.hpp"
 #include "support/temp_dir.hpp"
 #include "swish/core/error.hpp"
+#include "swish/gpu/allocation_plan.hpp"
 #include "swish/gpu/frame_recorder.hpp"
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/replay/replay_job.hpp"
+#include "swish/replay/replay_plan.hpp"
 #include "swish/replay/report_writer.hpp"
-#include "swish/runtime/planner.hpp"
 #include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
 
@@ -336,7 +338,7 @@ TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
   json lean = full;
   lean["outputs"]["render"] = false;
   lean["outputs"]["meshes"] = true;
-  auto positions = [&](const runtime::Scene& s, runtime::ReplayPlan* plan) {
+  auto positions = [&](const runtime::Scene& s, replay::ReplayPlan* plan) {
     replay::ModelLibrary lib(s);
     replay::ReplayOptions o;
     o.context = &ctx();
@@ -352,7 +354,7 @@ TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
     for (const auto& f : r.frames) EXPECT_LE(f.gpuDispatches, plan->gpuDispatchesPerFrame()) << f.frame;
     return out;
   };
-  runtime::ReplayPlan pFull, pLean;
+  replay::ReplayPlan pFull, pLean;
   const auto a = positions(scene(full), &pFull);
   const auto b = positions(scene(lean), &pLean);
   EXPECT_EQ(pFull.gpuDispatchesPerFrame(), 5u);
@@ -362,39 +364,68 @@ TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.f) << i;
 }
 
+// The plan's memory is what the GPU side allocates, buffer by buffer (name and bytes): the planner
+// asks gpu::modelAllocations / frameAllocations, and GpuModel / FrameResources size their buffers
+// with the same code. A body proxy adds the posed capsules (the mirror the planner once kept missed them).
 TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
-  for (bool maps : {true, false}) {
+  struct Case {
+    bool maps, proxy;
+  };
+  for (const Case k : {Case{true, false}, Case{false, false}, Case{true, true}, Case{false, true}}) {
+    SCOPED_TRACE("maps " + std::to_string(k.maps) + ", proxy " + std::to_string(k.proxy));
     Model m = model_;
-    if (!maps) m.normalMaps = NormalMapDatabase{};
+    if (!k.maps) m.normalMaps = NormalMapDatabase{};
+    if (!k.proxy)
+      m.bodyProxy = BodyProxy{};
+    else if (m.bodyProxy.empty())
+      m.bodyProxy.capsules = {{0, Vec3f::Zero(), Vec3f(0.f, 0.5f, 0.f), 0.1f},
+                              {0, Vec3f::Zero(), Vec3f::Zero(), 0.05f}};
     gpu::GpuModel g(ctx(), m, "m");
     gpu::FrameRecorderOptions ro;
     ro.framesInFlight = 1;
-    ro.normalMaps = ro.tangentFrames = maps;
+    ro.normalMaps = ro.tangentFrames = k.maps;
     gpu::FrameRecorder rec(ctx(), g, 3, ro);
-    uint64_t model = 0, frame = 0;
-    for (const gpu::Buffer* b :
-         {&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets, &g.normalTriangles,
-          &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook, &g.indices})
-      model += b->size();
+    // What was allocated: name (without its "<owner>: " prefix) -> bytes.
+    auto allocated = [](std::initializer_list<const gpu::Buffer*> buffers, const std::string& prefix) {
+      std::map<std::string, uint64_t> out;
+      for (const gpu::Buffer* b : buffers) {
+        if (!b->handle()) continue;  // not allocated (no maps, no proxy, or texels shared with the images)
+        EXPECT_EQ(b->name().rfind(prefix, 0), 0u) << b->name();
+        out[b->name().substr(prefix.size())] = b->size();
+      }
+      return out;
+    };
+    auto planned = [](const std::vector<gpu::Allocation>& list, bool images) {
+      std::map<std::string, uint64_t> out;
+      for (const auto& a : list)
+        if (a.image == images) out[a.name] = a.bytes;
+      return out;
+    };
+    EXPECT_EQ(allocated({&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets,
+                         &g.normalTriangles, &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook,
+                         &g.indices},
+                        "m: "),
+              planned(gpu::modelAllocations(m, k.maps), false));
     const auto& f = rec.frame(0);
-    for (const gpu::Buffer* b :
-         {&f.meshWeights, &f.instanceOrder, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters, &f.positions,
-          &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels})
-      frame += b->handle() ? b->size() : 0;  // blendedTexels: none where the images share its memory
-    frame += uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4;
     // Shared texels need a device that samples linear 2D arrays (and lays them out tightly): lavapipe does.
-    const bool shared = maps && f.normalMaps.sharesTexels();
+    const bool shared = k.maps && f.normalMaps.sharesTexels();
     if (shared) {
       EXPECT_TRUE(gpu::NormalMapImages::deviceSupportsLinear(ctx(), f.normalMaps.width(), f.normalMaps.height(), 3));
     }
-    if (maps && ctx().deviceName().find("llvmpipe") != std::string::npos) {
+    if (k.maps && ctx().deviceName().find("llvmpipe") != std::string::npos) {
       EXPECT_TRUE(shared);
     }
-    uint64_t plannedModel = 0, plannedFrame = 0;
-    for (const auto& a : runtime::modelAllocations(model_, "m", maps)) plannedModel += a.bytes;
-    for (const auto& a : runtime::frameAllocations(model_, "m", 3, maps, maps, shared)) plannedFrame += a.bytes;
-    EXPECT_EQ(plannedModel, model) << "maps " << maps;
-    EXPECT_EQ(plannedFrame, frame) << "maps " << maps;
+    const auto plan = gpu::frameAllocations(m, 3, k.maps, k.maps, shared);
+    EXPECT_EQ(allocated({&f.meshWeights, &f.instanceOrder, &f.skinMatrices, &f.posedCapsules, &f.decodeSlotMaps,
+                         &f.blendCharacters, &f.positions, &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps,
+                         &f.blendedTexels},
+                        "m frame 0: "),
+              planned(plan, false));
+    uint64_t imageBytes = 0;
+    for (const auto& [name, bytes] : planned(plan, true)) imageBytes += bytes;
+    EXPECT_EQ(imageBytes,
+              k.maps ? uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4 : 0u);
+    EXPECT_EQ(planned(plan, false).count("posed capsules"), k.proxy ? 1u : 0u);
   }
 }
 

@@ -26,9 +26,9 @@
 #include "swish/core/error.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/replay/replay_job.hpp"
+#include "swish/replay/replay_plan.hpp"
 #include "swish/replay/replay_render.hpp"
 #include "swish/runtime/level_planner.hpp"
-#include "swish/runtime/planner.hpp"
 #include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
 
@@ -51,7 +51,7 @@ struct ReplayCliOptions {
 // root motion is not read without a replay); the budget needs costs, which only a replay calibrates, or
 // a ladder whose GPU times were measured.
 void printPlannedLevels(const swish::runtime::Scene& scene, swish::replay::ModelLibrary& models,
-                        const swish::runtime::ReplayPlan& plan, const ReplayCliOptions& o) {
+                        const swish::replay::ReplayPlan& plan, const ReplayCliOptions& o) {
   using namespace swish;
   std::vector<runtime::QualityLadder> ladders;
   std::vector<const runtime::QualityLadder*> per;
@@ -59,7 +59,7 @@ void printPlannedLevels(const swish::runtime::Scene& scene, swish::replay::Model
   std::vector<Eigen::Vector3d> roots;
   std::vector<uint32_t> characters;
   ladders.reserve(plan.batches.size());
-  for (const runtime::PlannedBatch& b : plan.batches) {
+  for (const replay::PlannedBatch& b : plan.batches) {
     ladders.push_back(runtime::ladderOf(models.at(b.model).model, b.normalMaps));
   }
   runtime::LevelCosts costs;
@@ -126,7 +126,7 @@ int runReplay(const ReplayCliOptions& o) {
   replay::ModelLibrary models(scene);  // loaded once: plan, replay and render share it
 
   if (o.plan) {
-    const runtime::ReplayPlan plan = runtime::planReplay(scene, models.modelMap());
+    const replay::ReplayPlan plan = replay::planReplay(scene, models.modelMap());
     std::printf("Scene '%s' (%s): %zu characters, frames %u..%u at %g fps\n", scene.name.c_str(),
                 scene.source.string().c_str(), scene.characters.size(), scene.firstFrame,
                 scene.firstFrame + scene.frameCount - 1, scene.framesPerSecond);

@@ -4,6 +4,7 @@
 
 #include "swish/core/error.hpp"
 #include "swish/core/mesh_frames.hpp"
+#include "swish/gpu/allocation_plan.hpp"
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/tangent_frames_pass.hpp"
 
@@ -11,18 +12,78 @@ namespace swish::gpu {
 
 namespace {
 
-template <class T>
-Buffer uploaded(Context& ctx, const std::string& name, const T* data, size_t count) {
-  Buffer b(ctx, count * sizeof(T), MemoryKind::DeviceLocal, name);
-  b.upload(ctx, data, count * sizeof(T));
-  return b;
-}
-template <class T>
-Buffer uploaded(Context& ctx, const std::string& name, const std::vector<T>& v) {
-  return uploaded(ctx, name, v.data(), v.size());
-}
+// Everything GpuModel uploads, in upload order: the buffer each goes to, its name and its bytes. The
+// constructor uploads these and modelAllocations() lists them, so the two cannot disagree. The arrays
+// the model does not hold as they go up (the frame topology, 32-bit joints, padded VQ data) live here.
+struct ModelUploads {
+  struct Upload {
+    Buffer GpuModel::*target;
+    const char* name;
+    const void* data;  // nullptr: allocated, nothing uploaded (the 8-byte stand-in for missing UVs)
+    VkDeviceSize bytes;
+  };
+  std::vector<Upload> list;
+
+  std::vector<float> zeroBasis;  // K = 0: one column of zeros, so the kernel has a column to read
+  std::vector<uint32_t> joints;
+  MeshFrameTopology topo;
+  std::vector<uint32_t> frameTriangles;
+  std::vector<int8_t> codebook;
+  std::vector<uint16_t> indices;
+
+  ModelUploads(const Model& m, bool withNormalMaps) {
+    const Mesh& g = m.gameMesh;
+    const size_t n = g.vertexCount();
+    auto add = [&](Buffer GpuModel::*target, const char* name, const void* data, size_t bytes) {
+      list.push_back({target, name, data, VkDeviceSize(bytes)});
+    };
+    add(&GpuModel::mean, "PCA mean", m.meshPca.mean.data(), 3 * n * 4);
+    if (m.meshPca.components() == 0) {
+      zeroBasis.assign(3 * n, 0.f);
+      add(&GpuModel::basis, "PCA basis", zeroBasis.data(), zeroBasis.size() * 4);
+    } else {  // column-major = [k][3N]
+      add(&GpuModel::basis, "PCA basis", m.meshPca.basis.data(), size_t(m.meshPca.basis.size()) * 4);
+    }
+    joints.assign(g.skin.joints.begin(), g.skin.joints.end());
+    add(&GpuModel::skinJoints, "skin joints", joints.data(), joints.size() * 4);
+    add(&GpuModel::skinWeights, "skin weights", g.skin.weights.data(), g.skin.weights.size() * 4);
+    if (size_t(g.uvs.rows()) == n)
+      add(&GpuModel::uvs, "UVs", g.uvs.data(), 2 * n * 4);
+    else
+      add(&GpuModel::uvs, "UVs (none)", nullptr, 8);
+    add(&GpuModel::triangles, "triangles", g.triangles.data(), size_t(g.triangles.size()) * 4);
+    topo = buildFrameTopology(g.triangles, g.positions);
+    frameTriangles = TangentFramesPass::frameTriangles(topo);
+    add(&GpuModel::normalOffsets, "normal adjacency offsets", topo.normalAdjacency.offsets.data(),
+        topo.normalAdjacency.offsets.size() * 4);
+    add(&GpuModel::normalTriangles, "normal adjacency", topo.normalAdjacency.triangles.data(),
+        topo.normalAdjacency.triangles.size() * 4);
+    add(&GpuModel::tangentOffsets, "tangent adjacency offsets", topo.tangentAdjacency.offsets.data(),
+        topo.tangentAdjacency.offsets.size() * 4);
+    add(&GpuModel::tangentTriangles, "tangent adjacency", topo.tangentAdjacency.triangles.data(),
+        topo.tangentAdjacency.triangles.size() * 4);
+    add(&GpuModel::frameTriangles, "flagged adjacency", frameTriangles.data(), frameTriangles.size() * 4);
+    const NormalMapDatabase& db = m.normalMaps;
+    if (withNormalMaps && !db.empty()) {
+      // Padded to whole 32-bit words: the kernel reads words.
+      codebook.assign(db.codebook.begin(), db.codebook.end());
+      codebook.resize((codebook.size() + 3) / 4 * 4, 0);
+      add(&GpuModel::codebook, "VQ codebook", codebook.data(), codebook.size());
+      indices.assign(db.indices.begin(), db.indices.end());
+      indices.resize((indices.size() + 1) / 2 * 2, 0);
+      add(&GpuModel::indices, "VQ indices", indices.data(), indices.size() * 2);
+    }
+  }
+};
 
 }  // namespace
+
+std::vector<Allocation> modelAllocations(const Model& model, bool withNormalMaps) {
+  const ModelUploads uploads(model, withNormalMaps);
+  std::vector<Allocation> out;
+  for (const auto& u : uploads.list) out.push_back({u.name, u.bytes == 0 ? 4 : u.bytes, false});
+  return out;
+}
 
 GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name_(name), bodyProxy_(m.bodyProxy) {
   const Mesh& g = m.gameMesh;
@@ -51,30 +112,6 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
         fail("triangle " + std::to_string(t) + " refers to vertex " + std::to_string(g.triangles(t, k)));
   hasUvs_ = size_t(g.uvs.rows()) == n;
 
-  mean = uploaded(ctx, name + ": PCA mean", m.meshPca.mean.data(), 3 * n);
-  if (meshComponents_ == 0) {
-    const std::vector<float> zero(3 * n, 0.f);
-    basis = uploaded(ctx, name + ": PCA basis", zero);
-  } else {
-    basis = uploaded(ctx, name + ": PCA basis", m.meshPca.basis.data(),
-                     size_t(m.meshPca.basis.size()));  // column-major = [k][3N]
-  }
-  const std::vector<uint32_t> joints(g.skin.joints.begin(), g.skin.joints.end());
-  skinJoints = uploaded(ctx, name + ": skin joints", joints);
-  skinWeights = uploaded(ctx, name + ": skin weights", g.skin.weights);
-  if (hasUvs_)
-    uvs = uploaded(ctx, name + ": UVs", g.uvs.data(), 2 * n);
-  else
-    uvs = Buffer(ctx, 8, MemoryKind::DeviceLocal, name + ": UVs (none)");
-  triangles = uploaded(ctx, name + ": triangles", g.triangles.data(), size_t(g.triangles.size()));
-
-  const MeshFrameTopology topo = buildFrameTopology(g.triangles, g.positions);
-  normalOffsets = uploaded(ctx, name + ": normal adjacency offsets", topo.normalAdjacency.offsets);
-  normalTriangles = uploaded(ctx, name + ": normal adjacency", topo.normalAdjacency.triangles);
-  tangentOffsets = uploaded(ctx, name + ": tangent adjacency offsets", topo.tangentAdjacency.offsets);
-  tangentTriangles = uploaded(ctx, name + ": tangent adjacency", topo.tangentAdjacency.triangles);
-  frameTriangles = uploaded(ctx, name + ": flagged adjacency", TangentFramesPass::frameTriangles(topo));
-
   const NormalMapDatabase& db = m.normalMaps;
   if (!db.empty()) {
     if (db.width == 0 || db.height == 0 || db.width % 4 || db.height % 4)
@@ -87,13 +124,13 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
     mapWidth_ = db.width;
     mapHeight_ = db.height;
     codebookSize_ = db.codebookSize;
-    // Padded to whole 32-bit words: the kernel reads words.
-    std::vector<int8_t> cb(db.codebook);
-    cb.resize((cb.size() + 3) / 4 * 4, 0);
-    codebook = uploaded(ctx, name + ": VQ codebook", cb);
-    std::vector<uint16_t> idx(db.indices);
-    idx.resize((idx.size() + 1) / 2 * 2, 0);
-    indices = uploaded(ctx, name + ": VQ indices", idx);
+  }
+
+  const ModelUploads uploads(m, true);
+  for (const auto& u : uploads.list) {
+    Buffer& b = this->*u.target;
+    b = Buffer(ctx, u.bytes, MemoryKind::DeviceLocal, name + ": " + u.name);
+    if (u.data) b.upload(ctx, u.data, u.bytes);
   }
 }
 

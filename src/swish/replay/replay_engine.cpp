@@ -50,7 +50,7 @@ int FrameRecord::maxMapErrorSteps() const {
 
 // One model's batch: its CPU evaluators, per-character motion and filter state, and its GPU side.
 struct Batch {
-  const runtime::PlannedBatch* planned = nullptr;
+  const PlannedBatch* planned = nullptr;
   const Model* model = nullptr;
   std::optional<Model> withoutMaps;  // a copy without the database, only when the plan leaves maps out
   const Model& uploaded() const { return withoutMaps ? *withoutMaps : *model; }  // the model on the GPU
@@ -111,7 +111,7 @@ struct ReplayEngine::Impl {
   const runtime::Scene& scene;
   ModelLibrary& models;
   ReplayOptions options;
-  runtime::ReplayPlan plan;
+  ReplayPlan plan;
   std::optional<gpu::Context> ownContext;
   gpu::Context* ctx = nullptr;
   std::vector<Batch> batches;
@@ -149,7 +149,7 @@ struct ReplayEngine::Impl {
 
 void ReplayEngine::Impl::setUp() {
   const std::string where = scene.source.empty() ? std::string("scene") : scene.source.string();
-  plan = runtime::planReplay(scene, models.modelMap());
+  plan = planReplay(scene, models.modelMap());
   batches.resize(plan.batches.size());
   for (size_t b = 0; b < plan.batches.size(); ++b) {
     Batch& B = batches[b];
@@ -217,9 +217,9 @@ void ReplayEngine::Impl::setUp() {
   const auto withMaps =
       std::find_if(batches.begin(), batches.end(), [](const Batch& B) { return B.planned->normalMaps; });
   if (withMaps != batches.end() && withMaps->recorder->frame(0).normalMaps.sharesTexels()) {
-    runtime::PlannerOptions po;
+    PlannerOptions po;
     po.normalMapsShareTexels = true;
-    plan.allocations = runtime::planReplay(scene, models.modelMap(), po).allocations;
+    plan.allocations = planReplay(scene, models.modelMap(), po).allocations;
   }
 }
 
@@ -617,7 +617,7 @@ ReplayEngine::ReplayEngine(const runtime::Scene& scene, ModelLibrary& models, co
 
 ReplayEngine::~ReplayEngine() = default;
 
-const runtime::ReplayPlan& ReplayEngine::plan() const { return impl_->plan; }
+const ReplayPlan& ReplayEngine::plan() const { return impl_->plan; }
 
 ReplayResult ReplayEngine::run() {
   Impl& I = *impl_;

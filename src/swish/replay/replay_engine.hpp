@@ -32,9 +32,9 @@
 #include "swish/gpu/context.hpp"
 #include "swish/replay/character_motion.hpp"
 #include "swish/replay/model_library.hpp"
+#include "swish/replay/replay_plan.hpp"
 #include "swish/replay/truth_simulation.hpp"
 #include "swish/runtime/level_planner.hpp"
-#include "swish/runtime/planner.hpp"
 #include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/reference_frame.hpp"
 #include "swish/runtime/scene.hpp"
@@ -147,7 +147,7 @@ inline constexpr double kPositionToleranceMm = 0.05, kFrameToleranceDeg = 0.5;
 inline constexpr int kMapToleranceSteps = 2;
 
 struct ReplayResult {
-  runtime::ReplayPlan plan;
+  ReplayPlan plan;
   std::string device;
   std::vector<FrameRecord> frames;
   std::vector<PoseIssue> issues;  // the first kMaxIssues
@@ -191,7 +191,7 @@ class ReplayEngine {
   ReplayEngine(const ReplayEngine&) = delete;
   ReplayEngine& operator=(const ReplayEngine&) = delete;
 
-  const runtime::ReplayPlan& plan() const;
+  const ReplayPlan& plan() const;
   // Runs every frame of the scene.
   ReplayResult run();
 

@@ -1,18 +1,18 @@
 // The replay planner leaves out what a scene does not need, and the plan really shrinks: fewer GPU
-// dispatches, less memory, fewer joints converted to 6D. Its memory figures mirror the GPU allocations
-// (checked against real GpuModel/FrameResources in tests/e2e/test_replay.cpp).
+// dispatches, less memory, fewer joints converted to 6D. Its memory figures are the GPU side's own
+// (gpu/allocation_plan.hpp; checked against real GpuModel/FrameResources in tests/e2e/test_replay.cpp).
 #include <gtest/gtest.h>
 
 #include "support/random_model.hpp"
 #include "swish/core/error.hpp"
-#include "swish/runtime/planner.hpp"
+#include "swish/replay/replay_plan.hpp"
 
 namespace {
 
 using namespace swish;
-using runtime::PlannerOptions;
-using runtime::planReplay;
-using runtime::ReplayPlan;
+using replay::PlannerOptions;
+using replay::planReplay;
+using replay::ReplayPlan;
 using runtime::Scene;
 
 struct Fixture {

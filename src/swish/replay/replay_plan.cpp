@@ -1,17 +1,15 @@
-#include "swish/runtime/planner.hpp"
+#include "swish/replay/replay_plan.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
 
 #include "swish/core/error.hpp"
-#include "swish/core/mesh_frames.hpp"
+#include "swish/gpu/allocation_plan.hpp"
 
-namespace swish::runtime {
+namespace swish::replay {
 
 namespace {
-
-uint64_t bufferBytes(uint64_t bytes) { return bytes == 0 ? 4 : bytes; }  // gpu::Buffer's rounding
 
 std::string humanBytes(uint64_t b) {
   char s[64];
@@ -33,73 +31,11 @@ std::string joinNames(const std::vector<std::string>& names, size_t max = 8) {
 
 }  // namespace
 
-std::vector<PlannedAllocation> modelAllocations(const Model& m, const std::string& owner, bool withMaps) {
-  const uint64_t n = m.gameMesh.vertexCount(), k = uint64_t(m.meshComponents()),
-                 infl = uint64_t(m.gameMesh.skin.influences);
-  const MeshFrameTopology topo = buildFrameTopology(m.gameMesh.triangles, m.gameMesh.positions);
-  std::vector<PlannedAllocation> a;
-  auto add = [&](const char* name, uint64_t bytes) { a.push_back({owner, name, bufferBytes(bytes), false}); };
-  add("PCA mean", 3 * n * 4);
-  add("PCA basis", 3 * n * std::max<uint64_t>(k, 1) * 4);
-  add("skin joints", n * infl * 4);
-  add("skin weights", n * infl * 4);
-  add("UVs", uint64_t(m.gameMesh.uvs.rows()) == n ? 2 * n * 4 : 8);
-  add("triangles", uint64_t(m.gameMesh.triangles.size()) * 4);
-  add("normal adjacency offsets", topo.normalAdjacency.offsets.size() * 4);
-  add("normal adjacency", topo.normalAdjacency.triangles.size() * 4);
-  add("tangent adjacency offsets", topo.tangentAdjacency.offsets.size() * 4);
-  add("tangent adjacency", topo.tangentAdjacency.triangles.size() * 4);
-  // gpu::TangentFramesPass::frameTriangles: the welded adjacency with each vertex's own triangles flagged.
-  add("flagged adjacency", topo.normalAdjacency.triangles.size() * 4);
-  if (withMaps && !m.normalMaps.empty()) {
-    add("VQ codebook", (m.normalMaps.codebook.size() + 3) / 4 * 4);
-    add("VQ indices", (m.normalMaps.indices.size() + 1) / 2 * 2 * 2);
-  }
-  return a;
-}
-
-std::vector<PlannedAllocation> frameAllocations(const Model& m, const std::string& owner, uint32_t instances,
-                                                bool frames, bool maps, bool normalMapsShareTexels) {
-  const uint64_t n = m.gameMesh.vertexCount(), c = std::max(1u, instances);
-  // The deform kernel reads the mesh weights as vec4 texels: K (at least 1) padded to a multiple of 4.
-  const uint64_t kk = (std::max<uint64_t>(uint64_t(m.meshComponents()), 1) + 3) / 4 * 4, j = m.skeleton.size();
-  std::vector<PlannedAllocation> a;
-  auto add = [&](const char* name, uint64_t bytes, bool image = false) {
-    a.push_back({owner, name, bufferBytes(bytes), image});
-  };
-  add("mesh weights", c * kk * 4);
-  add("instance order", c * 4);      // the deform's instances by quality band
-  add("skin matrices", c * j * 48);  // the top three rows of each affine matrix
-  add("positions", c * n * 12);
-  if (frames) {
-    add("normals", c * n * 12);
-    add("tangents", c * n * 16);
-    // The two-pass tangent frames' per-triangle terms: 9 floats a triangle, each instance's padded to
-    // a multiple of 4 (SWISH_TERMS_INSTANCE_FLOATS in shaders/swish_triangle_frames_layout.h), 16 B at least.
-    const uint64_t t = uint64_t(m.gameMesh.triangleCount());
-    add("triangle terms", std::max<uint64_t>(16, (t * 9 + 3) / 4 * 4 * 4 * c));
-  }
-  if (maps) {
-    const uint64_t texels = uint64_t(m.normalMaps.width) * m.normalMaps.height;
-    add("decode jobs", c * 8);        // map + slot of each map decoded
-    add("blend characters", c * 12);  // slot + alpha, then the layer of each
-    add("decoded maps", c * texels * 2);
-    if (normalMapsShareTexels) {
-      add("normal maps (RG16 snorm array, linear: the blend's output)", c * texels * 4, true);
-    } else {
-      // The blend's output (snorm16 x2), copied into the images; not allocated where the device lays
-      // the images over it (PlannerOptions::normalMapsShareTexels).
-      add("blended normal maps (none where the images share them)", c * texels * 4);
-      add("normal maps (RG16 snorm array)", c * texels * 4, true);
-    }
-  }
-  return a;
-}
-
-ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Model*>& models, const PlannerOptions& o) {
+ReplayPlan planReplay(const runtime::Scene& scene, const std::map<std::string, const Model*>& models,
+                      const PlannerOptions& o) {
   const std::string where = scene.source.empty() ? std::string("scene") : scene.source.string();
   ReplayPlan plan;
-  const SceneOutputs& out = scene.outputs;
+  const runtime::SceneOutputs& out = scene.outputs;
   const bool wantMeshes = !o.leaveOut || out.render || out.meshes || out.normalMaps;
   const bool wantShading = !o.leaveOut || out.render || out.normalMaps;
   plan.gpuWork = wantMeshes;
@@ -108,7 +44,7 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
   std::vector<std::string> order;
   std::map<std::string, std::vector<uint32_t>> onScreen;
   for (uint32_t c = 0; c < scene.characters.size(); ++c) {
-    const SceneCharacter& ch = scene.characters[c];
+    const runtime::SceneCharacter& ch = scene.characters[c];
     if (!models.count(ch.model) || !models.at(ch.model))
       throw Error(where + ": characters[" + std::to_string(c) + "].model: '" + ch.model + "' was not loaded");
     if (o.leaveOut && !scene.onScreen(c)) {
@@ -159,11 +95,12 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
                                    ", none on a frame whose maps earlier frames decoded"});
         plan.stages.push_back({"normal-map blend", "GPU", key, 1, inst * texels, std::to_string(inst) + " maps"});
       }
-      for (const auto& a : modelAllocations(m, key, b.normalMaps)) plan.allocations.push_back(a);
+      for (const gpu::Allocation& a : gpu::modelAllocations(m, b.normalMaps))
+        plan.allocations.push_back({key, a.name, a.bytes, a.image});
       for (uint32_t s = 0; s < o.framesInFlight; ++s)
-        for (const auto& a : frameAllocations(m, key + " frame " + std::to_string(s), uint32_t(inst), b.tangentFrames,
-                                              b.normalMaps, o.normalMapsShareTexels))
-          plan.allocations.push_back(a);
+        for (const gpu::Allocation& a :
+             gpu::frameAllocations(m, uint32_t(inst), b.tangentFrames, b.normalMaps, o.normalMapsShareTexels))
+          plan.allocations.push_back({key + " frame " + std::to_string(s), a.name, a.bytes, a.image});
     }
 
     if (!o.leaveOut) {
@@ -191,8 +128,8 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
                                   std::to_string(m.normalMaps.mapCount()) + " maps)"});
     if (wantMeshes && !b.normalMaps && !m.normalMaps.empty()) {
       uint64_t saved = 0;  // what the database would cost on the GPU
-      for (const auto& a : modelAllocations(m, key, true)) saved += a.bytes;
-      for (const auto& a : modelAllocations(m, key, false)) saved -= a.bytes;
+      for (const gpu::Allocation& a : gpu::modelAllocations(m, true)) saved += a.bytes;
+      for (const gpu::Allocation& a : gpu::modelAllocations(m, false)) saved -= a.bytes;
       plan.leftOut.push_back({key + ": normal-map lookup, VQ decode and blend; database not uploaded (" +
                                   humanBytes(saved) + ") and no per-character normal maps",
                               "no output wants normal maps (outputs.render and outputs.normalMaps are off)"});
@@ -208,7 +145,7 @@ ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Mode
     plan.leftOut.push_back({"every GPU pass (deform, normals + tangents, normal maps)",
                             "no output wants meshes (outputs.render, outputs.meshes and outputs.normalMaps are off)"});
   for (uint32_t c : plan.offScreen) {
-    const SceneCharacter& ch = scene.characters[c];
+    const runtime::SceneCharacter& ch = scene.characters[c];
     const std::string why = !ch.visible ? std::string("marked off screen (visible: false)")
                                         : "placed " + std::to_string((ch.placement.translation - scene.camera).norm()) +
                                               " m from the camera, beyond cullDistance " +
@@ -301,4 +238,4 @@ nlohmann::json ReplayPlan::toJson() const {
   return j;
 }
 
-}  // namespace swish::runtime
+}  // namespace swish::replay

@@ -1,8 +1,8 @@
 #pragma once
 // The replay planner: from a scene and its outputs, the work of one frame, and what it leaves out and
-// why (printed by `swish replay --plan` without running anything). Vulkan-free: it mirrors the
-// allocations of gpu::GpuModel and gpu::FrameResources byte for byte (tests/unit/test_planner*.cpp hold
-// it to that) so the memory it announces is the memory the replay engine will allocate.
+// why (printed by `swish replay --plan` without running anything, and without a device). Its memory
+// figures come from the GPU side itself (gpu/allocation_plan.hpp: the sizes GpuModel and
+// FrameResources allocate with), so the memory it announces is the memory the replay engine allocates.
 //
 // Decisions:
 //   - Normal-map lookup, VQ decode and blend, and the normals+tangents pass, run only when an output
@@ -25,7 +25,7 @@
 #include "swish/model/model.hpp"
 #include "swish/runtime/scene.hpp"
 
-namespace swish::runtime {
+namespace swish::replay {
 
 struct PlannerOptions {
   uint32_t framesInFlight = 1;  // the replay reads every frame back, so a second frame buys nothing
@@ -87,14 +87,7 @@ struct ReplayPlan {
 
 // models: every SceneCharacter::model of the scene -> the loaded model. Throws Error naming the scene
 // and character when a model is missing from the map or a character's skeleton does not fit.
-ReplayPlan planReplay(const Scene& scene, const std::map<std::string, const Model*>& models,
+ReplayPlan planReplay(const runtime::Scene& scene, const std::map<std::string, const Model*>& models,
                       const PlannerOptions& options = {});
 
-// The bytes gpu::GpuModel uploads for `model` (with or without its normal-map database), itemised.
-std::vector<PlannedAllocation> modelAllocations(const Model& model, const std::string& owner, bool withNormalMaps);
-// The bytes of one gpu::FrameResources for `instances` instances.
-std::vector<PlannedAllocation> frameAllocations(const Model& model, const std::string& owner, uint32_t instances,
-                                                bool tangentFrames, bool normalMaps,
-                                                bool normalMapsShareTexels = false);
-
-}  // namespace swish::runtime
+}  // namespace swish::replay
