@@ -1,5 +1,5 @@
 #pragma once
-// The replay frame loop: for every scene frame, per model batch (planner.hpp), on the CPU the poses
+// The replay frame loop: for every scene frame, per model batch (replay_plan.hpp), on the CPU the poses
 // (CharacterMotion), forward kinematics and skinning matrices, Theta, the MLP, the nearest-code lookup
 // and temporal filter; then the GPU passes of every batch recorded into one command buffer, submitted
 // and waited on. Per-stage times come from CPU clocks and GPU timestamps.

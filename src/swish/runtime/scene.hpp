@@ -1,7 +1,7 @@
 #pragma once
 // A replay scene: which characters play, wearing which model, driven by which motion, standing where,
 // over which frames, and which outputs are wanted. Plain data (no Vulkan, no I/O); scene_file.hpp reads
-// it from JSON and documents the file format; planner.hpp turns it into the work of one frame.
+// it from JSON and documents the file format; replay/replay_plan.hpp turns it into the work of one frame.
 //
 // Positions are kept in double: a character may stand kilometres from the origin (open worlds), and
 // the runtime computes everything relative to the character (float is precise there), applying the
@@ -63,7 +63,7 @@ struct SceneLevels {
   double holdSeconds = 1.0;               // a character keeps a level at least this long after a change
 };
 
-// Outputs a scene asks for. What they need decides the work (planner.hpp):
+// Outputs a scene asks for. What they need decides the work (replay/replay_plan.hpp):
 //   render     a renderer consumes every frame: deformed meshes, normals+tangents, normal maps
 //   meshes     per-frame glTF meshes (positions; with normals when render or normalMaps is on)
 //   normalMaps per-frame PNG normal maps per character (needs the normal-map passes and tangents)
