@@ -7,12 +7,13 @@
 #include <mutex>
 
 #include "swish/gpu/vk_check.hpp"
+#include "swish/gpu/vk_helpers.hpp"
 
 namespace swish::gpu {
 
 namespace {
 
-constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+constexpr const char* kValidationLayer = kValidationLayerName;
 
 bool envFlag(const char* name) {
   const char* v = std::getenv(name);
@@ -22,39 +23,9 @@ bool envFlag(const char* name) {
   return s == "1" || s == "true" || s == "on" || s == "yes";
 }
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
-
 std::string versionString(uint32_t v) {
   return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
          std::to_string(VK_API_VERSION_PATCH(v));
-}
-
-int typeRank(VkPhysicalDeviceType t) {
-  switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-      return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-      return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-      return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:
-      return 3;
-    default:
-      return 4;
-  }
-}
-
-std::optional<uint32_t> computeQueueFamily(VkPhysicalDevice pd) {
-  uint32_t n = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, nullptr);
-  std::vector<VkQueueFamilyProperties> fams(n);
-  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, fams.data());
-  for (uint32_t i = 0; i < n; ++i)
-    if (fams[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
-  return std::nullopt;
 }
 
 // Why a device cannot run swish, or "" when it can.
@@ -63,7 +34,7 @@ std::string unusableReason(VkPhysicalDevice pd) {
   vkGetPhysicalDeviceProperties(pd, &props);
   if (props.apiVersion < VK_API_VERSION_1_3)
     return "supports Vulkan " + versionString(props.apiVersion) + ", swish needs 1.3 (update the driver)";
-  if (!computeQueueFamily(pd)) return "has no compute queue";
+  if (!queueFamilyWith(pd, VK_QUEUE_COMPUTE_BIT)) return "has no compute queue";
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
   VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
@@ -155,23 +126,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
 }
 
 VkDebugUtilsMessengerCreateInfoEXT messengerInfo(Context::Impl* impl) {
-  VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                   VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-  mi.pfnUserCallback = onDebugMessage;
-  mi.pUserData = impl;
-  return mi;
-}
-
-bool layerAvailable(const char* name) {
-  uint32_t n = 0;
-  vkEnumerateInstanceLayerProperties(&n, nullptr);
-  std::vector<VkLayerProperties> layers(n);
-  vkEnumerateInstanceLayerProperties(&n, layers.data());
-  for (const auto& l : layers)
-    if (std::strcmp(l.layerName, name) == 0) return true;
-  return false;
+  return debugMessengerInfo(onDebugMessage, impl);
 }
 
 // A bare instance for listing devices, or the context's own instance when `impl` is given.
@@ -190,7 +145,7 @@ VkInstance createInstance(const ContextOptions& options, bool validation, Contex
   const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
   VkDebugUtilsMessengerCreateInfoEXT mi{};
   if (validation) {
-    if (!layerAvailable(kValidationLayer))
+    if (!instanceLayerAvailable(kValidationLayer))
       throw Error(std::string("validation was requested (SWISH_VALIDATION or an option) but ") + kValidationLayer +
                   " is not installed: install the Vulkan validation layers (Debian: vulkan-validationlayers) or turn "
                   "validation off");
@@ -239,12 +194,6 @@ std::vector<PhysicalDeviceInfo> describe(const std::vector<VkPhysicalDevice>& pd
   return out;
 }
 
-std::string requestedDevice(const ContextOptions& o) {
-  if (!o.device.empty()) return o.device;
-  if (const char* e = std::getenv("SWISH_DEVICE")) return e;
-  return "";
-}
-
 std::string deviceList(const std::vector<PhysicalDeviceInfo>& devs) {
   std::string s;
   for (const auto& d : devs)
@@ -260,18 +209,12 @@ int pick(const std::vector<PhysicalDeviceInfo>& devs, const std::string& request
         "no Vulkan device found: install a Vulkan driver (for a CPU fallback, Debian's mesa-vulkan-drivers provides "
         "lavapipe)");
   if (!request.empty()) {
-    const bool isIndex = std::all_of(request.begin(), request.end(), [](unsigned char c) { return std::isdigit(c); });
     int found = -1;
-    if (isIndex) {
-      const unsigned long i = std::strtoul(request.c_str(), nullptr, 10);
-      if (i < devs.size()) found = int(i);
-    } else {
-      for (const auto& d : devs)
-        if (lower(d.name).find(lower(request)) != std::string::npos) {
-          found = int(d.index);
-          break;
-        }
-    }
+    for (const auto& d : devs)
+      if (deviceMatches(request, d.index, d.name)) {
+        found = int(d.index);
+        break;
+      }
     if (found < 0)
       throw Error("no Vulkan device matches '" + request +
                   "' (SWISH_DEVICE or --device: an index or a name substring); devices:" + deviceList(devs));
@@ -281,7 +224,7 @@ int pick(const std::vector<PhysicalDeviceInfo>& devs, const std::string& request
   }
   int best = -1;
   for (const auto& d : devs)
-    if (d.usable && (best < 0 || typeRank(d.type) < typeRank(devs[best].type))) best = int(d.index);
+    if (d.usable && (best < 0 || deviceTypeRank(d.type) < deviceTypeRank(devs[best].type))) best = int(d.index);
   if (best < 0) throw Error("no Vulkan device can run swish; devices:" + deviceList(devs));
   return best;
 }
@@ -310,7 +253,7 @@ std::vector<PhysicalDeviceInfo> Context::listDevices(const ContextOptions& optio
     devs = describe(physicalDevices(instance));
     picked = -1;
     try {
-      picked = pick(devs, requestedDevice(options));
+      picked = pick(devs, requestedDevice(options.device));
     } catch (const Error& e) {
       whyNone = e.what();
     }
@@ -334,9 +277,9 @@ Context Context::create(const ContextOptions& options) {
     SWISH_VK(createMessenger(impl->instance, &mi, nullptr, &impl->messenger));
   }
   const auto pds = physicalDevices(impl->instance);
-  const int chosen = pick(describe(pds), requestedDevice(options));
+  const int chosen = pick(describe(pds), requestedDevice(options.device));
   impl->physicalDevice = pds[chosen];
-  impl->queueFamily = *computeQueueFamily(impl->physicalDevice);
+  impl->queueFamily = *queueFamilyWith(impl->physicalDevice, VK_QUEUE_COMPUTE_BIT);
 
   VkPhysicalDeviceFeatures supported;
   vkGetPhysicalDeviceFeatures(impl->physicalDevice, &supported);
@@ -431,12 +374,7 @@ void Context::clearValidationMessages() {
 }
 
 uint32_t Context::memoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const {
-  const auto& mp = impl_->memProps;
-  for (int pass = 0; pass < 2; ++pass) {
-    const VkMemoryPropertyFlags want = pass == 0 ? (required | preferred) : required;
-    for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
-      if ((typeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) return i;
-  }
+  if (const auto t = findMemoryType(impl_->memProps, typeBits, required, preferred)) return *t;
   throw Error("the Vulkan device '" + deviceName() + "' has no memory type with the properties swish needs");
 }
 

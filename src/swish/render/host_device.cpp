@@ -7,6 +7,7 @@
 
 #include "swish/api_error.hpp"
 #include "swish/api_runtime.hpp"
+#include "swish/gpu/vk_helpers.hpp"
 
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 
@@ -24,32 +25,6 @@ void check(VkResult r, const char* call) {
                      std::string("host device: ") + call + " returned " + std::to_string(int(r)));
 }
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
-
-int graphicsComputeFamily(VkPhysicalDevice pd) {
-  uint32_t n = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, nullptr);
-  std::vector<VkQueueFamilyProperties> fams(n);
-  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, fams.data());
-  const VkQueueFlags want = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
-  for (uint32_t i = 0; i < n; ++i)
-    if ((fams[i].queueFlags & want) == want) return int(i);
-  return -1;
-}
-
-bool layerAvailable(const char* name) {
-  uint32_t n = 0;
-  vkEnumerateInstanceLayerProperties(&n, nullptr);
-  std::vector<VkLayerProperties> layers(n);
-  vkEnumerateInstanceLayerProperties(&n, layers.data());
-  for (const auto& l : layers)
-    if (std::strcmp(l.layerName, name) == 0) return true;
-  return false;
-}
-
 }  // namespace
 
 VKAPI_ATTR VkBool32 VKAPI_CALL HostDevice::onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT,
@@ -62,18 +37,13 @@ VKAPI_ATTR VkBool32 VKAPI_CALL HostDevice::onMessage(VkDebugUtilsMessageSeverity
 }
 
 HostDevice::HostDevice(const HostDeviceOptions& options) {
-  const char* kLayer = "VK_LAYER_KHRONOS_validation";
-  if (options.validation && !layerAvailable(kLayer))
+  const char* kLayer = gpu::kValidationLayerName;
+  if (options.validation && !gpu::instanceLayerAvailable(kLayer))
     fail("validation asked for, but VK_LAYER_KHRONOS_validation is not installed (Debian: vulkan-validationlayers)");
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "swish preview";
   app.apiVersion = VK_API_VERSION_1_3;
-  VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                   VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-  mi.pfnUserCallback = &HostDevice::onMessage;
-  mi.pUserData = this;
+  const VkDebugUtilsMessengerCreateInfoEXT mi = gpu::debugMessengerInfo(&HostDevice::onMessage, this);
   const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   ici.pApplicationInfo = &app;
@@ -98,35 +68,27 @@ HostDevice::HostDevice(const HostDeviceOptions& options) {
     vkEnumeratePhysicalDevices(instance_, &n, nullptr);
     std::vector<VkPhysicalDevice> pds(n);
     vkEnumeratePhysicalDevices(instance_, &n, pds.data());
-    std::string want = options.device;
-    if (want.empty())
-      if (const char* env = std::getenv("SWISH_DEVICE")) want = env;
+    const std::string want = gpu::requestedDevice(options.device);
     std::string reasons;
-    int best = -1, bestScore = -1;
+    int best = -1, bestRank = 0;
     for (uint32_t i = 0; i < n; ++i) {
       VkPhysicalDeviceProperties p;
       vkGetPhysicalDeviceProperties(pds[i], &p);
-      if (!want.empty()) {
-        const bool isIndex = std::all_of(want.begin(), want.end(), [](unsigned char c) { return std::isdigit(c); });
-        if (isIndex ? std::to_string(i) != want : lower(p.deviceName).find(lower(want)) == std::string::npos) continue;
-      }
+      if (!gpu::deviceMatches(want, i, p.deviceName)) continue;
       std::string why = api::unsuitableReason(pds[i]);
-      if (why.empty() && graphicsComputeFamily(pds[i]) < 0)
+      if (why.empty() && !gpu::queueFamilyWith(pds[i], VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
         why = std::string(p.deviceName) + " has no graphics+compute queue";
       if (!why.empty()) {
         reasons += "; " + why;
         continue;
       }
-      const int score = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? 3
-                        : p.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? 2
-                        : p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU            ? 0
-                                                                                 : 1;
-      if (score > bestScore) best = int(i), bestScore = score;
+      if (best < 0 || gpu::deviceTypeRank(p.deviceType) < bestRank)
+        best = int(i), bestRank = gpu::deviceTypeRank(p.deviceType);
     }
     if (best < 0)
       fail("no usable Vulkan device" + (want.empty() ? std::string() : " matching '" + want + "'") + reasons);
     physical_ = pds[best];
-    family_ = uint32_t(graphicsComputeFamily(physical_));
+    family_ = *gpu::queueFamilyWith(physical_, VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
 
     VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
     f13.synchronization2 = VK_TRUE;  // the renderer's own barriers use vkCmdPipelineBarrier2
@@ -186,8 +148,7 @@ void HostDevice::clearValidationMessages() {
 uint32_t HostDevice::memoryType(uint32_t typeBits, VkMemoryPropertyFlags flags) const {
   VkPhysicalDeviceMemoryProperties mp;
   vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
-  for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
-    if ((typeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & flags) == flags) return i;
+  if (const auto t = gpu::findMemoryType(mp, typeBits, flags)) return *t;
   throw api::Error(api::ErrorCode::DeviceUnsupported,
                    "host device: no memory type with the properties the preview needs");
 }

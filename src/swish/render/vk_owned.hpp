@@ -1,7 +1,8 @@
 #pragma once
 // The preview renderer's Vulkan objects: buffers and images with their own memory, owned RAII-style.
-// The renderer is a host like any other, so it has its own small helpers rather than swish's private
-// gpu layer (apart from the header-only handle owner below).
+// The renderer is a host like any other (its own instance and graphics device), so it does not use the
+// library's gpu::Context; it shares the gpu layer's device-free pieces instead: the handle owner below
+// and the queries of gpu/vk_helpers.hpp (layers, queue families, memory types, device choice).
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
