@@ -238,6 +238,41 @@ TEST(JointMapChain, SharesTheRotationAlongTheChainAndKeepsTheLastJointsGlobal) {
   EXPECT_EQ(io::jointMapToJson(m)["y"]["joints"], nlohmann::json({"B", "C"}));
 }
 
+// Joint map errors name the map (its file, or the path of an inline map) and the JSON path of the value.
+TEST(JointMapErrors, NameTheFileAndTheJsonPath) {
+  const test::TempDir dir("joint_map_errors");
+  auto fileError = [&](const std::string& text) {
+    std::ofstream(dir / "map.json") << text;
+    return test::errorOf([&] { io::readJointMapFile(dir / "map.json"); });
+  };
+  const std::string f = (dir / "map.json").string();
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", "Spine1"], "shares": [0.5, 1.5]}})"),
+            f + ": chest.shares[1]: 1.5 is outside 0..1");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", "Spine1"], "shares": [0.5, "half"]}})"),
+            f + ": chest.shares[1]: must be a number, is string");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", "Spine1"], "shares": [0.3, 0.3]}})"),
+            f + ": chest.shares: must sum to 1 (they sum to 0.600000)");
+  EXPECT_EQ(fileError(R"({"chest": ["Spine", 3]})"), f + ": chest[1]: must be a non-empty joint name, is number");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", ""]}})"),
+            f + ": chest.joints[1]: must be a non-empty joint name");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": []}})"),
+            f + ": chest.joints: a chain must list at least one character joint, parent first");
+  EXPECT_EQ(fileError(R"({"chest": {"joint": ["Spine"]}})"),
+            f + ": chest.joint: unknown key (allowed here: joints, shares)");
+  EXPECT_EQ(fileError(R"({"": "Hips"})"), f + ": \"\": an empty clip joint name");
+  EXPECT_EQ(
+      fileError(R"(["Hips"])"),
+      f + ": (top level): must be a JSON object {\"clip joint\": \"character joint\" or [chain joints, parent first]}");
+  EXPECT_EQ(fileError("{").rfind(f + ": not valid JSON: ", 0), 0u) << fileError("{");
+  EXPECT_EQ(test::errorOf([&] { io::readJointMapFile(dir / "none.json"); }),
+            (dir / "none.json").string() + ": cannot open the joint map file");
+  // An inline map: `what` starts the message, the map's path.
+  EXPECT_EQ(test::errorOf([] {
+              io::parseJointMap({{"hip", ""}}, "scene.json: characters[2].animation.jointMap");
+            }),
+            "scene.json: characters[2].animation.jointMap.hip: must be a non-empty joint name");
+}
+
 namespace {
 #define SKIP_WITHOUT_CORPUS()                                                                                 \
   if (!fs::exists(test::sharedMocap("cmu-daz/index.tsv")) || !fs::exists(test::sharedMocap("index.tsv"))) {   \
