@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <unordered_map>
 
 #include "swish/core/error.hpp"
+#include "swish/files/json_file.hpp"
+#include "swish/files/json_reader.hpp"
 
 namespace swish::io {
 namespace {
@@ -131,56 +132,52 @@ JointMapping mapWith(const std::vector<std::string>& clip, const Skeleton& chara
   return m;
 }
 
-[[noreturn]] void fail(const std::string& what, const std::string& key, const std::string& problem) {
-  throw Error(what + (key.empty() ? "" : "." + key) + ": " + problem);
+// A joint name: a non-empty string.
+std::string jointName(const JsonReader& r) {
+  const nlohmann::json& v = r.value();
+  if (!v.is_string()) r.fail("must be a non-empty joint name, is " + std::string(v.type_name()));
+  if (v.get<std::string>().empty()) r.fail("must be a non-empty joint name");
+  return v.get<std::string>();
 }
 
 }  // namespace
 
-JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& what) {
-  if (!json.is_object())
-    fail(what, "", "must be a JSON object {\"clip joint\": \"character joint\" or [chain joints, parent first]}");
+JointMapOptions parseJointMap(const JsonReader& map) {
+  if (!map.value().is_object())
+    map.fail("must be a JSON object {\"clip joint\": \"character joint\" or [chain joints, parent first]}");
   JointMapOptions out;
-  for (auto it = json.begin(); it != json.end(); ++it) {
-    const std::string& clipJoint = it.key();
-    if (clipJoint.empty()) fail(what, "\"\"", "an empty clip joint name");
-    const nlohmann::json& v = it.value();
-    if (v.is_string()) {
-      if (v.get<std::string>().empty()) fail(what, clipJoint, "must be a non-empty joint name");
-      out.explicitPairs.emplace_back(clipJoint, v.get<std::string>());
+  for (const auto& [clipJoint, value] : map.value().items()) {
+    if (clipJoint.empty())
+      JsonReader(value, map.source(), map.path().empty() ? "\"\"" : map.path() + ".\"\"")
+          .fail("an empty clip joint name");
+    const JsonReader v = map.child(clipJoint);
+    if (v.value().is_string()) {
+      out.explicitPairs.emplace_back(clipJoint, jointName(v));
       continue;
     }
+    // A chain: an array of joints, or {"joints": [..], "shares": [..]}.
+    if (v.value().is_object()) {
+      v.requireObject({"joints", "shares"});
+      if (!v.has("joints")) v.child("joints").fail("is required (the chain, parent first)");
+    } else if (!v.value().is_array()) {
+      v.fail("must be a character joint name, an array of chain joints or {\"joints\", \"shares\"}");
+    }
+    const JsonReader joints = v.value().is_object() ? v.child("joints") : v;
+    if (!joints.value().is_array() || joints.value().empty())
+      joints.fail("a chain must list at least one character joint, parent first");
     JointChain chain;
-    const nlohmann::json* joints = &v;
-    if (v.is_object()) {
-      for (auto k = v.begin(); k != v.end(); ++k)
-        if (k.key() != "joints" && k.key() != "shares")
-          fail(what, clipJoint + "." + k.key(), "unknown key (known: joints, shares)");
-      if (!v.contains("joints")) fail(what, clipJoint + ".joints", "is required (the chain, parent first)");
-      joints = &v.at("joints");
-    } else if (!v.is_array()) {
-      fail(what, clipJoint, "must be a character joint name, an array of chain joints or {\"joints\", \"shares\"}");
-    }
-    if (!joints->is_array() || joints->empty())
-      fail(what, clipJoint, "a chain must list at least one character joint, parent first");
-    for (const auto& j : *joints) {
-      if (!j.is_string() || j.get<std::string>().empty()) fail(what, clipJoint, "chain joints must be non-empty names");
-      chain.joints.push_back(j.get<std::string>());
-    }
-    if (v.is_object() && v.contains("shares")) {
-      const auto& sh = v.at("shares");
-      if (!sh.is_array() || sh.size() != chain.joints.size())
-        fail(what, clipJoint + ".shares",
-             "must hold one number per chain joint (" + std::to_string(chain.joints.size()) + ")");
+    for (size_t i = 0; i < joints.value().size(); ++i) chain.joints.push_back(jointName(joints.at(i)));
+    if (v.value().is_object() && v.has("shares")) {
+      const JsonReader shares = v.child("shares");
+      if (!shares.value().is_array() || shares.value().size() != chain.joints.size())
+        shares.fail("must hold one number per chain joint (" + std::to_string(chain.joints.size()) + ")");
       double sum = 0.0;
-      for (const auto& x : sh) {
-        if (!x.is_number() || !(x.get<double>() >= 0.0 && x.get<double>() <= 1.0))
-          fail(what, clipJoint + ".shares", "each share must be a number in 0..1");
-        chain.shares.push_back(x.get<float>());
-        sum += x.get<double>();
+      for (size_t i = 0; i < chain.joints.size(); ++i) {
+        const double x = shares.at(i).number(0.0, 1.0);
+        chain.shares.push_back(float(x));
+        sum += x;
       }
-      if (std::abs(sum - 1.0) > 1e-3)
-        fail(what, clipJoint + ".shares", "must sum to 1 (they sum to " + std::to_string(sum) + ")");
+      if (std::abs(sum - 1.0) > 1e-3) shares.fail("must sum to 1 (they sum to " + std::to_string(sum) + ")");
     } else {
       chain.shares.assign(chain.joints.size(), 1.f / float(chain.joints.size()));
     }
@@ -190,16 +187,13 @@ JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& wha
   return out;
 }
 
+JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& what) {
+  return parseJointMap(JsonReader(json, "", what));  // no source: every message starts with `what`
+}
+
 JointMapOptions readJointMapFile(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot open the joint map file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file.string() + ": the joint map is not valid JSON: " + e.what());
-  }
-  return parseJointMap(j, file.string());
+  const nlohmann::json j = readJsonFile(file, "joint map file");
+  return parseJointMap(JsonReader(j, file.string()));
 }
 
 nlohmann::json jointMapToJson(const JointMapOptions& map) {

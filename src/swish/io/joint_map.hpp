@@ -22,6 +22,10 @@
 
 #include "swish/core/skeleton.hpp"
 
+namespace swish {
+class JsonReader;
+}
+
 namespace swish::io {
 
 enum class JointNaming { Auto, Same, Mixamo, Unreal };
@@ -41,11 +45,16 @@ struct JointMapOptions {
   bool empty() const { return explicitPairs.empty() && chains.empty(); }
 };
 
-// A joint map from its JSON form (above). `what` names it in errors ("scene.json: characters[2].animation.
-// joint_map.chest: ..."): a non-object, a non-string joint, an empty chain, shares that do not match
-// the joints or do not sum to 1.
+// A joint map from its JSON form (above), read at `map`'s node: errors read "<source>: <path>.<clip joint>:
+// <problem>" (files/json_reader.hpp), e.g. "recipe.json: part1.clips[3].joint_map.chest.shares[1]: 1.5 is
+// outside 0..1", for a non-object, an empty or non-string joint name, an empty chain, an unknown key of a
+// chain object, shares that do not match the joints, are not numbers in 0..1 or do not sum to 1.
+JointMapOptions parseJointMap(const JsonReader& map);
+// The same with `what` as the start of every error, the map's path ("scene.json: characters[2].animation.
+// jointMap" gives "scene.json: characters[2].animation.jointMap.chest: ...").
 JointMapOptions parseJointMap(const nlohmann::json& json, const std::string& what);
-// A joint map file: a JSON object of the same form; Error naming the file when missing or malformed.
+// A joint map file: a JSON object of the same form; errors name the file ("<file>: cannot open the joint
+// map file", "<file>: not valid JSON: ...") and the JSON path ("<file>: chest.shares: must sum to 1 ...").
 JointMapOptions readJointMapFile(const std::filesystem::path& file);
 // The JSON form back (for manifests, fingerprints and reports).
 nlohmann::json jointMapToJson(const JointMapOptions& map);

@@ -3,10 +3,12 @@
 #include <cctype>
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include "swish/core/error.hpp"
 #include "swish/core/skeleton.hpp"
 #include "swish/files/json_file.hpp"
+#include "swish/files/json_reader.hpp"
 
 namespace swish::bake {
 namespace {
@@ -113,132 +115,165 @@ constexpr const char* kEmbeddedRecipe = R"recipe({
 }
 )recipe";
 
-template <class T>
-T get(const nlohmann::json& j, const char* key, const std::string& what) {
-  if (!j.is_object() || !j.contains(key)) throw Error(what + ": missing '" + key + "'");
+// "<value> is outside <lo>..<hi>", in JsonReader's wording, of the float the recipe keeps.
+std::string outside(float v, float lo, float hi) {
+  std::ostringstream s;
+  s << v << " is outside " << lo << ".." << hi;
+  return s.str();
+}
+
+// A number in [lo, hi], compared as the float the recipe keeps.
+float real(const JsonReader& r, float lo, float hi) {
+  const float v = float(r.number());
+  if (!(std::isfinite(v) && v >= lo && v <= hi)) r.fail(outside(v, lo, hi));
+  return v;
+}
+
+int count(const JsonReader& r, int lo, int hi) { return int(r.integer(uint64_t(lo), uint64_t(hi))); }
+
+// [x, y, z] in metres, each within 10 m of the origin.
+Vec3f vec3(const JsonReader& r) {
+  if (!r.value().is_array() || r.value().size() != 3) r.fail("must be an array of 3 numbers [x, y, z]");
+  return {real(r.at(0), -10.f, 10.f), real(r.at(1), -10.f, 10.f), real(r.at(2), -10.f, 10.f)};
+}
+
+// An array (possibly empty) of the elements at `r`.
+void requireArray(const JsonReader& r, const std::string& of) {
+  if (!r.value().is_array()) r.fail("must be an array of " + of + ", is " + std::string(r.value().type_name()));
+}
+
+// Runs f; an error it throws gets `about` appended ("... (body part 'torso')"): the path says where the
+// value is, `about` which part of the character it shapes.
+template <class F>
+void about(const std::string& what, F&& f) {
   try {
-    return j.at(key).get<T>();
-  } catch (const nlohmann::json::exception&) {
-    throw Error(what + ": '" + key + "' has the wrong type");
+    f();
+  } catch (const Error& e) {
+    throw Error(std::string(e.what()) + " (" + what + ")");
   }
-}
-
-template <class T>
-T getOr(const nlohmann::json& j, const char* key, T fallback, const std::string& what) {
-  return j.contains(key) ? get<T>(j, key, what) : fallback;
-}
-
-float positive(const nlohmann::json& j, const char* key, const std::string& what, float lo = 1e-6f, float hi = 10.f) {
-  const float v = get<float>(j, key, what);
-  if (!std::isfinite(v) || v < lo || v > hi)
-    throw Error(what + ": '" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
-                std::to_string(hi) + "]");
-  return v;
-}
-
-int count(const nlohmann::json& j, const char* key, const std::string& what, int lo, int hi) {
-  const int v = get<int>(j, key, what);
-  if (v < lo || v > hi)
-    throw Error(what + ": '" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
-                std::to_string(hi) + "]");
-  return v;
-}
-
-Vec3f vec3(const nlohmann::json& j, const char* key, const std::string& what) {
-  const auto v = get<std::vector<float>>(j, key, what);
-  if (v.size() != 3) throw Error(what + ": '" + key + "' must have 3 components");
-  for (float x : v)
-    if (!std::isfinite(x) || std::abs(x) > 10.f)
-      throw Error(what + ": '" + key + "' has a non-finite or huge component");
-  return {v[0], v[1], v[2]};
 }
 
 }  // namespace
 
-DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, const std::string& what) {
-  if (get<std::string>(j, "format", what) != "swish-default-character-recipe")
-    throw Error(what + ": not a swish default character recipe ('format')");
-  if (get<int>(j, "version", what) != 1) throw Error(what + ": unsupported recipe version");
+DefaultCharacterRecipe parseDefaultCharacterRecipe(const JsonReader& j) {
+  j.requireObject({"format", "version", "name", "units", "skeleton", "body", "jersey"});
+  if (j.required("format").string() != "swish-default-character-recipe")
+    j.child("format").fail("not a swish default character recipe (must be \"swish-default-character-recipe\")");
+  const JsonReader version = j.required("version");
+  if (version.number() != 1)
+    version.fail("unsupported recipe version " + version.value().dump() + " (this swish reads version 1)");
   DefaultCharacterRecipe r;
-  r.name = get<std::string>(j, "name", what);
-  const auto& sk = get<nlohmann::json>(j, "skeleton", what);
-  r.mirrorSkeleton = getOr<bool>(sk, "mirror", true, what);
+  r.name = j.required("name").string();
+  if (j.has("units")) j.child("units").string();  // a note for people: where the numbers are measured
+
+  const JsonReader sk = j.required("skeleton");
+  sk.requireObject({"mirror", "joints"});
+  r.mirrorSkeleton = sk.boolean("mirror", true);
+  const JsonReader joints = sk.required("joints");
+  requireArray(joints, "joints");
   std::set<std::string> names;
-  for (const auto& jj : get<nlohmann::json>(sk, "joints", what + ": skeleton")) {
+  for (size_t i = 0; i < joints.value().size(); ++i) {
+    const JsonReader jj = joints.at(i);
+    jj.requireObject({"name", "parent", "head"});
     RecipeJoint joint;
-    const std::string w = what + ": skeleton joint";
-    joint.name = get<std::string>(jj, "name", w);
-    joint.parent = get<std::string>(jj, "parent", w + " '" + joint.name + "'");
-    joint.head = vec3(jj, "head", w + " '" + joint.name + "'");
-    if (!joint.parent.empty() && !names.count(joint.parent))
-      throw Error(w + " '" + joint.name + "': parent '" + joint.parent + "' must be listed before it");
-    if (!names.insert(joint.name).second) throw Error(w + " '" + joint.name + "' repeats");
+    joint.name = jj.required("name").string();
+    about("joint '" + joint.name + "'", [&] {
+      joint.parent = jj.required("parent").string();
+      joint.head = vec3(jj.required("head"));
+      if (!joint.parent.empty() && !names.count(joint.parent))
+        jj.child("parent").fail("parent '" + joint.parent + "' must be listed before it");
+      if (!names.insert(joint.name).second) jj.child("name").fail("repeats an earlier joint's name");
+    });
     r.joints.push_back(joint);
   }
-  if (r.joints.empty() || !r.joints[0].parent.empty())
-    throw Error(what + ": the first joint must be the root (parent \"\")");
-  auto known = [&](const std::string& n) {
-    return names.count(n) || (r.mirrorSkeleton && names.count(mirroredJointName(n)));
+  if (r.joints.empty() || !r.joints[0].parent.empty()) joints.fail("the first joint must be the root (parent \"\")");
+  auto known = [&](const JsonReader& name) {
+    const std::string n = name.string();
+    if (!names.count(n) && !(r.mirrorSkeleton && names.count(mirroredJointName(n))))
+      name.fail("unknown joint '" + n + "'");
+    return n;
   };
 
-  const auto& body = get<nlohmann::json>(j, "body", what);
-  for (const auto& pj : get<nlohmann::json>(body, "parts", what + ": body")) {
+  const JsonReader body = j.required("body");
+  // "ringSegments" is read and checked like a part's "segments" but not used: each part's decide.
+  body.requireObject({"ringSegments", "parts", "blends"});
+  if (body.has("ringSegments")) count(body.child("ringSegments"), 6, 256);
+  const JsonReader parts = body.required("parts");
+  requireArray(parts, "body parts");
+  for (size_t i = 0; i < parts.value().size(); ++i) {
+    const JsonReader pj = parts.at(i);
+    pj.requireObject({"name", "mirror", "ringsPerSpan", "segments", "stations"});
     RecipePart p;
-    p.name = get<std::string>(pj, "name", what + ": body part");
-    const std::string w = what + ": body part '" + p.name + "'";
-    p.mirror = getOr<bool>(pj, "mirror", false, w);
-    p.ringsPerSpan = count(pj, "ringsPerSpan", w, 1, 64);
-    p.segments = count(pj, "segments", w, 6, 256);
-    for (const auto& sj : get<nlohmann::json>(pj, "stations", w)) {
-      RecipeStation s;
-      s.joint = get<std::string>(sj, "joint", w);
-      if (!known(s.joint)) throw Error(w + ": unknown joint '" + s.joint + "'");
-      if (sj.contains("at")) {
-        s.at = get<std::string>(sj, "at", w);
-        if (!known(s.at)) throw Error(w + ": unknown joint '" + s.at + "'");
-        if (sj.contains("offset")) s.offset = vec3(sj, "offset", w);
-      } else {
-        s.center = vec3(sj, "center", w);
+    p.name = pj.required("name").string();
+    about("body part '" + p.name + "'", [&] {
+      p.mirror = pj.boolean("mirror", false);
+      p.ringsPerSpan = count(pj.required("ringsPerSpan"), 1, 64);
+      p.segments = count(pj.required("segments"), 6, 256);
+      const JsonReader stations = pj.required("stations");
+      requireArray(stations, "stations");
+      for (size_t k = 0; k < stations.value().size(); ++k) {
+        const JsonReader sj = stations.at(k);
+        sj.requireObject({"joint", "at", "offset", "center", "halfWidth", "halfDepth"});
+        RecipeStation s;
+        s.joint = known(sj.required("joint"));
+        if (sj.has("at")) {
+          s.at = known(sj.child("at"));
+          if (sj.has("center")) sj.child("center").fail("applies without \"at\" only (with \"at\": \"offset\")");
+          if (sj.has("offset")) s.offset = vec3(sj.child("offset"));
+        } else {
+          if (sj.has("offset")) sj.child("offset").fail("applies with \"at\" only (without it: \"center\")");
+          s.center = vec3(sj.required("center"));
+        }
+        s.halfWidth = real(sj.required("halfWidth"), 1e-3f, 1.f);
+        s.halfDepth = real(sj.required("halfDepth"), 1e-3f, 1.f);
+        p.stations.push_back(s);
       }
-      s.halfWidth = positive(sj, "halfWidth", w, 1e-3f, 1.f);
-      s.halfDepth = positive(sj, "halfDepth", w, 1e-3f, 1.f);
-      p.stations.push_back(s);
-    }
-    if (p.stations.size() < 2) throw Error(w + ": needs at least two stations");
+      if (p.stations.size() < 2) stations.fail("needs at least two stations");
+    });
     r.parts.push_back(p);
   }
-  if (body.contains("blends"))
-    for (const auto& bj : body.at("blends")) {
+  if (body.has("blends")) {
+    const JsonReader blends = body.child("blends");
+    requireArray(blends, "blends");
+    for (size_t i = 0; i < blends.value().size(); ++i) {
+      const JsonReader bj = blends.at(i);
+      bj.requireObject({"joint", "at", "offset", "radius", "mirror"});
       RecipeBlend b;
-      b.joint = get<std::string>(bj, "joint", what + ": blend");
-      b.at = get<std::string>(bj, "at", what + ": blend");
-      if (!known(b.joint) || !known(b.at)) throw Error(what + ": blend refers to an unknown joint");
-      if (bj.contains("offset")) b.offset = vec3(bj, "offset", what + ": blend");
-      b.radius = positive(bj, "radius", what + ": blend", 1e-3f, 1.f);
-      b.mirror = getOr<bool>(bj, "mirror", false, what + ": blend");
+      b.joint = known(bj.required("joint"));
+      b.at = known(bj.required("at"));
+      if (bj.has("offset")) b.offset = vec3(bj.child("offset"));
+      b.radius = real(bj.required("radius"), 1e-3f, 1.f);
+      b.mirror = bj.boolean("mirror", false);
       r.blends.push_back(b);
     }
+  }
 
-  const auto& js = get<nlohmann::json>(j, "jersey", what);
-  const std::string w = what + ": jersey";
+  const JsonReader js = j.required("jersey");
+  js.requireObject({"offset", "clearance", "columns", "rows", "hemY", "collarY", "armholeBottomY", "armholeTopY",
+                    "armholeHalfWidth", "sleeveLength", "sleeveRings", "skinTransferNeighbours",
+                    "skinSmoothingIterations", "maxInfluences"});
   RecipeJersey& g = r.jersey;
-  g.offset = positive(js, "offset", w, 1e-3f, 0.1f);
-  g.clearance = positive(js, "clearance", w, 1e-4f, 0.1f);
-  g.columns = count(js, "columns", w, 16, 1024);
-  g.rows = count(js, "rows", w, 4, 1024);
-  g.hemY = positive(js, "hemY", w, -10.f, 10.f);
-  g.collarY = positive(js, "collarY", w, -10.f, 10.f);
-  g.armholeBottomY = positive(js, "armholeBottomY", w, -10.f, 10.f);
-  g.armholeTopY = positive(js, "armholeTopY", w, -10.f, 10.f);
-  g.armholeHalfWidth = positive(js, "armholeHalfWidth", w, 1e-3f, 1.f);
-  g.sleeveLength = positive(js, "sleeveLength", w, 1e-3f, 1.f);
-  g.sleeveRings = count(js, "sleeveRings", w, 1, 256);
-  g.skinTransferNeighbours = count(js, "skinTransferNeighbours", w, 1, 16);
-  g.skinSmoothingIterations = count(js, "skinSmoothingIterations", w, 0, 10000);
-  g.maxInfluences = count(js, "maxInfluences", w, 1, 8);
+  g.offset = real(js.required("offset"), 1e-3f, 0.1f);
+  g.clearance = real(js.required("clearance"), 1e-4f, 0.1f);
+  g.columns = count(js.required("columns"), 16, 1024);
+  g.rows = count(js.required("rows"), 4, 1024);
+  g.hemY = real(js.required("hemY"), -10.f, 10.f);
+  g.collarY = real(js.required("collarY"), -10.f, 10.f);
+  g.armholeBottomY = real(js.required("armholeBottomY"), -10.f, 10.f);
+  g.armholeTopY = real(js.required("armholeTopY"), -10.f, 10.f);
+  g.armholeHalfWidth = real(js.required("armholeHalfWidth"), 1e-3f, 1.f);
+  g.sleeveLength = real(js.required("sleeveLength"), 1e-3f, 1.f);
+  g.sleeveRings = count(js.required("sleeveRings"), 1, 256);
+  g.skinTransferNeighbours = count(js.required("skinTransferNeighbours"), 1, 16);
+  g.skinSmoothingIterations = count(js.required("skinSmoothingIterations"), 0, 10000);
+  g.maxInfluences = count(js.required("maxInfluences"), 1, 8);
   if (!(g.hemY < g.armholeBottomY && g.armholeBottomY < g.armholeTopY && g.armholeTopY < g.collarY))
-    throw Error(w + ": need hemY < armholeBottomY < armholeTopY < collarY");
+    js.fail("need hemY < armholeBottomY < armholeTopY < collarY");
   return r;
+}
+
+DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, const std::string& what) {
+  return parseDefaultCharacterRecipe(JsonReader(j, what));
 }
 
 DefaultCharacterRecipe loadDefaultCharacterRecipe(const std::filesystem::path& file) {

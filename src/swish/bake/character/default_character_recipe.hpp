@@ -11,6 +11,10 @@
 
 #include "swish/core/types.hpp"
 
+namespace swish {
+class JsonReader;
+}
+
 namespace swish::bake {
 
 struct RecipeJoint {
@@ -69,8 +73,15 @@ struct DefaultCharacterRecipe {
   RecipeJersey jersey;
 };
 
-// Throws Error starting with `what` for missing keys, wrong types, non-finite or out-of-range values,
-// unknown joint references.
+// Reads a recipe (assets/default/recipe.json shows every key). Strict: an unknown key is an error listing
+// the keys allowed there, numbers must be JSON numbers (not true or "1"), counts whole numbers,
+// "center" and "offset" of a station go without and with "at". Errors are "<what>: <json.path>: <problem>"
+// (files/json_reader.hpp), with the joint or body part they concern where the path alone does not say it:
+//   "recipe.json: body.parts[2].segments: must be 6 to 256, is 3 (body part 'LeftArmPart')"
+//   "recipe.json: jersey.offset: -1 is outside 0.001..0.1"
+// for missing keys, wrong types, non-finite or out-of-range values and unknown joint references.
+// "body.ringSegments" is read and checked like a part's "segments" (6..256) but not used.
+DefaultCharacterRecipe parseDefaultCharacterRecipe(const JsonReader& recipe);
 DefaultCharacterRecipe parseDefaultCharacterRecipe(const nlohmann::json& j, const std::string& what);
 DefaultCharacterRecipe loadDefaultCharacterRecipe(const std::filesystem::path& file);
 const char* embeddedDefaultRecipeJson();

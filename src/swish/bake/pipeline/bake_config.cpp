@@ -173,7 +173,7 @@ DatasetBuildSettings parsePart1(const JsonReader& j, const std::filesystem::path
   DatasetBuildSettings s;
   if (j.has("character")) parseCharacter(j.child("character"), baseDir, s);
   if (!j.has("clips")) j.child("clips").fail("is required (the animation to sample poses from)");
-  s.clips = parseClipList(j.value().at("clips"), j.source().empty() ? "" : j.source() + ": ", baseDir);
+  s.clips = parseClipList(j.child("clips"), baseDir);
   s.inputJoints = j.strings("input_joints", s.inputJoints);
 
   if (j.has("holdout")) {

@@ -27,7 +27,8 @@
 //
 // Subjects compare as written, with leading zeros of numbers ignored ("01" is "1"). A file listed by
 // two entries is an error naming both (give it a weight instead). Errors name the config, the entry
-// (part1.clips[3].index) and the file, before any clip is read.
+// (part1.clips[3].index) and the file, before any clip is read: "<config>: <json.path>: <problem>"
+// (files/json_reader.hpp), e.g. "bake.json: part1.clips[3].weights.13_01: 0 is outside 0.01..100".
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -36,9 +37,17 @@
 
 #include "swish/bake/pipeline/part1_dataset.hpp"
 
+namespace swish {
+class JsonReader;
+}
+
 namespace swish::bake {
 
-// `where` prefixes errors (the config file and ": "); paths resolve against baseDir.
+// The clip list at `clips`'s node (a bake config's part1.clips, whose path its errors show); paths
+// resolve against baseDir.
+std::vector<ClipSource> parseClipList(const JsonReader& clips, const std::filesystem::path& baseDir);
+// The same for a list read as "part1.clips" of the document `where` names: `where` is "<document>: " (or
+// empty) and starts every error ("recipe.json: part1.clips[0].fps: ...").
 std::vector<ClipSource> parseClipList(const nlohmann::json& clips, const std::string& where,
                                       const std::filesystem::path& baseDir);
 

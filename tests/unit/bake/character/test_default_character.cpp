@@ -8,7 +8,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "support/error_message.hpp"
 #include "support/paths.hpp"
+#include "support/temp_dir.hpp"
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
 #include "swish/core/error.hpp"
@@ -294,4 +296,102 @@ TEST(DefaultCharacter, BadRecipesAreRefused) {
   bad = j;
   bad.erase("jersey");
   EXPECT_THROW(bake::parseDefaultCharacterRecipe(bad, "r"), Error);
+}
+
+namespace {
+// The message of parsing the embedded recipe after `change`, named "r".
+template <class F>
+std::string recipeError(F change) {
+  auto j = nlohmann::json::parse(bake::embeddedDefaultRecipeJson());
+  change(j);
+  return test::errorOf([&] { bake::parseDefaultCharacterRecipe(j, "r"); });
+}
+}  // namespace
+
+TEST(DefaultCharacter, RecipeErrorsNameTheFileTheJsonPathAndThePart) {
+  const test::TempDir dir("recipe_errors");
+  auto j = nlohmann::json::parse(bake::embeddedDefaultRecipeJson());
+  j["jersey"]["offset"] = -1;
+  std::ofstream(dir / "recipe.json") << j.dump(2);
+  EXPECT_EQ(test::errorOf([&] { bake::loadDefaultCharacterRecipe(dir / "recipe.json"); }),
+            (dir / "recipe.json").string() + ": jersey.offset: -1 is outside 0.001..0.1");
+
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][2]["segments"] = 3; }),
+            "r: body.parts[2].segments: must be 6 to 256, is 3 (body part 'LeftArmPart')");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][0]["stations"][0]["joint"] = "Tail"; }),
+            "r: body.parts[0].stations[0].joint: unknown joint 'Tail' (body part 'torso')");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][1]["stations"][2]["halfWidth"] = 2; }),
+            "r: body.parts[1].stations[2].halfWidth: 2 is outside 0.001..1 (body part 'head')");
+  EXPECT_EQ(recipeError([](auto& r) { r["skeleton"]["joints"][2]["parent"] = "Nowhere"; }),
+            "r: skeleton.joints[2].parent: parent 'Nowhere' must be listed before it (joint 'LeftUpLeg')");
+  EXPECT_EQ(recipeError([](auto& r) { r["skeleton"]["joints"][3]["head"][1] = 11; }),
+            "r: skeleton.joints[3].head[1]: 11 is outside -10..10 (joint 'LeftLeg')");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["blends"][1]["at"] = "Tail"; }),
+            "r: body.blends[1].at: unknown joint 'Tail'");
+  EXPECT_EQ(recipeError([](auto& r) { r.erase("jersey"); }), "r: jersey: is required");
+  EXPECT_EQ(recipeError([](auto& r) { r["jersey"]["hemY"] = 1.4; }),
+            "r: jersey: need hemY < armholeBottomY < armholeTopY < collarY");
+  EXPECT_EQ(recipeError([](auto& r) { r["version"] = 2; }),
+            "r: version: unsupported recipe version 2 (this swish reads version 1)");
+}
+
+// The recipe reader is strict: what it used to accept and read as something else, or ignore, is an error.
+TEST(DefaultCharacter, RecipesAreStrict) {
+  // Booleans where numbers are wanted (they read as 1).
+  EXPECT_EQ(recipeError([](auto& r) { r["jersey"]["offset"] = true; }),
+            "r: jersey.offset: must be a number, is boolean");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][0]["stations"][0]["halfWidth"] = true; }),
+            "r: body.parts[0].stations[0].halfWidth: must be a number, is boolean (body part 'torso')");
+  EXPECT_EQ(recipeError([](auto& r) { r["skeleton"]["joints"][0]["head"][1] = true; }),
+            "r: skeleton.joints[0].head[1]: must be a number, is boolean (joint 'Hips')");
+  EXPECT_EQ(recipeError([](auto& r) { r["version"] = true; }), "r: version: must be a number, is boolean");
+  // Fractions where counts are wanted (they were cut to whole numbers).
+  EXPECT_EQ(recipeError([](auto& r) { r["jersey"]["columns"] = 72.5; }),
+            "r: jersey.columns: must be an integer, is a fraction");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][3]["ringsPerSpan"] = 3.7; }),
+            "r: body.parts[3].ringsPerSpan: must be an integer, is a fraction (body part 'LeftLegPart')");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][0]["segments"] = true; }),
+            "r: body.parts[0].segments: must be an integer, is boolean (body part 'torso')");
+  EXPECT_EQ(recipeError([](auto& r) { r["version"] = 1.5; }),
+            "r: version: unsupported recipe version 1.5 (this swish reads version 1)");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["ringSegments"] = 28.5; }),
+            "r: body.ringSegments: must be an integer, is a fraction");
+  // Unknown keys (they were ignored), with the keys allowed there.
+  EXPECT_EQ(recipeError([](auto& r) { r["colour"] = "red"; }),
+            "r: colour: unknown key (allowed here: body, format, jersey, name, skeleton, units, version)");
+  EXPECT_EQ(recipeError([](auto& r) { r["jersey"]["hemline"] = 0.9; }),
+            "r: jersey.hemline: unknown key (allowed here: armholeBottomY, armholeHalfWidth, armholeTopY, clearance, "
+            "collarY, columns, hemY, maxInfluences, offset, rows, skinSmoothingIterations, skinTransferNeighbours, "
+            "sleeveLength, sleeveRings)");
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["parts"][0]["stations"][0]["radius"] = 0.1; }),
+            "r: body.parts[0].stations[0].radius: unknown key (allowed here: at, center, halfDepth, halfWidth, joint, "
+            "offset) (body part 'torso')");
+  EXPECT_EQ(recipeError([](auto& r) {
+              r["skeleton"]["joints"][1]["tail"] = {0, 1, 0};
+            }),
+            "r: skeleton.joints[1].tail: unknown key (allowed here: head, name, parent)");
+  // A station's "center" with "at", or "offset" without it (one of them was ignored).
+  EXPECT_EQ(recipeError([](auto& r) {
+              r["body"]["parts"][2]["stations"][2]["center"] = {0, 1, 0};
+            }),
+            "r: body.parts[2].stations[2].center: applies without \"at\" only (with \"at\": \"offset\") (body part "
+            "'LeftArmPart')");
+  EXPECT_EQ(recipeError([](auto& r) {
+              r["body"]["parts"][0]["stations"][0]["offset"] = {0, 1, 0};
+            }),
+            "r: body.parts[0].stations[0].offset: applies with \"at\" only (without it: \"center\") (body part "
+            "'torso')");
+  // Lists that are not arrays (an object's values, or nothing, were read as the list).
+  EXPECT_EQ(recipeError([](auto& r) { r["body"]["blends"] = nullptr; }),
+            "r: body.blends: must be an array of blends, is null");
+  EXPECT_EQ(recipeError([](auto& r) {
+              r["skeleton"]["joints"] = {{"Hips", r["skeleton"]["joints"][0]}};
+            }),
+            "r: skeleton.joints: must be an array of joints, is object");
+  // "units" is a note for people, but a string.
+  EXPECT_EQ(recipeError([](auto& r) { r["units"] = 1; }), "r: units: must be a string, is number");
+  // Whole numbers written as 2.0 are still whole.
+  auto j = nlohmann::json::parse(bake::embeddedDefaultRecipeJson());
+  j["jersey"]["columns"] = 72.0;
+  EXPECT_EQ(bake::parseDefaultCharacterRecipe(j, "r").jersey.columns, 72);
 }

@@ -131,7 +131,7 @@ TEST(ClipList, MistakesNameTheEntryAndTheFile) {
   EXPECT_SAYS(parseError({{{"index", "mocap/index.tsv"}, {"weights", {{"99_01", 2}}}}}, c.base()),
               "part1.clips[0].weights.99_01: names neither a clip");
   EXPECT_SAYS(parseError({{{"file", "mocap/01_01.bvh"}, {"weight", 0}}}, c.base()),
-              "part1.clips[0].weight: must be a number in 0.01..100");
+              "part1.clips[0].weight: 0 is outside 0.01..100");
   EXPECT_SAYS(parseError({{{"file", "mocap/01_01.bvh"}, {"joint_map", "none.json"}}}, c.base()), "joint map file");
   const auto badShares = nlohmann::json::parse(
       R"([{"file": "mocap/01_01.bvh", "joint_map": {"chest": {"joints": ["Spine", "Spine1"], "shares": [0.3, 0.3]}}}])");
@@ -149,6 +149,39 @@ TEST(ClipList, MistakesNameTheEntryAndTheFile) {
               "index.tsv:3: clip file " + (c.dir / "bad" / "lost.bvh").string());
   touch(c.dir / "bad" / "index.tsv", "file\tframes\n01_01.bvh\tmany\n");
   EXPECT_SAYS(parseError({{{"index", "bad/index.tsv"}}}, c.base()), "frames 'many' is not a positive integer");
+}
+
+// Through a bake config, the messages name the config file and the entry's JSON path.
+TEST(ClipList, ErrorsNameTheConfigFileAndTheJsonPath) {
+  const Corpus c;
+  auto error = [&](const nlohmann::json& entry) {
+    const nlohmann::json config = {
+        {"output", "o"}, {"part1", {{"clips", {"mocap/01_01.bvh", entry}}, {"thinning", {{"target_poses", 10}}}}}};
+    return test::errorOf([&] { parseBakeConfig(config, "bake.json", c.base()); });
+  };
+  EXPECT_EQ(error({{"glob", "mocap/02_*.bvh"}, {"fps", 2000}}),
+            "bake.json: part1.clips[1].fps: 2000 is outside 0..1000");
+  EXPECT_EQ(error({{"glob", "mocap/02_*.bvh"}, {"fps", "30"}}),
+            "bake.json: part1.clips[1].fps: must be a number, is string");
+  EXPECT_EQ(error({{"glob", "mocap/02_*.bvh"}, {"weights", {{"02_01", "x"}}}}),
+            "bake.json: part1.clips[1].weights.02_01: must be a number, is string");
+  EXPECT_EQ(error({{"glob", 5}}), "bake.json: part1.clips[1].glob: must be a non-empty string, is number");
+  EXPECT_EQ(error({{"glob", "mocap/02_*.bvh"}, {"subjects", {"2", 7}}}),
+            "bake.json: part1.clips[1].subjects[1]: must be a non-empty string, is number");
+  EXPECT_EQ(error({{"glob", "mocap/02_*.bvh"}, {"speed", 2}}),
+            "bake.json: part1.clips[1].speed: unknown key (allowed here: exclude_subjects, file, folder, fps, glob, "
+            "index, joint_map, naming, subject, subjects, weight, weights)");
+  EXPECT_EQ(
+      error({{"glob", "mocap/02_*.bvh"}, {"joint_map", {{"chest", {{"joints", {"A", "B"}}, {"shares", {2, 0}}}}}}}),
+      "bake.json: part1.clips[1].joint_map.chest.shares[0]: 2 is outside 0..1");
+  EXPECT_EQ(error("mocap/01_*.bvh"), "bake.json: part1.clips[1]: clip " + (c.dir / "mocap" / "01_01.bvh").string() +
+                                         " is listed again (first by part1.clips[0]); give it a weight instead");
+  // A list read from elsewhere (swish levels: a model's metadata) keeps its caller's prefix.
+  EXPECT_EQ(test::errorOf([&] { parseClipList({5}, "m.swish: metadata dataset_settings.clips: ", c.base()); }),
+            "m.swish: metadata dataset_settings.clips: part1.clips[0]: must be a clip file, folder or glob (string) or "
+            "an object");
+  EXPECT_EQ(test::errorOf([&] { parseClipList(nlohmann::json::array(), "", c.base()); }),
+            "part1.clips: must be a non-empty array of clip files, folders, globs or clip objects");
 }
 
 TEST(ClipList, SubjectsCompareWithoutLeadingZeros) {
@@ -236,6 +269,41 @@ TEST(JointMapChain, SharesTheRotationAlongTheChainAndKeepsTheLastJointsGlobal) {
   // Round trip through the JSON form.
   const io::JointMapOptions m = io::parseJointMap({{"y", {{"joints", {"B", "C"}}, {"shares", {0.25, 0.75}}}}}, "m");
   EXPECT_EQ(io::jointMapToJson(m)["y"]["joints"], nlohmann::json({"B", "C"}));
+}
+
+// Joint map errors name the map (its file, or the path of an inline map) and the JSON path of the value.
+TEST(JointMapErrors, NameTheFileAndTheJsonPath) {
+  const test::TempDir dir("joint_map_errors");
+  auto fileError = [&](const std::string& text) {
+    std::ofstream(dir / "map.json") << text;
+    return test::errorOf([&] { io::readJointMapFile(dir / "map.json"); });
+  };
+  const std::string f = (dir / "map.json").string();
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", "Spine1"], "shares": [0.5, 1.5]}})"),
+            f + ": chest.shares[1]: 1.5 is outside 0..1");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", "Spine1"], "shares": [0.5, "half"]}})"),
+            f + ": chest.shares[1]: must be a number, is string");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", "Spine1"], "shares": [0.3, 0.3]}})"),
+            f + ": chest.shares: must sum to 1 (they sum to 0.600000)");
+  EXPECT_EQ(fileError(R"({"chest": ["Spine", 3]})"), f + ": chest[1]: must be a non-empty joint name, is number");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": ["Spine", ""]}})"),
+            f + ": chest.joints[1]: must be a non-empty joint name");
+  EXPECT_EQ(fileError(R"({"chest": {"joints": []}})"),
+            f + ": chest.joints: a chain must list at least one character joint, parent first");
+  EXPECT_EQ(fileError(R"({"chest": {"joint": ["Spine"]}})"),
+            f + ": chest.joint: unknown key (allowed here: joints, shares)");
+  EXPECT_EQ(fileError(R"({"": "Hips"})"), f + ": \"\": an empty clip joint name");
+  EXPECT_EQ(
+      fileError(R"(["Hips"])"),
+      f + ": (top level): must be a JSON object {\"clip joint\": \"character joint\" or [chain joints, parent first]}");
+  EXPECT_EQ(fileError("{").rfind(f + ": not valid JSON: ", 0), 0u) << fileError("{");
+  EXPECT_EQ(test::errorOf([&] { io::readJointMapFile(dir / "none.json"); }),
+            (dir / "none.json").string() + ": cannot open the joint map file");
+  // An inline map: `what` starts the message, the map's path.
+  EXPECT_EQ(test::errorOf([] {
+              io::parseJointMap({{"hip", ""}}, "scene.json: characters[2].animation.jointMap");
+            }),
+            "scene.json: characters[2].animation.jointMap.hip: must be a non-empty joint name");
 }
 
 namespace {
