@@ -489,6 +489,15 @@ TEST_F(ReplayE2E, AClipWithOtherJointNamesPlaysThroughItsJointMap) {
     EXPECT_NE(std::string(e.what()).find("characters[0].animation.jointMap.chest.shares"), std::string::npos)
         << e.what();
   }
+  // The same map in a file is named by the file and the path inside it (not "<file>.chest.shares").
+  std::ofstream(dir_ / "bad_map.json") << j["characters"][0]["animation"]["jointMap"].dump();
+  j["characters"][0]["animation"]["jointMap"] = (dir_ / "bad_map.json").string();
+  try {
+    replay::runReplayJob(scene(j), jobOptions());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad_map.json: chest.shares"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }
 

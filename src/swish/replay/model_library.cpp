@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "swish/core/error.hpp"
+#include "swish/files/json_reader.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/io/bvh_reader.hpp"
 #include "swish/model/model_file.hpp"
@@ -129,11 +130,12 @@ std::map<std::string, const Model*> ModelLibrary::modelMap() const {
 }
 
 std::shared_ptr<const AnimationClip> ModelLibrary::clip(const fs::path& file, const std::string& key,
-                                                        const nlohmann::json& jointMap, const std::string& what) {
+                                                        const nlohmann::json& jointMap, const std::string& source,
+                                                        const std::string& path) {
   auto& slot = clips_[{file.string(), key, jointMap.dump()}];
   if (!slot) {
     io::AnimationImportOptions o;
-    if (!jointMap.is_null()) o.retarget.jointMap = io::parseJointMap(jointMap, what);
+    if (!jointMap.is_null()) o.retarget.jointMap = io::parseJointMap(JsonReader(jointMap, source, path));
     o.retarget.requiredJoints.clear();  // a model's input joints are checked below, by the caller's model
     for (uint32_t j : at(key).model.inputJoints)
       o.retarget.requiredJoints.push_back(at(key).model.skeleton.joints[j].name);

@@ -41,11 +41,13 @@ class ModelLibrary {
   const std::vector<std::unique_ptr<ModelEntry>>& entries() const { return entries_; }
 
   // The clip of `file` retargeted onto model `key`'s skeleton through `jointMap` (io/joint_map.hpp's
-  // JSON form; null: by naming convention), imported once per (file, model, joint map). `what` names
-  // the joint map in errors ("scene.json: characters[2].animation.jointMap").
+  // JSON form; null: by naming convention), imported once per (file, model, joint map). Errors in the
+  // map name `source` and the JSON path from `path` (files/json_reader.hpp): "scene.json:
+  // characters[2].animation.jointMap.chest: ..." for an inline map, "daz.json: chest: ..." for a map
+  // file (source the file, path empty).
   std::shared_ptr<const AnimationClip> clip(const std::filesystem::path& file, const std::string& key,
-                                            const nlohmann::json& jointMap = nullptr,
-                                            const std::string& what = "jointMap");
+                                            const nlohmann::json& jointMap = nullptr, const std::string& source = "",
+                                            const std::string& path = "jointMap");
 
  private:
   std::vector<std::unique_ptr<ModelEntry>> entries_;

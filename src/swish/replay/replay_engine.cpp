@@ -163,10 +163,10 @@ void ReplayEngine::Impl::setUp() {
       const runtime::SceneCharacter& ch = scene.characters[c];
       try {
         if (ch.clip) {
-          const std::string mapName = ch.clip->jointMapFile.empty()
-                                          ? where + ": characters[" + std::to_string(c) + "].animation.jointMap"
-                                          : ch.clip->jointMapFile.string();
-          auto clip = models.clip(ch.clip->file, ch.model, ch.clip->jointMap, mapName);
+          const bool inFile = !ch.clip->jointMapFile.empty();
+          auto clip =
+              models.clip(ch.clip->file, ch.model, ch.clip->jointMap, inFile ? ch.clip->jointMapFile.string() : where,
+                          inFile ? "" : "characters[" + std::to_string(c) + "].animation.jointMap");
           if (!ch.clip->clipName.empty() && ch.clip->clipName != clip->name)
             throw Error("the file's clip is '" + clip->name + "', not '" + ch.clip->clipName + "'");
           B.motions.emplace_back(clip, *ch.clip, B.model->skeleton, ch.name);

@@ -32,7 +32,12 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
 
   std::optional<CharacterMotion> motion;
   if (ch.clip)
-    motion.emplace(models.clip(ch.clip->file, ch.model, ch.clip->jointMap), *ch.clip, skeleton, ch.name);
+    motion.emplace(
+        models.clip(
+            ch.clip->file, ch.model, ch.clip->jointMap,
+            ch.clip->jointMapFile.empty() ? where : ch.clip->jointMapFile.string(),
+            ch.clip->jointMapFile.empty() ? "characters[" + std::to_string(o.character) + "].animation.jointMap" : ""),
+        *ch.clip, skeleton, ch.name);
   else if (ch.poseStream)
     motion.emplace(std::make_shared<PoseStream>(readPoseStream(*ch.poseStream)), skeleton, ch.name);
   else

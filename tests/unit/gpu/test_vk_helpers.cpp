@@ -32,8 +32,10 @@ TEST(VkHelpers, RequestedDeviceTakesTheOptionBeforeTheEnvironment) {
 }
 
 TEST(VkHelpers, DevicesRankDiscreteFirstAndCpuImplementationsLate) {
-  EXPECT_LT(deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU), deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU));
-  EXPECT_LT(deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU), deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU));
+  EXPECT_LT(deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU),
+            deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU));
+  EXPECT_LT(deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU),
+            deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU));
   EXPECT_LT(deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU), deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_CPU));
   EXPECT_LT(deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_CPU), deviceTypeRank(VK_PHYSICAL_DEVICE_TYPE_OTHER));
 }
@@ -43,13 +45,13 @@ TEST(VkHelpers, MemoryTypePrefersThenRequires) {
   mp.memoryTypeCount = 3;
   mp.memoryTypes[0].propertyFlags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   mp.memoryTypes[1].propertyFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  mp.memoryTypes[2].propertyFlags = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT |
-                                    VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+  mp.memoryTypes[2].propertyFlags =
+      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
   const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  EXPECT_EQ(findMemoryType(mp, 0b111, host), 1u);                                     // the first that has it
+  EXPECT_EQ(findMemoryType(mp, 0b111, host), 1u);                                      // the first that has it
   EXPECT_EQ(findMemoryType(mp, 0b111, host, VK_MEMORY_PROPERTY_HOST_CACHED_BIT), 2u);  // preferred when there
   EXPECT_EQ(findMemoryType(mp, 0b011, host, VK_MEMORY_PROPERTY_HOST_CACHED_BIT), 1u);  // else required alone
-  EXPECT_EQ(findMemoryType(mp, 0b001, host), std::nullopt);                           // type bits rule
+  EXPECT_EQ(findMemoryType(mp, 0b001, host), std::nullopt);                            // type bits rule
   EXPECT_EQ(findMemoryType(mp, 0b111, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT), 0u);
 }
 
