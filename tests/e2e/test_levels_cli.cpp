@@ -46,12 +46,16 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   const test::TempDir tmp("levels_cli");
   const fs::path out = tmp / "models" / "default_levels.swish", report = tmp / "report";
   const std::string before = readText(defaultModel());
-  const CommandResult r = swishCmd({"levels", defaultModel().string(), "--frames", "2", "--threads", "2", "--out",
-                                    out.string(), "--report", report.string()});
+  // The clips are given: the default model is baked from the motion corpus of ../shared/mocap, and its
+  // metadata names those clips where the bake read them. Debian's 01_01 and 01_03 are two of the corpus's
+  // training clips (subject 01, at their recorded 120 fps).
+  const CommandResult r =
+      swishCmd({"levels", defaultModel().string(), "--clips", test::debianMocap("01_01.bvh").string(),
+                test::debianMocap("01_03.bvh").string(), "--frames", "2", "--threads", "2", "--out", out.string(),
+                "--report", report.string()});
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("truth 2/2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("s left"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("random frames of the training clips"), std::string::npos) << r.out;
   EXPECT_EQ(readText(defaultModel()), before);  // --out: the model given is left as it was
 
   const Model m = loadModel(out);
@@ -64,12 +68,13 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   ASSERT_EQ(l.size(), 5u);  // K = 128 with maps: full, k64, k32-flat, k16-flat, skinned
   EXPECT_GE(l.poses, 1u);
   EXPECT_LE(l.poses, 2u);
-  EXPECT_NE(l.measuredOn.find("training clips 01_01.bvh, 01_03.bvh"), std::string::npos) << l.measuredOn;
+  EXPECT_NE(l.measuredOn.find("the clips 01_01.bvh, 01_03.bvh"), std::string::npos) << l.measuredOn;
   EXPECT_FALSE(l.timedOn.empty());
   const runtime::QualityLevel &full = l.levels.front(), &skinned = l.levels.back();
-  // The default model's held-out error is 1.88 mm; the mean shape alone misses the pose's correctives.
+  // The default model's held-out error is 14.8 mm mean, 33 mm p95 on random held-out frames of its
+  // training clips (assets/default/report); the mean shape alone misses the pose's correctives.
   EXPECT_GT(full.vertexMeanMm, 0.1);
-  EXPECT_LT(full.vertexMeanMm, 10.0);
+  EXPECT_LT(full.vertexMeanMm, 33.0);
   EXPECT_GT(skinned.vertexMeanMm, 2.0 * full.vertexMeanMm);
   EXPECT_TRUE(std::isfinite(full.normalMeanDeg));
   EXPECT_GT(full.cpuUsPerCharacter, 0.0);
@@ -80,7 +85,7 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   EXPECT_TRUE(fs::exists(report / "quality_levels.svg"));
   const auto j = nlohmann::json::parse(readText(report / "levels.json"));
   EXPECT_EQ(j["frames"].size(), 2u);
-  EXPECT_TRUE(j["clips_are_the_models_own"].get<bool>());
+  EXPECT_FALSE(j["clips_are_the_models_own"].get<bool>());  // --clips given
   EXPECT_EQ(j["quality_levels"]["levels"].size(), 5u);
 }
 
