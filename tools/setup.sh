@@ -7,6 +7,7 @@ PACKAGES=(
   cmake ninja-build g++ pkg-config git             # build
   clang libclang-rt-14-dev                         # libFuzzer target for the model loader
   clang-format                                     # tools/format.sh and the format_check test
+  clang-tidy                                       # tools/tidy.sh (the checks of .clang-tidy)
   libvulkan-dev vulkan-tools                       # Vulkan loader, headers (incl. Vulkan-Hpp), vulkaninfo
   glslang-tools spirv-tools                        # GLSL -> SPIR-V at build time, spirv-val
   vulkan-validationlayers mesa-vulkan-drivers      # validation layers, lavapipe (CPU Vulkan device)
