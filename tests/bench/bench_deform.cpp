@@ -125,16 +125,7 @@ void BM_Deform(benchmark::State& state) {
   const uint32_t instances = uint32_t(state.range(0));
   DeformSetup s = makeSetup(*ctx, instances, state.range(1) != 0);
   gpu::TimestampQueries ts(*ctx, 2);
-  gpu::DeformPass::Args a;
-  a.mean = s.gpuModel->mean.address();
-  a.basis = s.gpuModel->basis.address();
-  a.instanceInputs = s.instanceInputs.get();
-  a.skinJoints = s.gpuModel->skinJoints.address();
-  a.skinWeights = s.gpuModel->skinWeights.address();
-  a.positionsOut = s.positions.address();
-  a.vertexCount = 3000;
-  a.instanceCount = instances;
-  a.jointCount = uint32_t(s.model.skeleton.size());
+  gpu::DeformPass::Args a = s.gpuModel->deformArgs(s.instanceInputs.get(), s.positions, instances);
   // Warm-up: lavapipe compiles a pipeline at its first dispatch; that is not the kernel's cost.
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); });
   gpuSeconds(*ctx, ts,
@@ -184,16 +175,7 @@ void BM_DeformPushOut(benchmark::State& state) {
   gpu::Buffer caps(*ctx, posed.size() * 4, gpu::MemoryKind::DeviceLocal, "posed capsules");
   caps.upload(*ctx, posed.data(), posed.size() * 4);
   gpu::TimestampQueries ts(*ctx, 2);
-  gpu::DeformPass::Args a;
-  a.mean = s.gpuModel->mean.address();
-  a.basis = s.gpuModel->basis.address();
-  a.instanceInputs = s.instanceInputs.get();
-  a.skinJoints = s.gpuModel->skinJoints.address();
-  a.skinWeights = s.gpuModel->skinWeights.address();
-  a.positionsOut = s.positions.address();
-  a.vertexCount = 3000;
-  a.instanceCount = instances;
-  a.jointCount = uint32_t(s.model.skeleton.size());
+  gpu::DeformPass::Args a = s.gpuModel->deformArgs(s.instanceInputs.get(), s.positions, instances);
   gpu::DeformPass::Args pushed = a;
   pushed.capsules = caps.address();
   pushed.capsuleCount = capsules;
@@ -230,16 +212,7 @@ void BM_TangentFrames(benchmark::State& state) {
   DeformSetup s = makeSetup(*ctx, instances, true);
   const gpu::GpuModel& g = *s.gpuModel;
   gpu::TimestampQueries ts(*ctx, 2);
-  gpu::DeformPass::Args d;
-  d.mean = g.mean.address();
-  d.basis = g.basis.address();
-  d.instanceInputs = s.instanceInputs.get();
-  d.skinJoints = g.skinJoints.address();
-  d.skinWeights = g.skinWeights.address();
-  d.positionsOut = s.positions.address();
-  d.vertexCount = g.vertexCount();
-  d.instanceCount = instances;
-  d.jointCount = g.jointCount();
+  gpu::DeformPass::Args d = g.deformArgs(s.instanceInputs.get(), s.positions, instances);
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, d); });  // the positions to frame
   const VkDeviceSize n = g.vertexCount();
   gpu::Buffer normals(*ctx, instances * n * 12, gpu::MemoryKind::DeviceLocal, "normals");
@@ -424,15 +397,7 @@ void BM_DeformLevels(benchmark::State& state) {
     r.order.upload(*ctx, levels.order.data(), levels.order.size() * 4);
     r.inputs = pass.bindInstanceInputs(*ctx, r.weights, matrices, &g.basis);
     gpu::DeformPass::Args& a = r.args;
-    a.mean = g.mean.address();
-    a.basis = g.basis.address();
-    a.instanceInputs = r.inputs.get();
-    a.skinJoints = g.skinJoints.address();
-    a.skinWeights = g.skinWeights.address();
-    a.positionsOut = positions.address();
-    a.vertexCount = g.vertexCount();
-    a.instanceCount = instances;
-    a.jointCount = g.jointCount();
+    a = g.deformArgs(r.inputs.get(), positions, instances);
     if (configs[c].bands) {
       a.instanceOrder = r.order.address();
       a.bandEnd = levels.bandEnd;

@@ -133,16 +133,7 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
   f.timestamps.reset(cmd);
   f.timestamps.mark(cmd, kBegin);
 
-  DeformPass::Args d;
-  d.mean = m.mean.address();
-  d.basis = m.basis.address();
-  d.instanceInputs = f.deformInputs.get();
-  d.skinJoints = m.skinJoints.address();
-  d.skinWeights = m.skinWeights.address();
-  d.positionsOut = f.positions.address();
-  d.vertexCount = m.vertexCount();
-  d.instanceCount = in.instanceCount;
-  d.jointCount = m.jointCount();
+  DeformPass::Args d = m.deformArgs(f.deformInputs.get(), f.positions, in.instanceCount);
   if (pushOut) {
     d.capsules = f.posedCapsules.address();
     d.capsuleCount = m.capsuleCount();

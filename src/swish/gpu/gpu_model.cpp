@@ -134,4 +134,19 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   }
 }
 
+DeformPass::Args GpuModel::deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut,
+                                      uint32_t instances) const {
+  DeformPass::Args a;
+  a.mean = mean.address();
+  a.basis = basis.address();
+  a.instanceInputs = instanceInputs;
+  a.skinJoints = skinJoints.address();
+  a.skinWeights = skinWeights.address();
+  a.positionsOut = positionsOut.address();
+  a.vertexCount = vertexCount_;
+  a.instanceCount = instances;
+  a.jointCount = jointCount_;
+  return a;
+}
+
 }  // namespace swish::gpu

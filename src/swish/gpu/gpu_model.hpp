@@ -10,6 +10,7 @@
 #include <string>
 
 #include "swish/gpu/buffer.hpp"
+#include "swish/gpu/deform_pass.hpp"
 #include "swish/model/model.hpp"
 
 namespace swish::gpu {
@@ -37,6 +38,10 @@ class GpuModel {
   // The body proxy the deform kernel's push-out poses each frame (on the CPU; no GPU copy of its own).
   const BodyProxy& bodyProxy() const { return bodyProxy_; }
   uint32_t capsuleCount() const { return uint32_t(bodyProxy_.capsules.size()); }
+
+  // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
+  // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
+  DeformPass::Args deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut, uint32_t instances) const;
 
   Buffer mean, basis, skinJoints, skinWeights;
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;
