@@ -1,6 +1,10 @@
 #include "swish/core/skinning.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+
+#include <Eigen/SVD>
 
 #include "swish/core/error.hpp"
 
@@ -24,16 +28,42 @@ Points3f skinPositions(const Points3f& pre, const SkinWeights& skin, const std::
   return out;
 }
 
-Points3f unskinPositions(const Points3f& posed, const SkinWeights& skin, const std::vector<Mat4f>& m) {
+Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const SkinWeights& skin,
+                         const std::vector<Mat4f>& m, const UnskinSettings& settings, UnskinStats* stats) {
+  if (reference.rows() != posed.rows())
+    throw Error("un-skinning: " + std::to_string(posed.rows()) + " posed positions but " +
+                std::to_string(reference.rows()) + " reference positions");
+  if (!(settings.minSingularValue > 0.f && settings.minSingularValue <= 1.f))
+    throw Error("un-skinning: the smallest trusted singular value must be in (0, 1]");
+  const float floor = settings.minSingularValue;
+  UnskinStats st;
   Points3f out(posed.rows(), 3);
   for (Eigen::Index v = 0; v < posed.rows(); ++v) {
     const Mat4f b = blendedSkinMatrix(skin, size_t(v), m);
     const Mat3f a = b.topLeftCorner<3, 3>();
-    const float det = a.determinant();
-    if (!(std::abs(det) > 1e-6f))
-      throw Error("cannot un-skin vertex " + std::to_string(v) + ": its blended skinning matrix is singular");
-    out.row(v) = (a.inverse() * (posed.row(v).transpose() - b.topRightCorner<3, 1>())).transpose();
+    const Vec3f y = posed.row(v).transpose() - b.topRightCorner<3, 1>();
+    // The smallest singular value is at least |det| / s_max^2 >= |det| / |A|_F^2: a cheap proof that
+    // the matrix is well conditioned, true for almost every vertex.
+    const float frob2 = a.squaredNorm();
+    if (frob2 > 0.f && std::abs(a.determinant()) >= floor * frob2) {
+      out.row(v) = (a.inverse() * y).transpose();
+      continue;
+    }
+    const Eigen::JacobiSVD<Mat3f> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Vec3f s = svd.singularValues();
+    if (s.minCoeff() >= floor) {
+      out.row(v) = (a.inverse() * y).transpose();
+      continue;
+    }
+    ++st.dampedVertices;
+    st.smallestSingularValue = std::min(st.smallestSingularValue, s.minCoeff());
+    Vec3f f;
+    for (int k = 0; k < 3; ++k) f[k] = s[k] >= floor ? 1.f / s[k] : s[k] / (floor * floor);
+    const Vec3f ref = reference.row(v).transpose();
+    const Vec3f x = ref + svd.matrixV() * f.asDiagonal() * svd.matrixU().transpose() * (y - a * ref);
+    out.row(v) = x.transpose();
   }
+  if (stats) *stats = st;
   return out;
 }
 

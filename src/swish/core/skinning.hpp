@@ -11,8 +11,30 @@ Mat4f blendedSkinMatrix(const SkinWeights& skin, size_t vertex, const std::vecto
 // Skins pre-skinning-space positions (N x 3) with the given matrices.
 Points3f skinPositions(const Points3f& preSkin, const SkinWeights& skin, const std::vector<Mat4f>& skinMatrices);
 
-// Inverse: character-space positions -> pre-skinning space, by inverting each vertex's blended
-// matrix. Throws Error if a blended matrix is singular (a vertex whose weights cancel a rotation).
-Points3f unskinPositions(const Points3f& posed, const SkinWeights& skin, const std::vector<Mat4f>& skinMatrices);
+// How far un-skinning trusts a vertex's blended matrix A (its upper 3x3). Linear blend skinning
+// collapses where a vertex's joints turn far apart: two joints half-and-half, turned 180 degrees
+// relative to each other, blend to a matrix with a zero singular value (the candy wrapper), and a
+// shape there has no pre-skinning position. An exact inverse then throws a millimetre of posed
+// shape metres away (measured on the corpus bake: a shoulder vertex of an arms-overhead pose 180 m
+// from rest), and one such pose takes over the PCA basis and the network's loss. So along each
+// singular direction with singular value s < minSingularValue the inverse is damped to s / floor^2
+// instead of 1 / s (continuous at the floor, zero at s = 0): the displacement from the reference
+// (rest) position there is amplified at most 1 / floor, never without bound. Directions at or
+// above the floor are inverted exactly, so a vertex whose matrix is well conditioned gets the exact
+// inverse, bitwise as before.
+struct UnskinSettings {
+  float minSingularValue = 0.2f;  // rigid skinning: all 1; 0.2 is two joints 157 degrees apart, half and half
+};
+struct UnskinStats {
+  size_t dampedVertices = 0;          // vertices with a singular value below the floor
+  float smallestSingularValue = 1.f;  // the smallest among them (1 when none)
+};
+
+// Inverse: character-space positions -> pre-skinning space, per vertex (posed - t) through the
+// blended matrix's inverse, damped as above towards `reference` (the pre-skin positions to fall
+// back on, the rest shape: same size as `posed`).
+Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const SkinWeights& skin,
+                         const std::vector<Mat4f>& skinMatrices, const UnskinSettings& settings = {},
+                         UnskinStats* stats = nullptr);
 
 }  // namespace swish

@@ -67,9 +67,52 @@ TEST(Skinning, UnskinInvertsSkin) {
   Model m = test::makeRandomModel(rng);
   const auto mats = m.skeleton.skinningMatrices(test::makeRandomPose(rng, m.skeleton));
   const Points3f posed = skinPositions(m.gameMesh.positions, m.gameMesh.skin, mats);
-  const Points3f back = unskinPositions(posed, m.gameMesh.skin, mats);
+  const Points3f back = unskinPositions(posed, m.gameMesh.positions, m.gameMesh.skin, mats);
   EXPECT_LT((back - m.gameMesh.positions).cwiseAbs().maxCoeff(), 1e-4f);
   EXPECT_GT((posed - m.gameMesh.positions).cwiseAbs().maxCoeff(), 1e-3f);  // the pose did move it
+}
+
+// The candy wrapper: a vertex half on each of two joints turned 180 degrees apart has a blended
+// matrix with two zero singular values, and one turned 170 degrees apart two of cos(85 deg) = 0.087.
+// The exact inverse amplifies its offset from the skinned reference 11x (at 170 degrees; without
+// bound at 180), the damped one at most 1 / floor = 5x; a vertex on one joint is inverted exactly.
+TEST(Skinning, UnskinDampsCollapsedVerticesTowardsTheReference) {
+  auto turn = [](float degrees) {
+    Mat4f m = Mat4f::Identity();
+    m.topLeftCorner<3, 3>() = Eigen::AngleAxisf(degrees * float(M_PI) / 180.f, Vec3f::UnitX()).toRotationMatrix();
+    return m;
+  };
+  SkinWeights skin;
+  skin.influences = 2;
+  skin.joints = {0, 1, 0, 1, 0, 1};
+  skin.weights = {0.5f, 0.5f, 0.5f, 0.5f, 1.f, 0.f};
+  Points3f reference(3, 3);
+  reference << 0.f, 0.1f, 0.f, 0.f, 0.1f, 0.f, 0.f, 0.1f, 0.f;
+  const float floor = UnskinSettings{}.minSingularValue;
+  for (const float degrees : {170.f, 180.f}) {
+    const std::vector<Mat4f> mats = {Mat4f::Identity(), turn(degrees)};
+    // The reference skinned, then moved 5 mm off it in y (the collapsed plane) and 5 mm in x (the axis).
+    Points3f posed = skinPositions(reference, skin, mats);
+    posed.rowwise() += Eigen::RowVector3f(0.005f, 0.005f, 0.f);
+    UnskinStats stats;
+    const Points3f back = unskinPositions(posed, reference, skin, mats, {}, &stats);
+    EXPECT_EQ(stats.dampedVertices, 2u) << degrees << " degrees";
+    EXPECT_LE(stats.smallestSingularValue, std::cos(85.f * float(M_PI) / 180.f) + 1e-4f);
+    for (int v = 0; v < 2; ++v) {
+      const float offset = (back.row(v) - reference.row(v)).norm();
+      EXPECT_TRUE(std::isfinite(offset));
+      // x is along the turn's axis (singular value 1, exact: 5 mm); y at most 5x its 5 mm.
+      EXPECT_NEAR(back(v, 0) - reference(v, 0), 0.005f, 1e-5f);
+      EXPECT_LE(std::abs(back(v, 1) - reference(v, 1)), 0.005f / floor + 1e-5f) << degrees << " degrees";
+    }
+    // The rigid vertex: exact.
+    const Vec3f expected = mats[0].topLeftCorner<3, 3>().inverse() * posed.row(2).transpose();
+    EXPECT_LT((back.row(2).transpose() - expected).norm(), 1e-6f);
+  }
+  // Out of range settings and mismatched sizes are errors, not silent results.
+  const std::vector<Mat4f> mats = {Mat4f::Identity(), turn(90.f)};
+  EXPECT_THROW(unskinPositions(reference, reference, skin, mats, UnskinSettings{0.f}), Error);
+  EXPECT_THROW(unskinPositions(reference, Points3f(2, 3), skin, mats), Error);
 }
 
 TEST(MeshFrames, FlatGridHasUnitFramesAlongUvAxes) {

@@ -10,6 +10,7 @@
 #include "swish/bake/transfer/laplacian_smoothing.hpp"
 #include "swish/bake/transfer/mesh_transfer.hpp"
 #include "swish/bake/transfer/normal_map_baker.hpp"
+#include "swish/core/skinning.hpp"
 
 namespace swish::bake {
 
@@ -24,6 +25,7 @@ struct TransferredPose {
   NormalMapImage normalMap;
   NormalMapBakeStats bakeStats;
   float maxSmoothingShift = 0.f;  // largest distance smoothing moved a vertex (metres)
+  UnskinStats unskin;             // vertices whose skinning collapsed, un-skinned damped (core/skinning.hpp)
 };
 
 class PoseTransfer {
