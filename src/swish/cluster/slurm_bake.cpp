@@ -410,7 +410,7 @@ nlohmann::json submitSlurmBake(const bake::BakeConfig& cfg, const fs::path& conf
       return "";
     }
     try {
-      const std::string id = submit(argv, o.log);
+      std::string id = submit(argv, o.log);
       submitted.push_back(id);
       return id;
     } catch (const Error&) {

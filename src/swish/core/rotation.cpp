@@ -5,7 +5,7 @@
 namespace swish {
 
 SanitizedQuat sanitizeQuaternion(const Quatf& q) {
-  const Vec4f c = q.coeffs();
+  const Vec4f& c = q.coeffs();
   if (!c.allFinite()) return {Quatf::Identity(), QuatStatus::Invalid};
   const double n =
       std::sqrt(double(c.x()) * c.x() + double(c.y()) * c.y() + double(c.z()) * c.z() + double(c.w()) * c.w());

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "swish/core/error.hpp"
 
@@ -46,7 +47,7 @@ JsonReader JsonReader::required(const char* key) const {
 
 JsonReader JsonReader::section(const std::string& key, std::initializer_list<const char*> allowed) const {
   static const json empty = json::object();
-  const JsonReader r = j_.contains(key) ? child(key) : JsonReader(empty, source_, child(key).path());
+  JsonReader r = j_.contains(key) ? child(key) : JsonReader(empty, source_, child(key).path());
   r.requireObject(allowed);
   return r;
 }
@@ -136,7 +137,7 @@ std::string JsonReader::nonEmptyString(const char* key, const std::string& fallb
 }
 
 std::vector<std::string> JsonReader::strings(const char* key, std::vector<std::string> fallback) const {
-  return has(key) ? child(key).strings() : fallback;
+  return has(key) ? child(key).strings() : std::move(fallback);
 }
 
 }  // namespace swish

@@ -16,7 +16,7 @@ std::optional<Quatd> kabsch(const std::vector<Vec3d>& a, const std::vector<Vec3d
   Mat3d h = Mat3d::Zero();
   for (size_t i = 0; i < a.size(); ++i) h += a[i] * b[i].transpose();
   Eigen::JacobiSVD<Mat3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const auto s = svd.singularValues();
+  const auto& s = svd.singularValues();
   if (s[1] < 1e-3 * std::max(s[0], 1e-12)) return std::nullopt;
   Mat3d d = Mat3d::Identity();
   d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;

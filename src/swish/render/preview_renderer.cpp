@@ -72,7 +72,7 @@ struct PreviewRenderer::State {
   uint64_t frame = 0;
   api::FrameReport lastReport;
 
-  State(HostDevice& d, api::Runtime rt, api::Model m, PreviewOptions o)
+  State(HostDevice& d, api::Runtime rt, const api::Model& m, PreviewOptions o)
       : dev(&d),
         runtime(std::move(rt)),
         model(m),
@@ -161,11 +161,12 @@ size_t BodyMesh::hideCovered(const api::ModelInfo& model) {
   return hidden;
 }
 
-PreviewRenderer::PreviewRenderer(HostDevice& device, api::Runtime runtime, api::Model model, PreviewOptions options) {
+PreviewRenderer::PreviewRenderer(HostDevice& device, api::Runtime runtime, const api::Model& model,
+                                 PreviewOptions options) {
   if (options.width == 0 || options.height == 0 || options.width > 8192 || options.height > 8192)
     throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: image size must be 1..8192 a side");
   if (options.body) options.body->validate(model.info().jointNames.size());
-  s_ = std::make_unique<State>(device, std::move(runtime), std::move(model), std::move(options));
+  s_ = std::make_unique<State>(device, std::move(runtime), model, std::move(options));
   State& s = *s_;
   VkDevice dev = device.device();
   const api::ModelInfo& info = s.model.info();

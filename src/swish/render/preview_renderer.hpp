@@ -63,7 +63,7 @@ struct PreviewVariant {
 class PreviewRenderer {
  public:
   // `device` must be the device `runtime` adopted; `model` loaded on that runtime.
-  PreviewRenderer(HostDevice& device, api::Runtime runtime, api::Model model, PreviewOptions options);
+  PreviewRenderer(HostDevice& device, api::Runtime runtime, const api::Model& model, PreviewOptions options);
   ~PreviewRenderer();
   PreviewRenderer(const PreviewRenderer&) = delete;
   PreviewRenderer& operator=(const PreviewRenderer&) = delete;

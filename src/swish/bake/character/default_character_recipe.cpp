@@ -188,7 +188,7 @@ DefaultCharacterRecipe parseDefaultCharacterRecipe(const JsonReader& j) {
   }
   if (r.joints.empty() || !r.joints[0].parent.empty()) joints.fail("the first joint must be the root (parent \"\")");
   auto known = [&](const JsonReader& name) {
-    const std::string n = name.string();
+    std::string n = name.string();
     if (!names.count(n) && !(r.mirrorSkeleton && names.count(mirroredJointName(n))))
       name.fail("unknown joint '" + n + "'");
     return n;

@@ -15,7 +15,7 @@ namespace {
 std::filesystem::path existingFile(const JsonReader& r, const std::filesystem::path& baseDir) {
   if (!r.value().is_string() || r.value().get<std::string>().empty())
     r.fail("must be a non-empty string (a file path)");
-  const std::filesystem::path f = baseDir / r.value().get<std::string>();
+  std::filesystem::path f = baseDir / r.value().get<std::string>();
   if (!std::filesystem::is_regular_file(f)) r.fail("file " + f.string() + " does not exist");
   return f;
 }
