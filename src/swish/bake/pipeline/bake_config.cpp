@@ -145,7 +145,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
     sim.fail(e.what());
   }
 
-  const JsonReader tr = j.section("transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights"});
+  const JsonReader tr = j.section(
+      "transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights", "unskin_min_singular_value"});
   LaplacianSmoothingSettings& ls = s.transfer.smoothing;
   ls.strength = float(tr.number("smoothing_strength", 0, 1, ls.strength));
   ls.iterations = int(tr.wholeNumber("smoothing_iterations", 0, 1000, ls.iterations));
@@ -156,6 +157,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
     ls.weights = LaplacianWeights::Uniform;
   else
     tr.child("smoothing_weights").fail("'" + weights + "' is not one of cotangent, uniform");
+  UnskinSettings& un = s.transfer.unskin;
+  un.minSingularValue = float(tr.number("unskin_min_singular_value", 0.01, 1, un.minSingularValue));
 
   const JsonReader nm = j.section("normal_maps", {"size", "max_distance", "dilation_rings", "bit_depth"});
   NormalMapBakeSettings& nb = s.transfer.normalMap;

@@ -39,7 +39,8 @@
 //                      "character" (default) | "world" with "units_per_metre", "up_axis" (y|z), "origin"
 //                      (external_simulation.hpp; `swish bake CONFIG --export-poses DIR` writes what
 //                      the external tool needs)},
-//       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights"},
+//       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
+//                    "unskin_min_singular_value" (0.01-1, default 0.2: core/skinning.hpp)},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}
 //     },

@@ -247,7 +247,8 @@ nlohmann::json DatasetBuildSettings::toJson() const {
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength},
         {"smoothing_iterations", transfer.smoothing.iterations},
-        {"smoothing_weights", transfer.smoothing.weights == LaplacianWeights::Cotangent ? "cotangent" : "uniform"}}},
+        {"smoothing_weights", transfer.smoothing.weights == LaplacianWeights::Cotangent ? "cotangent" : "uniform"},
+        {"unskin_min_singular_value", transfer.unskin.minSingularValue}}},
       {"normal_maps",
        {{"size", transfer.normalMap.width},
         {"max_distance", transfer.normalMap.maxDistance},
@@ -280,6 +281,10 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"simulations_reused", simulationsReused},
           {"transferred", transferred},
           {"transfers_reused", transfersReused},
+          {"unskin_damped",
+           {{"poses", unskinDampedPoses},
+            {"max_vertices", unskinDampedMaxVertices},
+            {"smallest_singular_value", unskinSmallestSingularValue}}},
           {"failed", f},
           {"rebuilt", rebuilt},
           {"simulation", simulationReport},
@@ -583,6 +588,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   auto one = [&](size_t k) {
     const uint32_t id = todo[k];
     std::string failure;
+    UnskinStats unskin;
     try {
       if (external) {
         // Another tool's shape: read, matched to the simulation mesh, then the same transfer.
@@ -594,6 +600,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         }
         if (failure.empty()) {
           TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], positions);
+          unskin = tp.unskin;
           DatasetPose dp;
           dp.id = id;
           dp.pose = recorded[id];
@@ -619,6 +626,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         // The pre-skin shape from the corrected simulation, the world shape skinned with the
         // recorded pose (pose_shape.hpp); the dataset keeps the recorded pose.
         TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], rec->result.positions);
+        unskin = tp.unskin;
         DatasetPose dp;
         dp.id = id;
         dp.pose = recorded[id];
@@ -638,6 +646,11 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
       log("part 1: pose " + std::to_string(id) + " left out: " + failure);
     } else {
       ++res.transferred;
+      if (unskin.dampedVertices > 0) {
+        ++res.unskinDampedPoses;
+        res.unskinDampedMaxVertices = std::max(res.unskinDampedMaxVertices, unskin.dampedVertices);
+        res.unskinSmallestSingularValue = std::min(res.unskinSmallestSingularValue, unskin.smallestSingularValue);
+      }
     }
     if (transferThrottle.due(n, total)) {
       const double el = since(transferStart);
@@ -651,6 +664,15 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     tbb::parallel_for(size_t(0), total, size_t(1), one);
   }
   std::sort(res.failed.begin(), res.failed.end(), [](const FailedPose& a, const FailedPose& b) { return a.id < b.id; });
+  if (res.unskinDampedPoses > 0) {
+    char line[300];
+    std::snprintf(line, sizeof line,
+                  "part 1: %zu of %zu poses have garment vertices where skinning collapses (up to %zu in a pose, "
+                  "smallest singular value %.3f): un-skinned damped towards rest (core/skinning.hpp)",
+                  res.unskinDampedPoses, res.transferred, res.unskinDampedMaxVertices,
+                  double(res.unskinSmallestSingularValue));
+    log(line);
+  }
   nlohmann::json source = {{"tool", "swish bake (part 1)"},
                            {"samples", res.samples},
                            {"kept_poses", res.keptPoses},

@@ -148,6 +148,10 @@ struct DatasetBuildResult {
   size_t simulationVertices = 0;
   size_t simulated = 0, simulationsReused = 0;
   size_t transferred = 0, transfersReused = 0;
+  // Transferred poses (this run's, not reused ones) with vertices whose skinning collapsed, un-skinned
+  // damped (core/skinning.hpp): how many, the most such vertices in one pose, the smallest singular value.
+  size_t unskinDampedPoses = 0, unskinDampedMaxVertices = 0;
+  float unskinSmallestSingularValue = 1.f;
   std::vector<FailedPose> failed;  // left out of the dataset, with the reason
   // The simulation's report (cloth/simulation_quality.hpp): failures per reason, retried poses, seconds
   // per pose per core, equilibrium residuals, and "quality" (convergence, noise) when measured.

@@ -19,6 +19,7 @@ const Character& checked(const Character& c) {
 PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, const Triangles& simTriangles,
                            const PoseTransferSettings& settings)
     : character_(&checked(character)),
+      unskin_(settings.unskin),
       simTriangles_(simTriangles),
       simTopology_(buildFrameTopology(simTriangles, simRest)),
       transfer_(simRest, simTriangles, character.garment.positions, "pose transfer: binding the game mesh"),
@@ -33,7 +34,7 @@ TransferredPose PoseTransfer::transfer(const Pose& pose, const Points3f& simPose
   TransferredPose out;
   out.gameMeshWorld = smoother_.smoothDisplacement(followed, skinned);
   out.maxSmoothingShift = (out.gameMeshWorld - followed).rowwise().norm().maxCoeff();
-  out.gameMeshPreSkin = unskinPositions(out.gameMeshWorld, g.positions, g.skin, mats, {}, &out.unskin);
+  out.gameMeshPreSkin = unskinPositions(out.gameMeshWorld, g.positions, g.skin, mats, unskin_, &out.unskin);
   out.normalMap = baker_.bake(out.gameMeshWorld, simPosed, simTriangles_, simTopology_, &out.bakeStats);
   return out;
 }

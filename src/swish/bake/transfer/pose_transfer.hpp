@@ -17,6 +17,7 @@ namespace swish::bake {
 struct PoseTransferSettings {
   LaplacianSmoothingSettings smoothing;
   NormalMapBakeSettings normalMap;
+  UnskinSettings unskin;  // where the garment's skinning collapses (core/skinning.hpp)
 };
 
 struct TransferredPose {
@@ -41,6 +42,7 @@ class PoseTransfer {
 
  private:
   const Character* character_;
+  UnskinSettings unskin_;
   Triangles simTriangles_;
   MeshFrameTopology simTopology_;
   MeshTransfer transfer_;
