@@ -145,8 +145,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
     sim.fail(e.what());
   }
 
-  const JsonReader tr = j.section(
-      "transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights", "unskin_min_singular_value"});
+  const JsonReader tr = j.section("transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
+                                               "unskin_min_singular_value", "max_edge_strain"});
   LaplacianSmoothingSettings& ls = s.transfer.smoothing;
   ls.strength = float(tr.number("smoothing_strength", 0, 1, ls.strength));
   ls.iterations = int(tr.wholeNumber("smoothing_iterations", 0, 1000, ls.iterations));
@@ -159,6 +159,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
     tr.child("smoothing_weights").fail("'" + weights + "' is not one of cotangent, uniform");
   UnskinSettings& un = s.transfer.unskin;
   un.minSingularValue = float(tr.number("unskin_min_singular_value", 0.01, 1, un.minSingularValue));
+  s.transfer.maxEdgeStrain = float(tr.number("max_edge_strain", 0.5, 1000, s.transfer.maxEdgeStrain));
 
   const JsonReader nm = j.section("normal_maps", {"size", "max_distance", "dilation_rings", "bit_depth"});
   NormalMapBakeSettings& nb = s.transfer.normalMap;

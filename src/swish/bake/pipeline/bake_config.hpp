@@ -40,7 +40,9 @@
 //                      (external_simulation.hpp; `swish bake CONFIG --export-poses DIR` writes what
 //                      the external tool needs)},
 //       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
-//                    "unskin_min_singular_value" (0.01-1, default 0.2: core/skinning.hpp)},
+//                    "unskin_min_singular_value" (0.01-1, default 0.2: core/skinning.hpp),
+//                    "max_edge_strain" (0.5-1000, default 4: a game-mesh edge stretched more fails
+//                    the pose as torn; transfer/pose_transfer.hpp)},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}
 //     },

@@ -1,5 +1,8 @@
 #include "swish/bake/transfer/pose_transfer.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 
@@ -24,7 +27,38 @@ PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, 
       simTopology_(buildFrameTopology(simTriangles, simRest)),
       transfer_(simRest, simTriangles, character.garment.positions, "pose transfer: binding the game mesh"),
       smoother_(character.garment.triangles, character.garment.positions, settings.smoothing),
-      baker_(character.garment.uvs, character.garment.triangles, character.garment.positions, settings.normalMap) {}
+      baker_(character.garment.uvs, character.garment.triangles, character.garment.positions, settings.normalMap) {
+  const Triangles& t = character.garment.triangles;
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = uint32_t(t(f, k)), b = uint32_t(t(f, (k + 1) % 3));
+      edges_.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(edges_.begin(), edges_.end());
+  edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
+  const Points3f& p = character.garment.positions;
+  edgeRest_.reserve(edges_.size());
+  for (const auto& [a, b] : edges_) edgeRest_.push_back((p.row(a) - p.row(b)).norm());
+  if (!edgeRest_.empty()) {
+    std::vector<float> sorted = edgeRest_;
+    std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
+    const float floor = 0.5f * sorted[sorted.size() / 2];
+    for (float& l : edgeRest_) l = std::max(l, floor);
+  }
+}
+
+EdgeStretch PoseTransfer::worstEdge(const Points3f& shape) const {
+  EdgeStretch w;
+  for (size_t e = 0; e < edges_.size(); ++e) {
+    const auto [a, b] = edges_[e];
+    const float strain = (shape.row(a) - shape.row(b)).norm() / edgeRest_[e] - 1.f;
+    if (strain > w.strain || !std::isfinite(strain)) {
+      w = {strain, a};
+      if (!std::isfinite(strain)) break;
+    }
+  }
+  return w;
+}
 
 TransferredPose PoseTransfer::transfer(const Pose& pose, const Points3f& simPosed) const {
   const Mesh& g = character_->garment;

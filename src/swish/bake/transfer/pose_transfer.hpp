@@ -4,7 +4,10 @@
 // skinned to the pose (laplacian_smoothing.hpp), un-skinned to pre-skinning space (core/skinning.hpp),
 // and the normal map of the detail the smoothed game mesh lacks (normal_map_baker.hpp). Built once per
 // character and simulation mesh; transfer() is const and may run for several poses at once.
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/transfer/laplacian_smoothing.hpp"
@@ -18,6 +21,19 @@ struct PoseTransferSettings {
   LaplacianSmoothingSettings smoothing;
   NormalMapBakeSettings normalMap;
   UnskinSettings unskin;  // where the garment's skinning collapses (core/skinning.hpp)
+  // A torn shape is not training data. A game-mesh edge stretched beyond this strain (4: five times
+  // its rest length, or half the median rest edge where that is longer) fails the pose. Measured on
+  // the corpus bake's 1960 poses (docs/baking.md): the worst edge of a pose is 1.8x its length at the
+  // median, 4.4x at p99; the poses above 5x are sleeves torn into sheets several metres long, which
+  // the re-skinning of a pose limb clearance changed (pose_shape.hpp) or the solver left.
+  float maxEdgeStrain = 4.f;
+};
+
+// The game mesh's worst edge in a shape: its strain (length / max(rest length, half the median rest
+// edge) - 1) and one of its vertices.
+struct EdgeStretch {
+  float strain = 0.f;
+  uint32_t vertex = 0;
 };
 
 struct TransferredPose {
@@ -39,10 +55,14 @@ class PoseTransfer {
   TransferredPose transfer(const Pose& pose, const Points3f& simPosed) const;
 
   const MeshTransfer& meshTransfer() const { return transfer_; }
+  // The worst edge of a game-mesh shape (world or pre-skin), against the game mesh's rest edges.
+  EdgeStretch worstEdge(const Points3f& gameMeshShape) const;
 
  private:
   const Character* character_;
   UnskinSettings unskin_;
+  std::vector<std::pair<uint32_t, uint32_t>> edges_;  // the game mesh's unique edges
+  std::vector<float> edgeRest_;                       // their rest lengths, floored at half the median
   Triangles simTriangles_;
   MeshFrameTopology simTopology_;
   MeshTransfer transfer_;

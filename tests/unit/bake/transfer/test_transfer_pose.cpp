@@ -1,6 +1,9 @@
 // The per-pose chain: bind, follow, smooth, un-skin, bake.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "support/random_model.hpp"
 #include "swish/bake/transfer/pose_transfer.hpp"
 #include "swish/core/error.hpp"
@@ -52,4 +55,36 @@ TEST(PoseTransfer, SimulationEqualToSkinnedGameMeshRoundTripsToRestAndFlatMap) {
   Character noUv = c;
   noUv.garment.uvs.resize(0, 2);
   EXPECT_THROW(PoseTransfer(noUv, c.garment.positions, c.garment.triangles, s), Error);
+}
+
+// The torn-shape measure: 0 at rest, the scale - 1 for a uniformly scaled shape (every edge above
+// the half-median floor stretches by exactly that), and large where one vertex is thrown away.
+TEST(PoseTransfer, WorstEdgeMeasuresStretchAgainstTheRestEdges) {
+  Rng rng(test::testSeed(602));
+  test::RandomModelSpec spec;
+  spec.vertices = 120;
+  const Model m = test::makeRandomModel(rng, spec);
+  Character c;
+  c.name = "random";
+  c.skeleton = m.skeleton;
+  c.garment = m.gameMesh;
+  c.body = m.gameMesh;
+  PoseTransferSettings s;
+  s.normalMap.width = s.normalMap.height = 32;
+  const PoseTransfer pt(c, c.garment.positions, c.garment.triangles, s);
+  EXPECT_LT(std::abs(pt.worstEdge(c.garment.positions).strain), 1e-5f);
+  EXPECT_NEAR(pt.worstEdge(c.garment.positions * 1.5f).strain, 0.5f, 1e-4f);
+  Points3f torn = c.garment.positions;
+  const uint32_t thrown = uint32_t(c.garment.triangles(5, 1));
+  torn(thrown, 0) += 1.f;  // a metre: the sheet of a torn sleeve
+  const EdgeStretch w = pt.worstEdge(torn);
+  EXPECT_GT(w.strain, 10.f);
+  bool onEdgeOfThrown = w.vertex == thrown;
+  for (Eigen::Index f = 0; f < c.garment.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (uint32_t(c.garment.triangles(f, k)) == thrown)
+        for (int o = 0; o < 3; ++o) onEdgeOfThrown |= uint32_t(c.garment.triangles(f, o)) == w.vertex;
+  EXPECT_TRUE(onEdgeOfThrown) << "worst edge at vertex " << w.vertex << ", thrown vertex " << thrown;
+  torn(thrown, 1) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(pt.worstEdge(torn).strain <= s.maxEdgeStrain);  // a non-finite shape never passes
 }
