@@ -278,6 +278,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "hidden_width",
                                                   "activation",
                                                   "learning_rate",
+                                                  "weight_decay",
                                                   "batch_size",
                                                   "max_epochs",
                                                   "patience",
@@ -314,6 +315,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
           "with the trainer, not for baked models");
   }
   t.mlp.learningRate = train.number("learning_rate", 1e-7, 1.0, t.mlp.learningRate);
+  t.mlp.weightDecay = train.number("weight_decay", 0, 100, t.mlp.weightDecay);
   t.mlp.batchSize = int(train.wholeNumber("batch_size", 1, 1 << 20, t.mlp.batchSize));
   t.mlp.maxEpochs = int(train.wholeNumber("max_epochs", 1, 1e7, t.mlp.maxEpochs));
   t.mlp.patience = int(train.wholeNumber("patience", 1, 1e7, t.mlp.patience));

@@ -38,7 +38,8 @@ nlohmann::json BakeTrainSettings::toJson() const {
                       {"test_fraction", testFraction},
                       {"temporal_time_constant", temporalTimeConstant},
                       {"seed", seed}};
-  if (!inputJoints.empty()) j["input_joints"] = inputJoints;  // absent: the dataset's (older fingerprints stay)
+  if (!inputJoints.empty()) j["input_joints"] = inputJoints;       // absent: the dataset's (older fingerprints stay)
+  if (mlp.weightDecay > 0.0) j["weight_decay"] = mlp.weightDecay;  // absent when off (older fingerprints stay)
   return j;
 }
 

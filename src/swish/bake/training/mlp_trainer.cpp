@@ -77,6 +77,8 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
   if (o.hiddenLayers < 0 || o.hiddenWidth < 1) throw Error("MLP training: hidden layers/width out of range");
   if (!(o.learningRate > 0.0) || o.batchSize < 1 || o.maxEpochs < 1 || o.patience < 1)
     throw Error("MLP training: learning rate, batch size, epochs and patience must be positive");
+  if (!(o.weightDecay >= 0.0) || !(o.weightDecay * o.learningRate < 1.0))
+    throw Error("MLP training: weight decay must be at least 0 and below 1 / learning rate");
   if (!(o.validationFraction > 0.0 && o.validationFraction < 1.0))
     throw Error("MLP training: validation fraction must be in (0, 1)");
   if (!o.outputWeights.empty() && Eigen::Index(o.outputWeights.size()) != outputs.rows())
@@ -162,7 +164,9 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
         s.v = beta2 * s.v + (1.f - beta2) * grad.cwiseAbs2();
         param.array() -= lr * (s.m.array() / c1) / ((s.v.array() / c2).sqrt() + eps);
       };
+      const float decay = 1.f - lr * float(o.weightDecay);
       for (int l = 0; l < net.layers(); ++l) {
+        if (o.weightDecay > 0.0) net.weights[size_t(l)] *= decay;
         adam(net.weights[size_t(l)], gW[size_t(l)], adamW[size_t(l)]);
         adam(net.biases[size_t(l)], gB[size_t(l)], adamB[size_t(l)]);
       }

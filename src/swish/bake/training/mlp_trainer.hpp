@@ -1,7 +1,8 @@
 #pragma once
 // Trains the regressor Lambda = R(Theta) of the paper (5 hidden layers of 32, SELU by default) with
-// Adam on standardised inputs and outputs, a held-out validation split and early stopping (the best
-// validation epoch is kept). Deterministic for a seed: one thread, fixed shuffles from swish::Rng.
+// Adam (optionally with decoupled weight decay) on standardised inputs and outputs, a held-out validation split and
+// early stopping (the best validation epoch is kept). Deterministic for a seed: one thread, fixed shuffles from
+// swish::Rng.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -18,6 +19,9 @@ struct MlpTrainOptions {
   Activation activation = Activation::Selu;
   double learningRate = 2e-3;
   double minLearningRate = 2e-5;
+  // Decoupled weight decay (AdamW, Loshchilov & Hutter 2019): each step shrinks the weight matrices
+  // (not the biases) by learningRate * weightDecay of themselves. 0: plain Adam.
+  double weightDecay = 0.0;
   int batchSize = 32;
   int maxEpochs = 3000;
   int patience = 300;      // epochs without a better validation loss before stopping
