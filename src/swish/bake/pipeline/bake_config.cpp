@@ -279,6 +279,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "activation",
                                                   "learning_rate",
                                                   "weight_decay",
+                                                  "input_noise",
                                                   "batch_size",
                                                   "max_epochs",
                                                   "patience",
@@ -316,6 +317,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   }
   t.mlp.learningRate = train.number("learning_rate", 1e-7, 1.0, t.mlp.learningRate);
   t.mlp.weightDecay = train.number("weight_decay", 0, 100, t.mlp.weightDecay);
+  t.mlp.inputNoise = train.number("input_noise", 0, 10, t.mlp.inputNoise);
   t.mlp.batchSize = int(train.wholeNumber("batch_size", 1, 1 << 20, t.mlp.batchSize));
   t.mlp.maxEpochs = int(train.wholeNumber("max_epochs", 1, 1e7, t.mlp.maxEpochs));
   t.mlp.patience = int(train.wholeNumber("patience", 1, 1e7, t.mlp.patience));

@@ -49,9 +49,10 @@
 //     "train": {                         part 2 settings (every key optional; defaults in part2_training.hpp)
 //       "mesh_components", "mesh_variance", "normal_code_dims", "database_size", "codebook_size",
 //       "vq_training_blocks", "vq_iterations", "hidden_layers", "hidden_width", "activation",
-//       "learning_rate", "weight_decay" (AdamW, 0: off), "batch_size", "max_epochs", "patience", "validation_fraction",
-//       "normal_code_weight" (the normal code's share of the MLP loss, 1: the mesh's),
-//       "mesh_weight_floor" (0..1, default 0: the mesh weights' loss follows the vertex error; a floor
+//       "learning_rate", "weight_decay" (AdamW, 0: off),
+//       "input_noise" (std of Gaussian noise on the standardised inputs in training, 0: off), "batch_size",
+//       "max_epochs", "patience", "validation_fraction", "normal_code_weight" (the normal code's share of the MLP loss,
+//       1: the mesh's), "mesh_weight_floor" (0..1, default 0: the mesh weights' loss follows the vertex error; a floor
 //       shares that much of it evenly over the components), "max_training_seconds", "test_fraction",
 //       "temporal_time_constant", "seed", "bc5_baseline", "input_joints" (the network's Theta joints; absent:
 //       part1.input_joints, the thinning joints;

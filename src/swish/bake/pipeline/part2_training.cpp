@@ -40,6 +40,7 @@ nlohmann::json BakeTrainSettings::toJson() const {
                       {"seed", seed}};
   if (!inputJoints.empty()) j["input_joints"] = inputJoints;       // absent: the dataset's (older fingerprints stay)
   if (mlp.weightDecay > 0.0) j["weight_decay"] = mlp.weightDecay;  // absent when off (older fingerprints stay)
+  if (mlp.inputNoise > 0.0) j["input_noise"] = mlp.inputNoise;     // likewise
   return j;
 }
 

@@ -79,6 +79,8 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
     throw Error("MLP training: learning rate, batch size, epochs and patience must be positive");
   if (!(o.weightDecay >= 0.0) || !(o.weightDecay * o.learningRate < 1.0))
     throw Error("MLP training: weight decay must be at least 0 and below 1 / learning rate");
+  if (!(o.inputNoise >= 0.0) || !std::isfinite(o.inputNoise))
+    throw Error("MLP training: input noise must be at least 0");
   if (!(o.validationFraction > 0.0 && o.validationFraction < 1.0))
     throw Error("MLP training: validation fraction must be in (0, 1)");
   if (!o.outputWeights.empty() && Eigen::Index(o.outputWeights.size()) != outputs.rows())
@@ -156,6 +158,9 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
         xb.col(j) = xTrain.col(perm[size_t(start + j)]);
         yb.col(j) = yTrain.col(perm[size_t(start + j)]);
       }
+      if (o.inputNoise > 0.0)
+        for (Eigen::Index j = 0; j < b; ++j)
+          for (Eigen::Index i = 0; i < xb.rows(); ++i) xb(i, j) += float(o.inputNoise * rng.normal());
       trainSum += double(net.lossAndGradient(xb, yb, weights, gW, gB)) * double(b);
       ++step;
       const float c1 = 1.f - std::pow(beta1, float(step)), c2 = 1.f - std::pow(beta2, float(step));

@@ -22,6 +22,10 @@ struct MlpTrainOptions {
   // Decoupled weight decay (AdamW, Loshchilov & Hutter 2019): each step shrinks the weight matrices
   // (not the biases) by learningRate * weightDecay of themselves. 0: plain Adam.
   double weightDecay = 0.0;
+  // Gaussian noise added to every training batch's standardised inputs (standard deviation, in units
+  // of each input's own spread; 0: none): the network sees each pose as a small cloud of poses and
+  // cannot memorise single samples. Validation inputs are never perturbed.
+  double inputNoise = 0.0;
   int batchSize = 32;
   int maxEpochs = 3000;
   int patience = 300;      // epochs without a better validation loss before stopping

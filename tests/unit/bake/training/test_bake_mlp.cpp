@@ -142,6 +142,31 @@ TEST(BakeMlp, WeightDecayShrinksTheWeights) {
   EXPECT_THROW(trainMlp(x, y, o), Error);
 }
 
+// Input noise perturbs the training batches only: deterministic for a seed, a different network
+// from the noiseless one, and one that still fits the map.
+TEST(BakeMlp, InputNoiseIsSeededAndStillFits) {
+  const uint64_t seed = test::testSeed(405);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  Rng rng(seed);
+  MatXf x, y;
+  makeRegression(rng, 300, x, y);
+  MlpTrainOptions o;
+  o.hiddenLayers = 2;
+  o.hiddenWidth = 32;
+  o.maxEpochs = 100;
+  o.patience = 100;
+  o.seed = 11;
+  const MlpTrainResult plain = trainMlp(x, y, o);
+  o.inputNoise = 0.05;
+  const MlpTrainResult a = trainMlp(x, y, o), b = trainMlp(x, y, o);
+  EXPECT_EQ(a.mlp.layers[0].weight, b.mlp.layers[0].weight);
+  EXPECT_NE(a.mlp.layers[0].weight, plain.mlp.layers[0].weight);
+  EXPECT_EQ(a.validationSamples, plain.validationSamples);  // the split does not depend on the noise
+  EXPECT_LT(a.bestValidationLoss, 0.2);
+  o.inputNoise = -0.1;
+  EXPECT_THROW(trainMlp(x, y, o), Error);
+}
+
 TEST(BakeMlp, SeededSplitNeverHoldsAPinnedIndex) {
   // Without pins: the plain Fisher-Yates draw (the split bakes made before pins existed).
   Rng a(test::testSeed(21)), b(test::testSeed(21));
