@@ -79,6 +79,7 @@ void parseSimulationSource(const JsonReader& sim, DatasetBuildSettings& s) {
 // config's part1, or the settings a dataset and a baked model carry (DatasetBuildSettings::toJson).
 void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   const JsonReader sim = j.section("simulation", {"preset",
+                                                  "friction",
                                                   "vertices",
                                                   "thickness",
                                                   "transition_seconds",
@@ -113,6 +114,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
       preset.fail(e.what());
     }
   }
+  // The preset's Coulomb coefficient against the body, overridden (0: the cloth slides freely).
+  cs.material.friction = float(sim.number("friction", 0, 2, cs.material.friction));
   s.simulationVertices = size_t(sim.wholeNumber("vertices", 0, 2e6, double(s.simulationVertices)));
   cs.thickness = float(sim.number("thickness", 0, 0.05, cs.thickness));
   cs.transitionSeconds = float(sim.number("transition_seconds", 0.05, 10, cs.transitionSeconds));

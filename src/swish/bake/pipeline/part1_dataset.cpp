@@ -259,6 +259,12 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   // Set only where used, so that recipes without them keep their datasets.
   if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
   if (evenPoses > 0) out["even_poses"] = evenPoses;
+  // Only when overridden, so that the settings (and so the datasets) of other bakes stay as they were.
+  const auto& presets = clothMaterialPresets();
+  const auto preset =
+      std::find_if(presets.begin(), presets.end(), [&](const ClothMaterial& c) { return c.name == m.material.name; });
+  if (preset == presets.end() || m.material.friction != preset->friction)
+    out["simulation"]["friction"] = m.material.friction;
   // Only when external, so that the settings (and so the datasets) of solver bakes stay as they were.
   if (external.enabled()) out["simulation"].update(external.toJson());
   return out;
