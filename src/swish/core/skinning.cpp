@@ -50,7 +50,7 @@ Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const
       continue;
     }
     const Eigen::JacobiSVD<Mat3f> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    const Vec3f s = svd.singularValues();
+    const Vec3f& s = svd.singularValues();
     if (s.minCoeff() >= floor) {
       out.row(v) = (a.inverse() * y).transpose();
       continue;
