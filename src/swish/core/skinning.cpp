@@ -28,13 +28,42 @@ Points3f skinPositions(const Points3f& pre, const SkinWeights& skin, const std::
   return out;
 }
 
+namespace {
+
+// The smallest singular value of A is at least |det| / s_max^2 >= |det| / |A|_F^2: a cheap proof that
+// the matrix is well conditioned, true for almost every vertex.
+bool surelyAboveFloor(const Mat3f& a, float floor) {
+  const float frob2 = a.squaredNorm();
+  return frob2 > 0.f && std::abs(a.determinant()) >= floor * frob2;
+}
+
+void checkFloor(const UnskinSettings& settings) {
+  if (!(settings.minSingularValue > 0.f && settings.minSingularValue <= 1.f))
+    throw Error("un-skinning: the smallest trusted singular value must be in (0, 1]");
+}
+
+}  // namespace
+
+UnskinStats collapsedSkinning(const SkinWeights& skin, const std::vector<Mat4f>& m, const UnskinSettings& settings) {
+  checkFloor(settings);
+  UnskinStats st;
+  for (size_t v = 0; v < skin.vertexCount(); ++v) {
+    const Mat3f a = blendedSkinMatrix(skin, v, m).topLeftCorner<3, 3>();
+    if (surelyAboveFloor(a, settings.minSingularValue)) continue;
+    const float smallest = Eigen::JacobiSVD<Mat3f>(a).singularValues().minCoeff();
+    if (smallest >= settings.minSingularValue) continue;
+    ++st.dampedVertices;
+    st.smallestSingularValue = std::min(st.smallestSingularValue, smallest);
+  }
+  return st;
+}
+
 Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const SkinWeights& skin,
                          const std::vector<Mat4f>& m, const UnskinSettings& settings, UnskinStats* stats) {
   if (reference.rows() != posed.rows())
     throw Error("un-skinning: " + std::to_string(posed.rows()) + " posed positions but " +
                 std::to_string(reference.rows()) + " reference positions");
-  if (!(settings.minSingularValue > 0.f && settings.minSingularValue <= 1.f))
-    throw Error("un-skinning: the smallest trusted singular value must be in (0, 1]");
+  checkFloor(settings);
   const float floor = settings.minSingularValue;
   UnskinStats st;
   Points3f out(posed.rows(), 3);
@@ -42,10 +71,7 @@ Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const
     const Mat4f b = blendedSkinMatrix(skin, size_t(v), m);
     const Mat3f a = b.topLeftCorner<3, 3>();
     const Vec3f y = posed.row(v).transpose() - b.topRightCorner<3, 1>();
-    // The smallest singular value is at least |det| / s_max^2 >= |det| / |A|_F^2: a cheap proof that
-    // the matrix is well conditioned, true for almost every vertex.
-    const float frob2 = a.squaredNorm();
-    if (frob2 > 0.f && std::abs(a.determinant()) >= floor * frob2) {
+    if (surelyAboveFloor(a, floor)) {
       out.row(v) = (a.inverse() * y).transpose();
       continue;
     }

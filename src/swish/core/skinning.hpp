@@ -37,4 +37,10 @@ Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const
                          const std::vector<Mat4f>& skinMatrices, const UnskinSettings& settings = {},
                          UnskinStats* stats = nullptr);
 
+// The vertices un-skinning would damp under these matrices (the same test), and the smallest singular
+// value among them: a property of the pose and the weights, not of a shape, so a bake can count them
+// for poses whose shapes it made in an earlier run.
+UnskinStats collapsedSkinning(const SkinWeights& skin, const std::vector<Mat4f>& skinMatrices,
+                              const UnskinSettings& settings = {});
+
 }  // namespace swish

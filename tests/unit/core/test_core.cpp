@@ -97,6 +97,9 @@ TEST(Skinning, UnskinDampsCollapsedVerticesTowardsTheReference) {
     UnskinStats stats;
     const Points3f back = unskinPositions(posed, reference, skin, mats, {}, &stats);
     EXPECT_EQ(stats.dampedVertices, 2u) << degrees << " degrees";
+    const UnskinStats fromPose = collapsedSkinning(skin, mats);  // the same test, without a shape
+    EXPECT_EQ(fromPose.dampedVertices, stats.dampedVertices);
+    EXPECT_EQ(fromPose.smallestSingularValue, stats.smallestSingularValue);
     EXPECT_LE(stats.smallestSingularValue, std::cos(85.f * float(M_PI) / 180.f) + 1e-4f);
     for (int v = 0; v < 2; ++v) {
       const float offset = (back.row(v) - reference.row(v)).norm();

@@ -17,6 +17,7 @@
 #include "swish/bake/poses/pose_thinning.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
+#include "swish/core/skinning.hpp"
 #include "swish/files/atomic_write.hpp"
 #include "swish/io/animation_import.hpp"
 #include "swish/io/character_import.hpp"
@@ -595,7 +596,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   auto one = [&](size_t k) {
     const uint32_t id = todo[k];
     std::string failure;
-    UnskinStats unskin;
     try {
       if (external) {
         // Another tool's shape: read, matched to the simulation mesh, then the same transfer.
@@ -607,7 +607,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         }
         if (failure.empty()) {
           TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], positions);
-          unskin = tp.unskin;
           DatasetPose dp;
           dp.id = id;
           dp.pose = recorded[id];
@@ -633,7 +632,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         // The pre-skin shape from the corrected simulation, the world shape skinned with the
         // recorded pose (pose_shape.hpp); the dataset keeps the recorded pose.
         TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], rec->result.positions);
-        unskin = tp.unskin;
         DatasetPose dp;
         dp.id = id;
         dp.pose = recorded[id];
@@ -653,11 +651,6 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
       log("part 1: pose " + std::to_string(id) + " left out: " + failure);
     } else {
       ++res.transferred;
-      if (unskin.dampedVertices > 0) {
-        ++res.unskinDampedPoses;
-        res.unskinDampedMaxVertices = std::max(res.unskinDampedMaxVertices, unskin.dampedVertices);
-        res.unskinSmallestSingularValue = std::min(res.unskinSmallestSingularValue, unskin.smallestSingularValue);
-      }
     }
     if (transferThrottle.due(n, total)) {
       const double el = since(transferStart);
@@ -671,14 +664,29 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     tbb::parallel_for(size_t(0), total, size_t(1), one);
   }
   std::sort(res.failed.begin(), res.failed.end(), [](const FailedPose& a, const FailedPose& b) { return a.id < b.id; });
-  if (res.unskinDampedPoses > 0) {
-    char line[300];
-    std::snprintf(line, sizeof line,
-                  "part 1: %zu of %zu poses have garment vertices where skinning collapses (up to %zu in a pose, "
-                  "smallest singular value %.3f): un-skinned damped towards rest (core/skinning.hpp)",
-                  res.unskinDampedPoses, res.transferred, res.unskinDampedMaxVertices,
-                  double(res.unskinSmallestSingularValue));
-    log(line);
+  // Poses whose garment skinning collapses (damped un-skinning, core/skinning.hpp), over every pose in
+  // the dataset: a property of the simulated pose, so reused transfers count too.
+  {
+    size_t inDataset = 0;
+    for (uint32_t id = 0; id < poses.size(); ++id) {
+      if (std::any_of(res.failed.begin(), res.failed.end(), [&](const FailedPose& f) { return f.id == id; })) continue;
+      ++inDataset;
+      const UnskinStats u =
+          collapsedSkinning(character.garment.skin, character.skeleton.skinningMatrices(poses[id]), s.transfer.unskin);
+      if (u.dampedVertices == 0) continue;
+      ++res.unskinDampedPoses;
+      res.unskinDampedMaxVertices = std::max(res.unskinDampedMaxVertices, u.dampedVertices);
+      res.unskinSmallestSingularValue = std::min(res.unskinSmallestSingularValue, u.smallestSingularValue);
+    }
+    if (res.unskinDampedPoses > 0) {
+      char line[300];
+      std::snprintf(line, sizeof line,
+                    "part 1: %zu of %zu poses have garment vertices where skinning collapses (up to %zu in a "
+                    "pose, smallest singular value %.3f): un-skinned damped towards rest (core/skinning.hpp)",
+                    res.unskinDampedPoses, inDataset, res.unskinDampedMaxVertices,
+                    double(res.unskinSmallestSingularValue));
+      log(line);
+    }
   }
   nlohmann::json source = {{"tool", "swish bake (part 1)"},
                            {"samples", res.samples},

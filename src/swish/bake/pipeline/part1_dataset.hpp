@@ -148,8 +148,9 @@ struct DatasetBuildResult {
   size_t simulationVertices = 0;
   size_t simulated = 0, simulationsReused = 0;
   size_t transferred = 0, transfersReused = 0;
-  // Transferred poses (this run's, not reused ones) with vertices whose skinning collapsed, un-skinned
-  // damped (core/skinning.hpp): how many, the most such vertices in one pose, the smallest singular value.
+  // Poses in the dataset with garment vertices whose skinning collapses under the simulated pose,
+  // un-skinned damped (core/skinning.hpp): how many, the most such vertices in one pose, the smallest
+  // singular value.
   size_t unskinDampedPoses = 0, unskinDampedMaxVertices = 0;
   float unskinSmallestSingularValue = 1.f;
   std::vector<FailedPose> failed;  // left out of the dataset, with the reason

@@ -68,7 +68,7 @@ TransferredPose PoseTransfer::transfer(const Pose& pose, const Points3f& simPose
   TransferredPose out;
   out.gameMeshWorld = smoother_.smoothDisplacement(followed, skinned);
   out.maxSmoothingShift = (out.gameMeshWorld - followed).rowwise().norm().maxCoeff();
-  out.gameMeshPreSkin = unskinPositions(out.gameMeshWorld, g.positions, g.skin, mats, unskin_, &out.unskin);
+  out.gameMeshPreSkin = unskinPositions(out.gameMeshWorld, g.positions, g.skin, mats, unskin_);
   out.normalMap = baker_.bake(out.gameMeshWorld, simPosed, simTriangles_, simTopology_, &out.bakeStats);
   return out;
 }

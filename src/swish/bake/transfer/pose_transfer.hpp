@@ -42,7 +42,6 @@ struct TransferredPose {
   NormalMapImage normalMap;
   NormalMapBakeStats bakeStats;
   float maxSmoothingShift = 0.f;  // largest distance smoothing moved a vertex (metres)
-  UnskinStats unskin;             // vertices whose skinning collapsed, un-skinned damped (core/skinning.hpp)
 };
 
 class PoseTransfer {
