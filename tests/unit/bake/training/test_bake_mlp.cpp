@@ -76,6 +76,18 @@ void makeRegression(Rng& rng, int n, MatXf& x, MatXf& y) {
     y(3, s) = 5.f + c[0] * c[0];
   }
 }
+
+// Two hidden layers of 32, seed 11, every one of `epochs` epochs run (patience as long), so that two
+// runs with different regularisers end at the same step count.
+MlpTrainOptions fixedRun(int epochs) {
+  MlpTrainOptions o;
+  o.hiddenLayers = 2;
+  o.hiddenWidth = 32;
+  o.maxEpochs = epochs;
+  o.patience = epochs;
+  o.seed = 11;
+  return o;
+}
 }  // namespace
 
 TEST(BakeMlp, TrainsASmoothMapDeterministicallyAndKeepsTheBestEpoch) {
@@ -119,12 +131,7 @@ TEST(BakeMlp, WeightDecayShrinksTheWeights) {
   Rng rng(seed);
   MatXf x, y;
   makeRegression(rng, 300, x, y);
-  MlpTrainOptions o;
-  o.hiddenLayers = 2;
-  o.hiddenWidth = 32;
-  o.maxEpochs = 100;
-  o.patience = 100;  // every epoch, so that both runs end at the same step count
-  o.seed = 11;
+  MlpTrainOptions o = fixedRun(100);
   const MlpTrainResult plain = trainMlp(x, y, o);
   o.weightDecay = 1.0;  // lr 2e-3: 0.2 % per step
   const MlpTrainResult decayed = trainMlp(x, y, o);
@@ -150,12 +157,7 @@ TEST(BakeMlp, InputNoiseIsSeededAndStillFits) {
   Rng rng(seed);
   MatXf x, y;
   makeRegression(rng, 300, x, y);
-  MlpTrainOptions o;
-  o.hiddenLayers = 2;
-  o.hiddenWidth = 32;
-  o.maxEpochs = 100;
-  o.patience = 100;
-  o.seed = 11;
+  MlpTrainOptions o = fixedRun(100);
   const MlpTrainResult plain = trainMlp(x, y, o);
   o.inputNoise = 0.05;
   const MlpTrainResult a = trainMlp(x, y, o), b = trainMlp(x, y, o);

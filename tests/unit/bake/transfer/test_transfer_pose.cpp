@@ -12,8 +12,9 @@
 using namespace swish;
 using namespace swish::bake;
 
-TEST(PoseTransfer, SimulationEqualToSkinnedGameMeshRoundTripsToRestAndFlatMap) {
-  Rng rng(test::testSeed(601));
+namespace {
+// A random skinned mesh (120 vertices) as garment and body both.
+Character randomCharacter(Rng& rng) {
   test::RandomModelSpec spec;
   spec.vertices = 120;
   const Model m = test::makeRandomModel(rng, spec);
@@ -22,6 +23,13 @@ TEST(PoseTransfer, SimulationEqualToSkinnedGameMeshRoundTripsToRestAndFlatMap) {
   c.skeleton = m.skeleton;
   c.garment = m.gameMesh;
   c.body = m.gameMesh;
+  return c;
+}
+}  // namespace
+
+TEST(PoseTransfer, SimulationEqualToSkinnedGameMeshRoundTripsToRestAndFlatMap) {
+  Rng rng(test::testSeed(601));
+  const Character c = randomCharacter(rng);
   PoseTransferSettings s;
   s.normalMap.width = s.normalMap.height = 32;
   const PoseTransfer pt(c, c.garment.positions, c.garment.triangles, s);
@@ -61,14 +69,7 @@ TEST(PoseTransfer, SimulationEqualToSkinnedGameMeshRoundTripsToRestAndFlatMap) {
 // the half-median floor stretches by exactly that), and large where one vertex is thrown away.
 TEST(PoseTransfer, WorstEdgeMeasuresStretchAgainstTheRestEdges) {
   Rng rng(test::testSeed(602));
-  test::RandomModelSpec spec;
-  spec.vertices = 120;
-  const Model m = test::makeRandomModel(rng, spec);
-  Character c;
-  c.name = "random";
-  c.skeleton = m.skeleton;
-  c.garment = m.gameMesh;
-  c.body = m.gameMesh;
+  const Character c = randomCharacter(rng);
   PoseTransferSettings s;
   s.normalMap.width = s.normalMap.height = 32;
   const PoseTransfer pt(c, c.garment.positions, c.garment.triangles, s);
