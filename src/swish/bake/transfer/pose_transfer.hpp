@@ -23,8 +23,8 @@ struct PoseTransferSettings {
   UnskinSettings unskin;  // where the garment's skinning collapses (core/skinning.hpp)
   // A torn shape is not training data. A game-mesh edge stretched beyond this strain (4: five times
   // its rest length, or half the median rest edge where that is longer) fails the pose. Measured on
-  // the corpus bake's 1960 poses (docs/baking.md): the worst edge of a pose is 1.8x its length at the
-  // median, 4.4x at p99; the poses above 5x are sleeves torn into sheets several metres long, which
+  // the corpus bake's 1960 poses (docs/baking.md): the worst edge of a pose is 2.8x its length at the
+  // median, 4.4x at p99; of the 13 above 5x the worst are sleeves torn into sheets (edges 32x), which
   // the re-skinning of a pose limb clearance changed (pose_shape.hpp) or the solver left.
   float maxEdgeStrain = 4.f;
 };
