@@ -15,6 +15,15 @@ struct SkinWeights {
   std::vector<float> weights;    // vertexCount * influences, non-negative, summing to 1 per vertex
 
   size_t vertexCount() const { return influences > 0 ? weights.size() / size_t(influences) : 0; }
+  // The joint with the largest weight on `vertex` (the first of equal ones): where a vertex "is" in
+  // messages, and how vertices are grouped by body part.
+  uint16_t strongestJoint(size_t vertex) const {
+    const size_t base = vertex * size_t(influences);
+    size_t best = base;
+    for (size_t k = base + 1; k < base + size_t(influences); ++k)
+      if (weights[k] > weights[best]) best = k;
+    return joints[best];
+  }
 };
 
 struct Mesh {

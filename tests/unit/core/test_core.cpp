@@ -62,6 +62,15 @@ TEST(Skeleton, ChildFollowsParentRotation) {
   EXPECT_THROW(sk.validate(), Error);
 }
 
+TEST(Skinning, StrongestJointIsTheLargestWeightFirstOfEqualOnes) {
+  SkinWeights skin;
+  skin.influences = 3;
+  skin.joints = {4, 7, 9, 2, 5, 6};
+  skin.weights = {0.2f, 0.5f, 0.3f, 0.4f, 0.4f, 0.2f};
+  EXPECT_EQ(skin.strongestJoint(0), 7);
+  EXPECT_EQ(skin.strongestJoint(1), 2);  // a tie: the first influence
+}
+
 TEST(Skinning, UnskinInvertsSkin) {
   Rng rng(test::testSeed(13));
   Model m = test::makeRandomModel(rng);

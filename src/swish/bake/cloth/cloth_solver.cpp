@@ -354,15 +354,11 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown) const
   };
   // Where on the garment a failure happened: the vertex, its strongest joint and its rest position.
   auto whereIs = [&](uint32_t v) {
-    const int k = mesh_.skin.influences;
-    int best = 0;
-    for (int i = 1; i < k; ++i)
-      if (mesh_.skin.weights[size_t(v) * k + i] > mesh_.skin.weights[size_t(v) * k + best]) best = i;
     const Vec3f p = mesh_.restPositions.row(v);
     char at[96];
     std::snprintf(at, sizeof at, " (rest %.3f %.3f %.3f)", p.x(), p.y(), p.z());
     return "at simulation vertex " + std::to_string(v) + ", near joint '" +
-           skeleton_.joints[mesh_.skin.joints[size_t(v) * k + best]].name + "'" + at;
+           skeleton_.joints[mesh_.skin.strongestJoint(v)].name + "'" + at;
   };
   out.retryable = false;  // bad input: no other setting can help
   if (target.local.size() != skeleton_.size())

@@ -58,16 +58,12 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
         skinPositions(tp.gameMeshPreSkin, character_->garment.skin, character_->skeleton.skinningMatrices(recorded));
   const EdgeStretch worst = transfer_.worstEdge(tp.gameMeshWorld);
   if (!(worst.strain <= settings_.transfer.maxEdgeStrain)) {
-    const SkinWeights& skin = character_->garment.skin;
-    size_t best = size_t(worst.vertex) * size_t(skin.influences);
-    for (int k = 1; k < skin.influences; ++k)
-      if (skin.weights[size_t(worst.vertex) * size_t(skin.influences) + size_t(k)] > skin.weights[best])
-        best = size_t(worst.vertex) * size_t(skin.influences) + size_t(k);
+    const uint16_t joint = character_->garment.skin.strongestJoint(worst.vertex);
     char line[300];
     std::snprintf(line, sizeof line,
                   "the game mesh is torn: an edge at game vertex %u (near joint '%s') is stretched %.0f%% "
                   "(bound %.0f%%: part1.transfer.max_edge_strain)",
-                  worst.vertex, character_->skeleton.joints[skin.joints[best]].name.c_str(), 100.0 * worst.strain,
+                  worst.vertex, character_->skeleton.joints[joint].name.c_str(), 100.0 * worst.strain,
                   100.0 * settings_.transfer.maxEdgeStrain);
     throw Error(line);
   }

@@ -243,14 +243,8 @@ void LimbClearance::setUpHead() {
         break;
       }
   // Head vertices: dominant skin joint in the head joint's subtree.
-  const int n = body_.skin.influences;
   std::vector<char> isHead(body_.vertexCount(), 0);
-  for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
-    int best = 0;
-    for (int k = 1; k < n; ++k)
-      if (body_.skin.weights[size_t(v) * n + k] > body_.skin.weights[size_t(v) * n + best]) best = k;
-    isHead[v] = inHead[body_.skin.joints[size_t(v) * n + best]];
-  }
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) isHead[v] = inHead[body_.skin.strongestJoint(v)];
   // The rest of the body: the triangles with fewer than two head vertices.
   Mesh others = body_;
   std::vector<Eigen::Index> keep;

@@ -82,14 +82,8 @@ BodyProxyFit fitBodyProxy(const Mesh& body, const Skeleton& skeleton, const Mesh
 
   // Groups: (dominant joint, part) -> vertices.
   std::map<std::pair<uint32_t, uint32_t>, std::vector<Vec3f>> groups;
-  const int inf = body.skin.influences;
-  for (size_t v = 0; v < n; ++v) {
-    int best = 0;
-    for (int i = 1; i < inf; ++i)
-      if (body.skin.weights[v * size_t(inf) + size_t(i)] > body.skin.weights[v * size_t(inf) + size_t(best)]) best = i;
-    groups[{body.skin.joints[v * size_t(inf) + size_t(best)], part[v]}].push_back(
-        body.positions.row(Eigen::Index(v)).transpose());
-  }
+  for (size_t v = 0; v < n; ++v)
+    groups[{body.skin.strongestJoint(v), part[v]}].push_back(body.positions.row(Eigen::Index(v)).transpose());
 
   BodyCollider collider(body, 0.05f, "body proxy fit: body");
   collider.pose(std::vector<Mat4f>(skeleton.size(), Mat4f::Identity()));

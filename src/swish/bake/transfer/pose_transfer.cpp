@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "swish/core/error.hpp"
+#include "swish/core/mesh.hpp"
 #include "swish/core/skinning.hpp"
 
 namespace swish::bake {
@@ -28,15 +29,11 @@ PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, 
       transfer_(simRest, simTriangles, character.garment.positions, "pose transfer: binding the game mesh"),
       smoother_(character.garment.triangles, character.garment.positions, settings.smoothing),
       baker_(character.garment.uvs, character.garment.triangles, character.garment.positions, settings.normalMap) {
-  const Triangles& t = character.garment.triangles;
-  for (Eigen::Index f = 0; f < t.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const auto a = uint32_t(t(f, k)), b = uint32_t(t(f, (k + 1) % 3));
-      edges_.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  std::sort(edges_.begin(), edges_.end());
-  edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
   const Points3f& p = character.garment.positions;
+  const auto neighbours = buildVertexNeighbours(character.garment.triangles, size_t(p.rows()));
+  for (uint32_t a = 0; a < uint32_t(neighbours.size()); ++a)
+    for (const uint32_t b : neighbours[a])
+      if (b > a) edges_.emplace_back(a, b);
   edgeRest_.reserve(edges_.size());
   for (const auto& [a, b] : edges_) edgeRest_.push_back((p.row(a) - p.row(b)).norm());
   if (!edgeRest_.empty()) {
