@@ -1,8 +1,9 @@
-// swish body-proxy MODEL [--out OUT]: fits the body proxy of the run-time push-out (capsules on the
-// skinning joints, bake/training/body_proxy_fit.hpp) to the body the model was baked on, and writes the model
-// with it (format 1.1). `swish bake` fits it itself; this is for a model baked before the proxy existed
-// (format 1.0, e.g. a model whose bake took an hour): nothing else in the model changes, and the
-// network is not retrained.
+// swish body-proxy MODEL [--out OUT]: fits the body anchors of the run-time push-out
+// (bake/training/body_anchor_fit.hpp: per garment vertex, the closest point of the rest body, its
+// outward normal and its skin) to the body the model was baked on, and writes the model with them
+// (format 1.3). `swish bake` fits them itself; this is for a model baked before they existed: nothing
+// else in the model changes, and the network is not retrained. `--remove` writes the model without
+// them (no push-out at run time).
 //
 // The body is rebuilt as `swish replay --truth-every` rebuilds it, from the model's own bake metadata
 // (the embedded default character by code, or the recipe/character file it names, looked for as
@@ -12,7 +13,9 @@
 #include <filesystem>
 #include <string>
 
-#include "swish/bake/training/body_proxy_fit.hpp"
+#include <nlohmann/json.hpp>
+
+#include "swish/bake/training/body_anchor_fit.hpp"
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
 #include "swish/model/model_file.hpp"
@@ -24,40 +27,58 @@ namespace fs = std::filesystem;
 
 struct BodyProxyOptions {
   std::string model, out;
-  float reach = 0.5f;
+  float maxDistanceMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.maxDistance;
+  float marginMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.margin;
   bool remove = false;
 };
+
+// The metadata with `key` set to `value` (null: removed), and the capsule proxy's old entry dropped.
+std::string withMetadata(const std::string& metadata, const char* key, const nlohmann::json& value) {
+  nlohmann::json meta = nlohmann::json::parse(metadata, nullptr, false);
+  if (!meta.is_object()) meta = nlohmann::json::object();
+  meta.erase("body_proxy");
+  if (value.is_null())
+    meta.erase(key);
+  else
+    meta[key] = value;
+  return meta.dump();
+}
 
 int runBodyProxy(const BodyProxyOptions& o) {
   using namespace swish;
   if (o.remove) {
     replay::ModelEntry entry = replay::loadModelEntry(o.model);
-    entry.model.bodyProxy = {};
+    entry.model.bodyAnchors = {};
+    entry.model.metadata = withMetadata(entry.model.metadata, "body_anchors", nullptr);
     const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
     saveModel(entry.model, out);
-    std::printf("Wrote %s without a body proxy (no push-out at run time).\n", out.string().c_str());
+    std::printf("Wrote %s without body anchors (no push-out at run time).\n", out.string().c_str());
     return 0;
   }
-  replay::ModelWithBakeBody loaded = replay::loadModelWithBakeBody(o.model, "to fit the proxy to");
+  replay::ModelWithBakeBody loaded = replay::loadModelWithBakeBody(o.model, "to anchor the garment to");
   replay::ModelEntry& entry = loaded.entry;
   const Character* character = loaded.character.get();
-  const std::string& how = loaded.how;
   const fs::path out = o.out.empty() ? entry.file : fs::path(o.out);
-  bake::BodyProxyFitSettings s;
-  s.reach = o.reach;
-  const bake::BodyProxyFit fit = bake::fitBodyProxy(character->body, entry.model.skeleton, &entry.model.gameMesh, s);
-  if (fit.proxy.empty())
-    throw Error(o.model + ": no capsule fits the body of '" + character->name + "' (nothing written)");
+  bake::BodyAnchorFitSettings s;
+  s.maxDistance = o.maxDistanceMm / 1000.f;
+  s.margin = o.marginMm / 1000.f;
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(character->body, entry.model.skeleton, entry.model.gameMesh, s);
+  if (fit.anchored == 0)
+    throw Error(o.model + ": no garment vertex lies within " + std::to_string(o.maxDistanceMm) +
+                " mm of the body of '" + character->name + "' (nothing written)");
   std::printf(
-      "Body of '%s' (%s): %zu (joint, part) groups, %zu capsules kept, %zu dropped; the surfaces checked stand at most "
-      "%.2f mm outside the body.\n",
-      character->name.c_str(), how.c_str(), fit.groups, fit.proxy.capsules.size(), fit.dropped, fit.worstOutsideMm);
-  for (size_t c = 0; c < fit.proxy.capsules.size(); ++c) {
-    const BodyCapsule& k = fit.proxy.capsules[c];
-    std::printf("  %-16s radius %5.1f mm, length %5.1f mm\n", fit.capsuleJoints[c].c_str(), 1000.f * k.radius,
-                1000.f * (k.b - k.a).norm());
-  }
-  entry.model.bodyProxy = fit.proxy;
+      "Body of '%s' (%s): %zu of %zu garment vertices anchored (%zu farther than %.0f mm get none).\n"
+      "  distance to the anchor at rest: median %.1f mm, p95 %.1f mm, max %.1f mm; ball radius: 10th percentile "
+      "%.1f mm, median %.1f mm; %zu inside the body at rest, %zu within the %.1f mm margin of their ball (the "
+      "push-out moves them at rest); %zu normals turned outward.\n",
+      character->name.c_str(), loaded.how.c_str(), fit.anchored, entry.model.gameMesh.vertexCount(), fit.tooFar,
+      fit.maxDistanceMm, fit.medianMm, fit.p95Mm, fit.maxMm, fit.radiusP10Mm, fit.radiusMedianMm, fit.insideAtRest,
+      fit.withinMargin, o.marginMm, fit.flippedNormals);
+  BodyAnchors anchors = fit.anchors;
+  nlohmann::json j = bake::toJson(fit);
+  j["made_by"] = "swish body-proxy (after the bake)";
+  entry.model.bodyAnchors = anchors;
+  entry.model.metadata = withMetadata(entry.model.metadata, "body_anchors", j);
   saveModel(entry.model, out);
   std::printf("Wrote %s (format %u.%u).\n", out.string().c_str(), unsigned(kModelFileMajorVersion),
               unsigned(kModelFileMinorVersion));
@@ -66,14 +87,27 @@ int runBodyProxy(const BodyProxyOptions& o) {
 
 swish::cli::CommandRegistration reg{
     "body-proxy",
-    "Fit the run-time push-out's body proxy to the body a model was baked on, and write the model with it",
+    "Anchor a model's garment to the body it was baked on (the run-time push-out), and write the model with it",
     [](CLI::App& app) -> swish::cli::RunFn {
       auto o = std::make_shared<BodyProxyOptions>();
       app.add_option("model", o->model, "the .swish model (its bake metadata names the character)")->required();
       app.add_option("--out", o->out, "write here instead of over MODEL (written atomically either way)");
-      app.add_option("--reach", o->reach,
-                     "keep capsules within this many metres of the garment's rest bounds (default 0.5; negative: all)");
-      app.add_flag("--remove", o->remove, "write the model without a proxy instead (turns the push-out off for good)");
+      app.add_option("--max-distance-mm", o->maxDistanceMm,
+                     "garment vertices farther than this from the rest body get no anchor (default 40)")
+          ->check(CLI::Range(1.f, 500.f));
+      app.add_option("--margin-mm", o->marginMm,
+                     "clearance the push-out keeps between the garment and the anchor's ball (default 2)")
+          ->check(CLI::Range(0.f, 1000.f * swish::kMaxAnchorMargin));
+      app.add_flag("--remove", o->remove,
+                   "write the model without body anchors instead (turns the push-out off for good)");
+      app.footer(
+          "The push-out: each garment vertex is kept outside the ball of its anchor (the largest ball inside the "
+          "rest body touching it at the vertex's closest point, its centre skinned with the body's own weights "
+          "there), `margin` off it; it never pulls a vertex in, and a vertex answers to its own anchor only. It "
+          "runs at the end of "
+          "the GPU deform when asked: swish replay --push-out, api::BatchOptions::pushOut. "
+          "Models baked with format 1.3 or later carry the anchors already; models of 1.1 and 1.2 carried body "
+          "capsules, which are no longer used (this command replaces them).");
       return [o] { return runBodyProxy(*o); };
     }};
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "swish/bake/compression/bc5_baseline.hpp"
-#include "swish/bake/training/body_proxy_fit.hpp"
+#include "swish/bake/training/body_anchor_fit.hpp"
 #include "swish/bake/training/model_builder.hpp"
 #include "swish/bake/training/novelty_guard_fit.hpp"
 #include "swish/bake/transfer/body_coverage.hpp"
@@ -209,16 +209,13 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
                                    {"unit", out.model.noveltyGuard.unit},
                                    {"clamp", true},
                                    {"blend", false}};
-  // The run-time push-out's body proxy, fitted to the character's body (none for a body-less character).
+  // The run-time push-out's body anchors, fitted to the character's body (none for a body-less character).
   if (ds.character.body.triangleCount() > 0) {
-    report("body proxy", 0.92);
-    const BodyProxyFit fit = fitBodyProxy(ds.character.body, out.model.skeleton, &out.model.gameMesh);
-    out.model.bodyProxy = fit.proxy;
-    out.metadata["body_proxy"] = {{"capsules", fit.proxy.capsules.size()},
-                                  {"joints", fit.capsuleJoints},
-                                  {"dropped", fit.dropped},
-                                  {"worst_outside_mm", fit.worstOutsideMm}};
-    stage("body proxy");
+    report("body anchors", 0.92);
+    const BodyAnchorFit fit = fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh);
+    out.model.bodyAnchors = fit.anchors;
+    out.metadata["body_anchors"] = toJson(fit);
+    stage("body anchors");
   }
 
   // The body triangles the garment covers in (nearly) every training pose: what a renderer may leave out.
