@@ -83,8 +83,10 @@ struct TemporalFilterParams {
 // model: +1.0 mm mean vertex error); the ball inscribed in the arm follows the arm's round section
 // (a flat chest gets a large ball, a plane in the limit), and the same push then kept the error.
 //
-// The clearance is the model's margin; an anchor may keep its vertex nearer (or inside its ball),
-// down to -kMaxAnchorDepth.
+// The clearance is the model's margin, or lower where pushing the network's garment to the margin
+// took it away from the source simulation in the poses the anchors were calibrated on
+// (calibrateBodyAnchors): then the push-out removes what the network adds beyond what the simulation
+// does, and never pushes against the simulation there.
 inline constexpr int kAnchorInfluences = 4;
 struct BodyAnchor {
   Vec3f position = Vec3f::Zero();  // on the body surface, rest character space, metres
@@ -113,7 +115,7 @@ struct BodyAnchors {
 // the garment visibly off the body, which is not what it is for.
 inline constexpr float kMaxAnchorMargin = 0.05f;
 // Deepest an anchor's clearance may go into its ball (metres): beyond that the anchor says nothing
-// (it is dropped instead).
+// (the calibration drops such anchors instead).
 inline constexpr float kMaxAnchorDepth = 0.2f;
 // Range of an anchor's ball radius (metres): from a crease of the body to a flat back.
 inline constexpr float kMinAnchorRadius = 0.001f, kMaxAnchorRadius = 1.f;

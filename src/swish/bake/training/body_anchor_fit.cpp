@@ -8,6 +8,7 @@
 
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/core/error.hpp"
+#include "swish/runtime/reference_push_out.hpp"
 
 namespace swish::bake {
 
@@ -151,6 +152,100 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
   fit.radiusP10Mm = percentile(radii, 0.1);
   fit.radiusMedianMm = percentile(radii, 0.5);
   return fit;
+}
+
+BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vector<BodyAnchorCalibrationPose>& poses,
+                                           const BodyAnchorCalibrationSettings& s) {
+  if (!(s.step > 0.f) || !std::isfinite(s.step)) throw Error("body anchor calibration: the step must be > 0 metres");
+  const size_t n = anchors.anchors.size();
+  for (size_t p = 0; p < poses.size(); ++p) {
+    const BodyAnchorCalibrationPose& cp = poses[p];
+    for (const Points3f* g : {cp.truth, cp.predicted})
+      if (!g || size_t(g->rows()) != n)
+        throw Error("body anchor calibration: pose " + std::to_string(p) + " has a garment of " +
+                    std::to_string(g ? g->rows() : 0) + " vertices for " + std::to_string(n) + " anchors");
+  }
+  BodyAnchorCalibration c;
+  c.poses = poses.size();
+  if (poses.empty() || n == 0) return c;
+  struct Sample {
+    float d;  // the network's vertex's distance off the ball's surface (negative inside)
+    Vec3f x, c, t;
+    double error;  // |x - t|
+  };
+  std::vector<Sample> samples;
+  std::vector<float> lowered;
+  double without = 0, with = 0;
+  size_t pairs = 0, pushed = 0;
+  for (size_t v = 0; v < n; ++v) {
+    BodyAnchor& an = anchors.anchors[v];
+    samples.clear();
+    for (const BodyAnchorCalibrationPose& cp : poses) {
+      const Vec3f x = cp.predicted->row(Eigen::Index(v)).transpose(), t = cp.truth->row(Eigen::Index(v)).transpose();
+      if (!x.allFinite() || !t.allFinite()) continue;
+      const double e = double((x - t).norm());
+      without += e, ++pairs;
+      const Vec3f c = an.present() ? runtime::skinAnchorCentre(an, cp.skinMatrices) : Vec3f::Zero();
+      if (an.present() && c.allFinite())
+        samples.push_back({(x - c).norm() - an.radius, x, c, t, e});
+      else
+        with += e;
+    }
+    if (!an.present()) continue;
+    std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.d < b.d; });
+    // The change of the summed error when every sample is pushed to clearance cl (only those with d < cl move).
+    auto change = [&](float cl) {
+      double sum = 0;
+      for (const Sample& q : samples) {
+        if (!(q.d < cl)) break;
+        sum += double((runtime::pushedOutOfBall(q.x, q.c, an.radius + cl) - q.t).norm()) - q.error;
+      }
+      return sum;
+    };
+    bool found = false;
+    float chosen = 0.f;
+    for (int k = 0;; ++k) {
+      const float cl = anchors.margin - float(k) * s.step;
+      if (cl < -kMaxAnchorDepth || !(an.radius + cl > 0.f)) break;
+      if (change(cl) <= 0.0) {
+        chosen = cl, found = true;
+        break;
+      }
+    }
+    if (!found) {
+      an = BodyAnchor{};
+      ++c.dropped;
+      for (const Sample& q : samples) with += q.error;
+      continue;
+    }
+    if (chosen < an.clearance) {
+      an.clearance = chosen;
+      ++c.lowered;
+      lowered.push_back(1000.f * chosen);
+    }
+    for (const Sample& q : samples) {
+      const Vec3f y = runtime::pushedOutOfBall(q.x, q.c, an.reach());
+      pushed += y != q.x ? 1 : 0;
+      with += double((y - q.t).norm());
+    }
+  }
+  c.medianLoweredMm = percentile(lowered, 0.5);
+  if (pairs > 0) {
+    c.meanMmWithout = 1000.0 * without / double(pairs);
+    c.meanMmWith = 1000.0 * with / double(pairs);
+    c.pushedShare = double(pushed) / double(pairs);
+  }
+  return c;
+}
+
+nlohmann::json toJson(const BodyAnchorCalibration& c) {
+  return {{"poses", c.poses},
+          {"lowered", c.lowered},
+          {"dropped", c.dropped},
+          {"median_lowered_mm", c.medianLoweredMm},
+          {"vertex_mean_mm_without", c.meanMmWithout},
+          {"vertex_mean_mm_with", c.meanMmWith},
+          {"pushed_share", c.pushedShare}};
 }
 
 nlohmann::json toJson(const BodyAnchorFit& f) {

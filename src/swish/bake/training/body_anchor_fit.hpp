@@ -52,7 +52,46 @@ struct BodyAnchorFit {
 BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const Mesh& garment,
                              const BodyAnchorFitSettings& settings = {});
 
+// Calibration against the source simulation. The ball stands for the body, but the bake's own
+// simulated garment (the truth the network learns) lies inside it in places: cloth squeezed between an
+// arm and the trunk that overlap in a pose, a hem over the thigh, a sleeve the transfer's smoothing
+// draws into the arm. There, pushing the network's garment out to the ball moves it away from the
+// truth; and the truth's depth follows the pose (where the network puts a vertex deep, the truth is
+// mostly deep there too), so no per-vertex bound taken from the truth alone serves.
+//
+// So the calibration measures the push-out itself: on each calibration pose it has the network's garment
+// (without the push-out) and the truth, and per anchor it takes the HIGHEST clearance, from the margin
+// down in `step`s, at which pushing that vertex out on every calibration pose does not raise the sum of
+// its distances to the truth over those poses. A clearance below every calibration pose's distance
+// pushes nothing there and qualifies, so one is found unless the network put the vertex deeper than
+// its ball's radius or kMaxAnchorDepth; such an anchor is dropped. The push-out then removes what it can
+// without making any vertex worse on the calibration poses.
+struct BodyAnchorCalibrationSettings {
+  float step = 0.001f;  // metres between the clearances tried
+};
+
+struct BodyAnchorCalibrationPose {
+  std::vector<Mat4f> skinMatrices;      // the pose's, one per joint
+  const Points3f* truth = nullptr;      // the simulated garment, character space, posed
+  const Points3f* predicted = nullptr;  // the network's garment there, without the push-out (the run time's)
+};
+
+struct BodyAnchorCalibration {
+  size_t poses = 0;
+  size_t lowered = 0;         // anchors whose clearance went below the margin
+  size_t dropped = 0;         // anchors dropped (see above)
+  float medianLoweredMm = 0;  // median clearance of the lowered anchors (mm, negative: inside the ball)
+  // Over the calibration poses and every vertex: mean distance to the truth (mm) without and with the
+  // calibrated push-out, and the share of (pose, vertex) pairs it moves.
+  double meanMmWithout = 0, meanMmWith = 0, pushedShare = 0;
+};
+
+// Throws Error naming the problem for sizes that do not fit the anchors. Deterministic.
+BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vector<BodyAnchorCalibrationPose>& poses,
+                                           const BodyAnchorCalibrationSettings& settings = {});
+
 // The fit's figures for the model's metadata ("body_anchors") and reports.
 nlohmann::json toJson(const BodyAnchorFit& fit);
+nlohmann::json toJson(const BodyAnchorCalibration& calibration);
 
 }  // namespace swish::bake

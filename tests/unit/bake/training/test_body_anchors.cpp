@@ -1,5 +1,5 @@
-// The body anchors of the run-time push-out and the penetration measure: bake::fitBodyAnchors on a box
-// body (known weights and normals), the analytic capsule character
+// The body anchors of the run-time push-out and the penetration measure: bake::fitBodyAnchors and
+// bake::calibrateBodyAnchors on a box body (known weights and normals), the analytic capsule character
 // (exact distances, support/cloth_fixture.hpp) and the embedded default character;
 // runtime::referencePushOut on hand-made anchors; bake::measurePenetration.
 #include <gtest/gtest.h>
@@ -231,6 +231,65 @@ TEST(BodyAnchorFit, DefaultCharacter) {
   EXPECT_EQ(runtime::referencePushOut(rest, fit.anchors, identities(ch.skeleton.size())), 0u);
 }
 
+// Calibration: each anchor keeps the highest clearance at which pushing the network's garment does not
+// take that vertex further from the truth over the poses; an anchor whose ball the network and the
+// truth both go nearly through to the centre is dropped.
+TEST(BodyAnchorFit, CalibrationKeepsTheErrorAndPushesWhereItHelps) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  bake::BodyAnchorFit fit = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
+  fit.anchors.anchors[2].radius = 0.01f;
+  const auto& an = fit.anchors.anchors;
+  // Distances off the ball (mm, along the normal through the anchor: as the plane's) of the network's vertex and of the
+  // truth, per vertex and pose.
+  struct Pair {
+    float predicted, truth;
+  };
+  const Pair table[4][2] = {
+      {{-10.f, 5.f}, {-10.f, 5.f}},          // the network deep, the truth outside: pushing helps, margin kept
+      {{-10.5f, -10.5f}, {-10.5f, -10.5f}},  // the network on the truth: the first clearance below, -11 mm
+      {{-9.7f, -9.7f}, {-9.7f, -9.7f}},      // near the centre of a 1 cm ball: no clearance above -1 cm qualifies
+      {{-20.f, 1.f}, {-15.f, -15.f}},        // helps 21 mm in one pose, hurts 17 in the other: margin kept
+  };
+  std::vector<Points3f> truth(2, ch.garment.positions), predicted(2, ch.garment.positions);
+  std::vector<bake::BodyAnchorCalibrationPose> poses(2);
+  for (size_t p = 0; p < 2; ++p) {
+    for (int v = 0; v < 4; ++v) {
+      const BodyAnchor& a = an[size_t(v)];
+      predicted[p].row(v) = (a.position + 0.001f * table[v][p].predicted * a.normal).transpose();
+      truth[p].row(v) = (a.position + 0.001f * table[v][p].truth * a.normal).transpose();
+    }
+    poses[p] = {identities(ch.skeleton.size()), &truth[p], &predicted[p]};
+  }
+  BodyAnchors anchors = fit.anchors;
+  const bake::BodyAnchorCalibration c = bake::calibrateBodyAnchors(anchors, poses);
+  EXPECT_EQ(c.poses, 2u);
+  EXPECT_EQ(anchors.anchors[0].clearance, fit.anchors.margin);
+  EXPECT_NEAR(anchors.anchors[1].clearance, -0.011f, 1e-6f);
+  EXPECT_FALSE(anchors.anchors[2].present());
+  EXPECT_EQ(anchors.anchors[3].clearance, fit.anchors.margin);
+  for (size_t v = 4; v < anchors.anchors.size(); ++v) EXPECT_EQ(anchors.anchors[v].clearance, fit.anchors.margin);
+  EXPECT_EQ(c.lowered, 1u);
+  EXPECT_EQ(c.dropped, 1u);
+  EXPECT_LT(c.meanMmWith, c.meanMmWithout);
+  // The calibrated push-out on those poses: each vertex's summed distance to the truth no larger.
+  std::vector<double> before(4, 0.0), after(4, 0.0);
+  for (size_t p = 0; p < 2; ++p) {
+    Points3f x = predicted[p];
+    runtime::referencePushOut(x, anchors, poses[p].skinMatrices);
+    for (int v = 0; v < 4; ++v) {
+      before[size_t(v)] += (predicted[p].row(v) - truth[p].row(v)).norm();
+      after[size_t(v)] += (x.row(v) - truth[p].row(v)).norm();
+    }
+  }
+  for (int v = 0; v < 4; ++v) EXPECT_LE(after[size_t(v)], before[size_t(v)] + 1e-6) << v;
+  EXPECT_LT(after[0], before[0] - 0.02);
+
+  EXPECT_THROW(bake::calibrateBodyAnchors(anchors, {{identities(4), &truth[0], nullptr}}), Error);
+  const Points3f tooShort = ch.garment.positions.topRows(3);
+  EXPECT_THROW(bake::calibrateBodyAnchors(anchors, {{identities(4), &tooShort, &tooShort}}), Error);
+}
+
 // The reference on hand-made anchors: a ball of 5 cm touching z = 0 from below at (0, 1, 0). A vertex
 // inside lands on the sphere of radius + clearance along the radius, one outside stays, the ball rides
 // its joints, and the push is continuous and never pulls a vertex in.
@@ -245,7 +304,7 @@ TEST(PushOutReference, KnownAnswersAndContinuity) {
   a.weights = {0.5f, 0.5f, 0.f, 0.f};
   EXPECT_LT((a.centre() - Vec3f(0, 1, -0.05f)).norm(), 1e-7f);
   anchors.anchors = {a, a, BodyAnchor{}};
-  anchors.anchors[1].clearance = -0.01f;  // kept 1 cm inside the ball only
+  anchors.anchors[1].clearance = -0.01f;  // calibrated: kept 1 cm inside the ball only
   Points3f p(3, 3);
   p.row(0) << 0.f, 1.f, -0.03f;   // 2 cm above the centre: to z = -0.05 + 0.052
   p.row(1) << 0.f, 1.f, -0.005f;  // 4.5 cm from the centre, but its reach is 4 cm: stays
