@@ -25,9 +25,11 @@
 // instance count, so the texel form pays most where characters are few (docs/performance.md).
 //
 // The push-out (runtime/reference_push_out.hpp, the specification): after skinning, each instance's
-// vertex is pushed out of that instance's posed body capsules, in order. Every thread of the dispatch
-// reads the same capsule at the same time (a uniform address), and the loop's trip count is a push
-// constant, so a frame without push-out (capsuleCount 0) skips it in one uniform branch.
+// vertex is kept outside its body anchor's ball. The anchor (rest centre, reach, four influences) is
+// loaded once per thread with the rest of the vertex, and its centre skinned per instance with the
+// instance's matrix rows like the vertex itself: 12 more texel fetches and a 3x4 blend per vertex and
+// instance, no per-frame input. `pushOut` is a push constant, so a frame without the push-out
+// skips it in one uniform branch.
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
@@ -75,6 +77,25 @@ vec3 mean;
 float basis[3 * K];
 uint joints[INFLUENCES];
 float skinW[INFLUENCES];
+vec3 anchorC;   // the body anchor's ball centre (rest), when p.pushOut
+float anchorR;  // its reach (radius + clearance; 0: no anchor)
+uint anchorJ[4];
+float anchorW[4];
+
+// The blend of `count` skinning matrices of `instance` (weights w, joints j; a zero weight is skipped by
+// a select, as in the reference), as the columns b0..b3 of its top three rows.
+#define SWISH_BLEND_MATRICES(count, J, W, b0, b1, b2, b3)                                              \
+  [[unroll]] for (uint i = 0u; i < count; ++i) {                                                       \
+    const int m = int((instance * p.jointCount + J[i]) * 3u);                                          \
+    const float w = W[i];                                                                              \
+    const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2); \
+    const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w); \
+    const bool use = w != 0.0;                                                                         \
+    b0 = use ? b0 + w * c0 : b0;                                                                       \
+    b1 = use ? b1 + w * c1 : b1;                                                                       \
+    b2 = use ? b2 + w * c2 : b2;                                                                       \
+    b3 = use ? b3 + w * c3 : b3;                                                                       \
+  }
 
 // One instance's vertex from its first `groups` weight groups (a constant at every call, so that the
 // unrolled loop keeps constant indices into `basis` and drops the groups beyond).
@@ -96,34 +117,16 @@ void deformInstance(const uint instance, const uint groups) {
     // (lavapipe gathers per lane, masked branches do not save that), and a skipped matrix still
     // cannot bring its NaN/Inf in.
     precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
-    [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
-      const int m = int((instance * p.jointCount + joints[i]) * 3u);
-      const float w = skinW[i];
-      const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2);
-      const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w);
-      const bool use = w != 0.0;
-      b0 = use ? b0 + w * c0 : b0;
-      b1 = use ? b1 + w * c1 : b1;
-      b2 = use ? b2 + w * c2 : b2;
-      b3 = use ? b3 + w * c3 : b3;
-    }
+    SWISH_BLEND_MATRICES(INFLUENCES, joints, skinW, b0, b1, b2, b3)
     y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
   }
-  if (p.capsuleCount > 0u) {
-    FloatsIn caps = FloatsIn(p.capsules);
-    for (uint c = 0u; c < p.capsuleCount; ++c) {
-      const uint b = (instance * p.capsuleCount + c) * 8u;
-      const vec3 a = vec3(caps.v[b], caps.v[b + 1u], caps.v[b + 2u]);
-      const float r = caps.v[b + 3u];
-      const vec3 d = vec3(caps.v[b + 4u], caps.v[b + 5u], caps.v[b + 6u]);
-      const float invLenSq = caps.v[b + 7u];
-      precise const vec3 w = y - a;
-      precise const float t = clamp(((w.x * d.x + w.y * d.y) + w.z * d.z) * invLenSq, 0.0, 1.0);
-      precise const vec3 q = a + d * t;
-      precise const vec3 e = y - q;
-      precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
-      if (s > 1e-12 && s < r * r) y = q + e * (r / sqrt(s));  // kMinPushDistanceSq
-    }
+  if (APPLY_SKINNING && p.pushOut != 0u) {  // (character space: after skinning only)
+    precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
+    SWISH_BLEND_MATRICES(4u, anchorJ, anchorW, a0, a1, a2, a3)
+    precise const vec3 c = ((a0 * anchorC.x + a1 * anchorC.y) + a2 * anchorC.z) + a3;
+    precise const vec3 e = y - c;
+    precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
+    if (s > 1e-12 && s < anchorR * anchorR) y = c + e * (anchorR / sqrt(s));  // kMinAnchorDistanceSq
   }
   FloatsOut outBuf = FloatsOut(p.positionsOut);
   const uint o = (instance * p.vertexCount + v) * 3u;
@@ -167,6 +170,24 @@ void main() {
   [[unroll]] for (uint i = 0u; i < INFLUENCES; ++i) {
     joints[i] = jointBuf.v[v * INFLUENCES + i];
     skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
+  }
+  if (p.pushOut != 0u) {
+    FloatsIn anchorF = FloatsIn(p.anchors);
+    UintsIn anchorU = UintsIn(p.anchors);
+    const uint o = v * SWISH_ANCHOR_WORDS;
+    anchorC = vec3(anchorF.v[o], anchorF.v[o + 1u], anchorF.v[o + 2u]);
+    anchorR = anchorF.v[o + 3u];
+    [[unroll]] for (uint i = 0u; i < 4u; ++i) {
+      anchorW[i] = anchorF.v[o + 4u + i];
+      anchorJ[i] = anchorU.v[o + 8u + i];
+    }
+  } else {
+    anchorC = vec3(0.0);
+    anchorR = 0.0;
+    [[unroll]] for (uint i = 0u; i < 4u; ++i) {
+      anchorW[i] = 0.0;
+      anchorJ[i] = 0u;
+    }
   }
 
   if (BANDS == 1u) {  // every instance at K4 groups, in order

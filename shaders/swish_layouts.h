@@ -12,6 +12,8 @@
 //   instance order    : uint[instance], the instances band by band (deform quality levels, deform.glsl)
 //   skin matrix rows  : vec4[instance][joint][3], rows 0..2 of each affine skinning matrix (texels)
 //   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
+//   body anchors      : word[vertex][SWISH_ANCHOR_WORDS]: float ball centre xyz (rest), float reach
+//                       (radius + clearance), float weights[4], uint joints[4] (BodyAnchor; all 0: none)
 //   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
 //   VQ codebook       : int8[entry][16 texels][2] read as uint words (2 texels per word)
 //   VQ indices        : uint16[map][block] read as uint words (2 indices per word, little-endian)
@@ -37,8 +39,11 @@ struct alignas(8) Address {
 // hundred they would spill).
 #define SWISH_MAX_MESH_COMPONENTS 256
 
+// 32-bit words per vertex of the body-anchor buffer (layout above).
+#define SWISH_ANCHOR_WORDS 12
+
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
-// push-out of the posed body proxy (runtime/reference_push_out.hpp). The mesh weights
+// push-out of the body anchors' balls (runtime/reference_push_out.hpp). The mesh weights
 // (float[instanceCount][K4]) and skin matrix rows (vec4[instanceCount][jointCount][3]) are texel
 // buffers of its descriptor set. Quality levels (pipelines with more than one band): the instances
 // come band by band in instanceOrder, band b ending at bandEnd[b] (the last at instanceCount), each
@@ -49,12 +54,12 @@ struct DeformParams {
   SWISH_ADDRESS skinJoints;      // uint[N][influences]
   SWISH_ADDRESS skinWeights;     // float[N][influences]
   SWISH_ADDRESS positionsOut;    // float[instanceCount][N][3]
-  SWISH_ADDRESS capsules;        // float[instanceCount][capsuleCount][8]: posed capsules (unused when 0)
+  SWISH_ADDRESS anchors;         // word[N][SWISH_ANCHOR_WORDS]: body anchors (unused when pushOut is 0)
   SWISH_ADDRESS instanceOrder;   // uint[instanceCount]: instances by band (unused with one band)
   uint vertexCount;
   uint instanceCount;
   uint jointCount;
-  uint capsuleCount;             // 0: no push-out
+  uint pushOut;                  // 0: no push-out; else every instance is pushed to its anchors' planes
   uint maxGroups;                // basis groups each vertex loads: the widest band in use (K4 / 4 at most)
   uint bandEnd[4];               // end of bands 0..3 in instanceOrder (bands beyond the pipeline's: unused)
   uint pad0;

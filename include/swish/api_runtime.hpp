@@ -85,11 +85,12 @@ struct BatchOptions {
   uint32_t characters = 1;      // characters of this model drawn per frame
   uint32_t framesInFlight = 2;  // 1..8: sets of frame resources; frame f uses set f % framesInFlight
   bool normalMaps = true;       // per-character normal maps (ignored when the model or device has none)
-  // Push the deformed garment out of the model's body proxy (capsules fitted inside the body at bake
-  // time, ModelInfo::bodyCapsules; a step at the end of the deform pass): keeps the body the host draws
-  // from showing through where the network puts the cloth inside it. No effect without a proxy. Off by
-  // default: on the default character it has been measured to raise the vertex error against the source
-  // simulation (README, issue notes), so a host opts in where the look matters more than that error.
+  // Keep the deformed garment off the body the model was baked on (a step at the end of the deform
+  // pass): each vertex stays outside the ball of its body anchor (the largest ball inside the rest
+  // body that touches it at the vertex's closest point, skinned with the body's weights there;
+  // ModelInfo::bodyAnchors), a margin off it, so the body the host draws does not show through where
+  // the network puts the cloth inside it. No effect for a model without anchors (formats before 1.3: `swish body-proxy`
+  // adds them).
   bool pushOut = false;
   // The model's novelty guard (ModelInfo::hasNoveltyGuard): clamp the mesh weights to the range seen in
   // training and blend towards the mean shape as a pose grows novel. Novelty is reported either way.

@@ -85,7 +85,7 @@ struct ModelInfo {
   bool hasNormalMaps = false;
   uint32_t normalMapWidth = 0, normalMapHeight = 0, normalMapDatabaseSize = 0;
   float temporalFilterSeconds = 0;  // the normal-map filter's time constant
-  uint32_t bodyCapsules = 0;        // capsules of the body proxy the push-out uses (0: none)
+  uint32_t bodyAnchors = 0;         // garment vertices anchored to the body for the push-out (0: no push-out)
   // The novelty guard (models of format 1.2): FrameReport::novelty is measured per character, and a
   // character above noveltyFlagAbove is in FrameReport::novelCharacters. Novelty 1 is the sparse edge
   // of the poses the model was trained on.

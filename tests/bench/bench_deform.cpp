@@ -4,7 +4,8 @@
 // and the cost of an empty dispatch (one alone, and amortised over 100 back to back). Also the
 // tangent-frames pass on the same 22 deformed instances, single-pass kernel vs the two-pass
 // (per-triangle terms + per-vertex gather) that FrameRecorder uses. And the push-out step of the deform
-// (the body proxy's capsules, runtime/reference_push_out.hpp): the same dispatch with and without it,
+// (each vertex kept off the body by its anchor's plane, runtime/reference_push_out.hpp): the same
+// dispatch with and without it,
 // alternating, its share of the deform pass reported (goal <= 10%). And quality levels (issue 21): the
 // deform pass and the whole frame (FrameRecorder) of 22 characters of the committed default model
 // (assets/default/default.swish) at each level of its default ladder, and at a mix of them.
@@ -30,7 +31,6 @@
 #include "swish/gpu/timestamp_queries.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/quality_levels.hpp"
-#include "swish/runtime/reference_push_out.hpp"
 
 namespace swish {
 namespace {
@@ -76,13 +76,13 @@ struct DeformSetup {
 };
 
 DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint32_t components = 30,
-                      uint32_t capsules = 0) {
+                      bool anchors = false) {
   DeformSetup s;
   Rng rng(42);
   test::RandomModelSpec spec;
   spec.vertices = 3000;
   spec.meshComponents = components;
-  spec.bodyCapsules = capsules;
+  spec.bodyAnchors = anchors;
   spec.influences = 4;
   spec.joints = 24;
   spec.normalMaps = 0;
@@ -156,29 +156,19 @@ BENCHMARK(BM_Deform)
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(0.5);
 
-// The deform pass with and without its push-out step: args instances, K, capsules. Each iteration times
-// both dispatches (alternating, so that drift of a shared machine hits both alike); the reported time
-// is the pass with the push-out, `pushout_share` its extra time over the plain deform.
+// The deform pass with and without its push-out step: args instances, K. Each iteration times both
+// dispatches (alternating, so that drift of a shared machine hits both alike); the reported time is the
+// pass with the push-out, `pushout_share` its extra time over the plain deform.
 void BM_DeformPushOut(benchmark::State& state) {
   gpu::Context* ctx = benchContext();
   if (!ctx) return state.SkipWithError("no Vulkan device");
   if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
-  const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1)),
-                 capsules = uint32_t(state.range(2));
-  DeformSetup s = makeSetup(*ctx, instances, true, k, capsules);
-  std::vector<float> posed;
-  Rng rng(7);
-  for (uint32_t i = 0; i < instances; ++i)
-    runtime::poseBodyProxy(s.model.bodyProxy,
-                           s.model.skeleton.skinningMatrices(test::makeRandomPose(rng, s.model.skeleton, 0.15f)),
-                           posed);
-  gpu::Buffer caps(*ctx, posed.size() * 4, gpu::MemoryKind::DeviceLocal, "posed capsules");
-  caps.upload(*ctx, posed.data(), posed.size() * 4);
+  const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1));
+  DeformSetup s = makeSetup(*ctx, instances, true, k, true);
   gpu::TimestampQueries ts(*ctx, 2);
   gpu::DeformPass::Args a = s.gpuModel->deformArgs(s.instanceInputs.get(), s.positions, instances);
   gpu::DeformPass::Args pushed = a;
-  pushed.capsules = caps.address();
-  pushed.capsuleCount = capsules;
+  pushed.anchors = s.gpuModel->anchors.address();
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, pushed); });  // warm-up
   double with = 0, without = 0;
   for (auto _ : state) {
@@ -189,13 +179,12 @@ void BM_DeformPushOut(benchmark::State& state) {
   }
   state.counters["plain_us"] = 1e6 * without / double(state.iterations());
   state.counters["pushout_share"] = (with - without) / without;
-  state.counters["capsules"] = capsules;
 }
-// Args: instances, K, capsules. K = 128 is the default model's; the default model's proxy is ~20 capsules.
+// Args: instances, K. K = 128 is the default model's.
 BENCHMARK(BM_DeformPushOut)
-    ->Args({22, 30, 24})
-    ->Args({22, 128, 24})
-    ->Args({1, 128, 24})
+    ->Args({22, 30})
+    ->Args({22, 128})
+    ->Args({1, 128})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(0.5);

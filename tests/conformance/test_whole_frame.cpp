@@ -89,7 +89,7 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
   spec.normalMaps = 6;
   spec.mapSize = 24;
   spec.codebookSize = 40;
-  spec.bodyCapsules = 8;  // the push-out inside the deform pass, on in frames 0 and 2, off in frame 1
+  spec.bodyAnchors = true;  // the push-out inside the deform pass, on in frames 0 and 2, off in frame 1
   const Model model = test::makeRandomModel(modelRng, spec);
   const uint32_t instances = 22;
   gpu::GpuModel gpuModel(ctx(), model, "random model");
@@ -192,7 +192,7 @@ TEST_F(WholeFrame, QualityLevelsPerInstanceMatchReferenceAndKeepMapsOfLevelsWith
   spec.normalMaps = 6;
   spec.mapSize = 24;
   spec.codebookSize = 40;
-  spec.bodyCapsules = 8;
+  spec.bodyAnchors = true;
   const Model model = test::makeRandomModel(modelRng, spec);
   const runtime::QualityLadder ladder = runtime::defaultLadder(model);
   ASSERT_EQ(ladder.size(), 5u);

@@ -183,6 +183,12 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   const Model loaded = loadModel(dir / "synthetic.swish");
   EXPECT_EQ(loaded.metadata, out.model.metadata);
   const auto meta = nlohmann::json::parse(loaded.metadata);
+  // The push-out's body anchors: fitted to the dataset's body and calibrated on the training poses.
+  EXPECT_EQ(loaded.bodyAnchors.anchors.size(), loaded.gameMesh.vertexCount());
+  EXPECT_GT(loaded.bodyAnchors.anchored(), 0u);
+  EXPECT_EQ(meta["body_anchors"]["calibration"]["poses"], out.trainingPoses.size());
+  EXPECT_LE(meta["body_anchors"]["calibration"]["vertex_mean_mm_with"].get<double>(),
+            meta["body_anchors"]["calibration"]["vertex_mean_mm_without"].get<double>() + 1e-9);
   EXPECT_TRUE(meta.contains("errors"));
   const runtime::QualityLadder carried = runtime::ladderOf(loaded);
   ASSERT_TRUE(meta.contains(runtime::kQualityLevelsKey));
@@ -212,6 +218,7 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
   in.skinMatrices = loaded.skeleton.skinningMatrices(p.pose);
   in.selectedMaps = {out.evaluation.perPose[0].selectedMap};
   in.blendAlpha = {1.f};
+  in.pushOut = false;  // perPose measures the network's garment; the push-out's figures are pooled apart
   const auto frame = runtime::referenceFrame(loaded, in);
   ASSERT_EQ(frame.positions.size(), 1u);
   double err = 0.0;

@@ -49,7 +49,7 @@ class ReplayE2E : public test::GpuTest {
     spec.vertices = 120;
     spec.normalMaps = 4;
     spec.mapSize = 16;
-    spec.bodyCapsules = 6;    // the push-out runs, and the GPU-vs-CPU checks cover it
+    spec.bodyAnchors = true;  // the push-out runs, and the GPU-vs-CPU checks cover it
     spec.noveltyCentres = 5;  // the novelty guard runs, and the checks cover its weights too
     model_ = test::makeRandomModel(rng, spec);
     // What the bake records of its evaluation on held-out poses (part2_training.cpp).
@@ -99,7 +99,7 @@ class ReplayE2E : public test::GpuTest {
     replay::ReplayJobOptions o;
     o.quiet = true;
     o.engine.context = &ctx();
-    o.engine.pushOut = true;  // the model carries capsules: the GPU-vs-CPU checks cover the push-out step
+    o.engine.pushOut = true;  // the model carries anchors: the GPU-vs-CPU checks cover the push-out step
     return o;
   }
 
@@ -366,7 +366,7 @@ TEST_F(ReplayE2E, LeavingNormalMapsOutKeepsTheMeshes) {
 
 // The plan's memory is what the GPU side allocates, buffer by buffer (name and bytes): the planner
 // asks gpu::modelAllocations / frameAllocations, and GpuModel / FrameResources size their buffers
-// with the same code. A body proxy adds the posed capsules (the mirror the planner once kept missed them).
+// with the same code. Body anchors add the model's anchor buffer (and nothing per frame).
 TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
   struct Case {
     bool maps, proxy;
@@ -375,11 +375,16 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
     SCOPED_TRACE("maps " + std::to_string(k.maps) + ", proxy " + std::to_string(k.proxy));
     Model m = model_;
     if (!k.maps) m.normalMaps = NormalMapDatabase{};
-    if (!k.proxy)
-      m.bodyProxy = BodyProxy{};
-    else if (m.bodyProxy.empty())
-      m.bodyProxy.capsules = {{0, Vec3f::Zero(), Vec3f(0.f, 0.5f, 0.f), 0.1f},
-                              {0, Vec3f::Zero(), Vec3f::Zero(), 0.05f}};
+    if (!k.proxy) {
+      m.bodyAnchors = BodyAnchors{};
+    } else if (m.bodyAnchors.empty()) {
+      BodyAnchor a;
+      a.normal = Vec3f::UnitZ();
+      a.radius = 0.05f;
+      a.clearance = 0.002f;
+      a.weights = {1.f, 0.f, 0.f, 0.f};
+      m.bodyAnchors.anchors.assign(m.gameMesh.vertexCount(), a);
+    }
     gpu::GpuModel g(ctx(), m, "m");
     gpu::FrameRecorderOptions ro;
     ro.framesInFlight = 1;
@@ -403,7 +408,7 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
     };
     EXPECT_EQ(allocated({&g.mean, &g.basis, &g.skinJoints, &g.skinWeights, &g.uvs, &g.triangles, &g.normalOffsets,
                          &g.normalTriangles, &g.tangentOffsets, &g.tangentTriangles, &g.frameTriangles, &g.codebook,
-                         &g.indices},
+                         &g.indices, &g.anchors},
                         "m: "),
               planned(gpu::modelAllocations(m, k.maps), false));
     const auto& f = rec.frame(0);
@@ -416,16 +421,15 @@ TEST_F(ReplayE2E, PlannedMemoryIsAllocatedMemory) {
       EXPECT_TRUE(shared);
     }
     const auto plan = gpu::frameAllocations(m, 3, k.maps, k.maps, shared);
-    EXPECT_EQ(allocated({&f.meshWeights, &f.instanceOrder, &f.skinMatrices, &f.posedCapsules, &f.decodeSlotMaps,
-                         &f.blendCharacters, &f.positions, &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps,
-                         &f.blendedTexels},
+    EXPECT_EQ(allocated({&f.meshWeights, &f.instanceOrder, &f.skinMatrices, &f.decodeSlotMaps, &f.blendCharacters,
+                         &f.positions, &f.normals, &f.tangents, &f.triangleTerms, &f.decodedMaps, &f.blendedTexels},
                         "m frame 0: "),
               planned(plan, false));
     uint64_t imageBytes = 0;
     for (const auto& [name, bytes] : planned(plan, true)) imageBytes += bytes;
     EXPECT_EQ(imageBytes,
               k.maps ? uint64_t(f.normalMaps.width()) * f.normalMaps.height() * f.normalMaps.layers() * 4 : 0u);
-    EXPECT_EQ(planned(plan, false).count("posed capsules"), k.proxy ? 1u : 0u);
+    EXPECT_EQ(planned(gpu::modelAllocations(m, k.maps), false).count("body anchors"), k.proxy ? 1u : 0u);
   }
 }
 

@@ -79,8 +79,8 @@ int main(int argc, char** argv) {
     s.hiddenLayers = 0;
     shapes.push_back({"linear_mlp", s});
     s = small();
-    s.bodyCapsules = 3;
-    shapes.push_back({"body_proxy", s});
+    s.bodyAnchors = true;
+    shapes.push_back({"body_anchors", s});
     s = small();
     s.noveltyCentres = 3;
     shapes.push_back({"novelty_guard", s});

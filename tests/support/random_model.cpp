@@ -118,17 +118,29 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
   m.outputNorm.mean = VecXf::Zero(out);
   m.outputNorm.scale = VecXf::Ones(out);
   m.metadata = R"({"generator":"makeRandomModel"})";
-  // Body proxy: capsules over the mesh's box (x, y spanning the grid, z near 0), a few centimetres thick,
-  // so that some vertices lie inside one or more of them and some outside all.
-  const float width = 0.02f * float(cols), height = 0.02f * float((n + cols - 1) / cols);
-  for (uint32_t c = 0; c < s.bodyCapsules; ++c) {
-    BodyCapsule cap;
-    cap.joint = uint32_t(rng.below(s.joints));
-    cap.a = Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
-    cap.b = c % 4 == 3 ? cap.a
-                       : Vec3f(rng.uniformf(0.f, width), 1.f + rng.uniformf(0.f, height), rng.uniformf(-.02f, .02f));
-    cap.radius = rng.uniformf(0.005f, 0.05f);
-    m.bodyProxy.capsules.push_back(cap);
+  // Body anchors: each vertex's anchor a few centimetres from its rest position, on either side of it
+  // along a normal near -z (the mesh lies in z ~ 0), with balls of 1.5 to 8 cm, so that the skinned
+  // mesh enters some balls and not others; four random influences, the first the vertex's own first
+  // joint (so that ball and vertex move together), the last often 0; every 7th vertex without one.
+  if (s.bodyAnchors) {
+    m.bodyAnchors.margin = 0.002f;
+    m.bodyAnchors.anchors.resize(n);
+    for (uint32_t v = 0; v < n; ++v) {
+      if (v % 7 == 3) continue;
+      BodyAnchor& a = m.bodyAnchors.anchors[v];
+      a.normal = Vec3f(rng.uniformf(-.5f, .5f), rng.uniformf(-.5f, .5f), -1.f).normalized();
+      a.position = m.gameMesh.positions.row(v).transpose() + a.normal * rng.uniformf(-.03f, .02f);
+      a.radius = rng.uniformf(.015f, .08f);
+      a.clearance = v % 3 == 0 ? m.bodyAnchors.margin : rng.uniformf(-.01f, m.bodyAnchors.margin);
+      float sum = 0.f;
+      for (int i = 0; i < kAnchorInfluences; ++i) {
+        a.joints[size_t(i)] =
+            i == 0 ? g.skin.joints[size_t(v) * size_t(g.skin.influences)] : uint16_t(rng.below(s.joints));
+        a.weights[size_t(i)] = i == 3 && v % 2 ? 0.f : rng.uniformf(0.05f, 1.f);
+        sum += a.weights[size_t(i)];
+      }
+      for (float& w : a.weights) w /= sum;
+    }
   }
   // Novelty guard: centres near the origin of the normalised input space, weight ranges around 0.
   if (s.noveltyCentres > 0) {

@@ -20,8 +20,8 @@ struct RandomModelSpec {
   uint32_t codeDims = 3;
   uint32_t mapSize = 16;  // width = height, multiple of 4
   uint32_t codebookSize = 32;
-  uint32_t bodyCapsules = 0;    // body proxy capsules across the mesh (drawn last: other draws unchanged)
-  uint32_t noveltyCentres = 0;  // novelty guard centres (drawn after the capsules), with clamp and blend
+  bool bodyAnchors = false;     // one body anchor per vertex (every 7th without), drawn after the MLP
+  uint32_t noveltyCentres = 0;  // novelty guard centres (drawn after the anchors), with clamp and blend
 };
 
 Model makeRandomModel(Rng& rng, const RandomModelSpec& spec = {});

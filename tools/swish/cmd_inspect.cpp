@@ -88,11 +88,9 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
   }
   j["temporalFilter"] = {{"timeConstantSeconds", m.temporalFilter.timeConstantSeconds}};
   j["qualityLevels"] = swish::runtime::toJson(swish::runtime::ladderOf(m));
-  json capsules = json::array();
-  for (const BodyCapsule& c : m.bodyProxy.capsules)
-    capsules.push_back(
-        {{"joint", m.skeleton.joints[c.joint].name}, {"radiusM", c.radius}, {"lengthM", (c.b - c.a).norm()}});
-  j["bodyProxy"] = {{"capsules", capsules}};
+  j["bodyAnchors"] = {{"anchored", m.bodyAnchors.anchored()},
+                      {"vertices", m.bodyAnchors.anchors.size()},
+                      {"marginM", m.bodyAnchors.margin}};
   // Metadata is meant to be JSON; show it as such when it is, as text when it is not.
   const json meta = json::parse(m.metadata, nullptr, /*allow_exceptions=*/false);
   if (meta.is_discarded())
@@ -140,9 +138,16 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
       o << line;
     }
   }
-  o << "  body proxy    " << m.bodyProxy.capsules.size() << " capsules"
-    << (m.bodyProxy.empty() ? " (no push-out at run time)" : " (the run-time push-out keeps the garment off them)")
-    << "\n";
+  if (m.bodyAnchors.empty()) {
+    o << "  body anchors  none (no push-out at run time; swish body-proxy fits them)\n";
+  } else {
+    char line[160];
+    std::snprintf(
+        line, sizeof line,
+        "  body anchors  %zu of %zu vertices, margin %.1f mm (the run-time push-out keeps them off the body)\n",
+        m.bodyAnchors.anchored(), m.bodyAnchors.anchors.size(), 1000.0 * double(m.bodyAnchors.margin));
+    o << line;
+  }
   o << "  sections\n";
   for (const auto& s : info.sections) {
     char line[128];

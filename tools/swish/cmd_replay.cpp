@@ -8,9 +8,9 @@
 // parallel.
 //
 // Penetration of the garment into the body it was baked on is measured every frame (on the CPU
-// reference's positions, before and after the run time's push-out of the model's body proxy) and
+// reference's positions, before and after the run time's push-out to the model's body anchors) and
 // reported with a plot; --penetration-every N thins that, 0 turns it off; --push-out runs the GPU with
-// the push-out of the model's body proxy (off by default: it measured worse against truth).
+// the push-out to the model's body anchors (off by default).
 //
 // Exit codes: 0 all frames replayed and every check within tolerance; 3 replayed, but bad poses were
 // met or a GPU output differed from the CPU reference beyond tolerance (see the report); 1 an error
@@ -261,8 +261,8 @@ swish::cli::CommandRegistration reg{
           "on every Nth frame; 0: not at all (default 30: the measure poses a body collider per character, costly on "
           "the CPU)");
       app.add_flag("--push-out", o->pushOut,
-                   "push the garment out of the model's body proxy on the GPU (models that carry one; off by default: "
-                   "measured to raise the error against the source simulation)");
+                   "keep the garment off the body on the GPU: each vertex outside its body anchor's ball "
+                   "(models that carry anchors, format 1.3: `swish body-proxy` adds them; off by default)");
       app.add_flag(
           "--hide-covered-body", o->hideCoveredBody,
           "with --render: leave out the body triangles the garment covers in (nearly) every training pose (the "

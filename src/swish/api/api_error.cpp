@@ -67,7 +67,7 @@ ModelInfo describeModel(const swish::Model& m, const std::string& name) {
   info.normalMapHeight = m.normalMaps.height;
   info.normalMapDatabaseSize = m.normalMaps.mapCount();
   info.temporalFilterSeconds = m.temporalFilter.timeConstantSeconds;
-  info.bodyCapsules = uint32_t(m.bodyProxy.capsules.size());
+  info.bodyAnchors = uint32_t(m.bodyAnchors.anchored());
   info.coveredBodyOf = m.bodyCoverage.bodyTriangles;
   info.coveredBodyTriangles = m.bodyCoverage.covered;
   info.hasNoveltyGuard = !m.noveltyGuard.empty();

@@ -1,6 +1,7 @@
 #include "swish/gpu/deform_pass.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 #include "shaders/swish_layouts.h"
@@ -71,6 +72,28 @@ void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
       for (int c = 0; c < 4; ++c) out[12 * i + 4 * r + c] = m[i](r, c);
 }
 
+static_assert(SWISH_ANCHOR_WORDS == 4 + 2 * kAnchorInfluences, "shaders/swish_layouts.h: body anchor layout");
+
+std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32_t jointCount) {
+  std::vector<uint32_t> out(anchors.anchors.size() * SWISH_ANCHOR_WORDS);
+  auto put = [&](size_t at, float f) { std::memcpy(&out[at], &f, 4); };
+  for (size_t v = 0; v < anchors.anchors.size(); ++v) {
+    const BodyAnchor& a = anchors.anchors[v];
+    const size_t o = v * SWISH_ANCHOR_WORDS;
+    const Vec3f centre = a.present() ? a.centre() : Vec3f::Zero();
+    for (int k = 0; k < 3; ++k) put(o + size_t(k), centre[k]);
+    put(o + 3, a.present() ? a.reach() : 0.f);
+    for (size_t i = 0; i < size_t(kAnchorInfluences); ++i) {
+      if (a.joints[i] >= jointCount)
+        throw Error("body anchor of vertex " + std::to_string(v) + ": joint " + std::to_string(a.joints[i]) +
+                    " is not in the skeleton of " + std::to_string(jointCount) + " joints");
+      put(o + 4 + i, a.weights[i]);
+      out[o + 8 + i] = a.joints[i];
+    }
+  }
+  return out;
+}
+
 DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats)
     : basisTexels_(basisFloats > 0 && basisFloats <= ctx.properties().limits.maxTexelBufferElements),
       meshComponents_(k) {
@@ -112,13 +135,11 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.skinJoints = layout::Address::of(a.skinJoints);
   p.skinWeights = layout::Address::of(a.skinWeights);
   p.positionsOut = layout::Address::of(a.positionsOut);
-  if (a.capsuleCount > 0 && !a.capsules)
-    throw Error("deform pass: " + std::to_string(a.capsuleCount) + " capsules but no capsule buffer");
-  p.capsules = layout::Address::of(a.capsules);
+  p.anchors = layout::Address::of(a.anchors);
+  p.pushOut = a.anchors ? 1u : 0u;
   p.vertexCount = a.vertexCount;
   p.instanceCount = a.instanceCount;
   p.jointCount = a.jointCount;
-  p.capsuleCount = a.capsuleCount;
   p.instanceOrder = layout::Address::of(a.instanceOrder);
   p.maxGroups = groupsOf(meshComponents_);
   for (size_t b = 0; b < a.bandEnd.size(); ++b) p.bandEnd[b] = a.instanceCount;

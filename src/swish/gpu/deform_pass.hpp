@@ -1,8 +1,8 @@
 #pragma once
 // The deform pass (shaders/deform.comp): PCA reconstruction + linear blend skinning (+ the push-out of
-// the posed body proxy, runtime/reference_push_out.hpp) of every instance of one model in ONE dispatch; each vertex's
-// basis values are read once per frame for all instances. The per-instance inputs (mesh weights, skin matrix rows) are
-// bound as texel buffers through a descriptor set made once per pair of buffers by bindInstanceInputs
+// the body anchors' balls, runtime/reference_push_out.hpp) of every instance of one model in ONE dispatch; each
+// vertex's basis values are read once per frame for all instances. The per-instance inputs (mesh weights, skin matrix
+// rows) are bound as texel buffers through a descriptor set made once per pair of buffers by bindInstanceInputs
 // (descriptor_binding.hpp says why), and with them the model's basis as R32 texels where it fits in the device's
 // maxTexelBufferElements (shaders/deform_basis_texels.comp; else shaders/deform.comp reads it through its address).
 // Quality levels (per-instance k, runtime/quality_levels.hpp) in the same one dispatch: two pipelines of
@@ -24,6 +24,7 @@
 #include "swish/core/types.hpp"
 #include "swish/gpu/compute_pipeline.hpp"
 #include "swish/gpu/descriptor_binding.hpp"
+#include "swish/model/model.hpp"
 
 namespace swish::gpu {
 
@@ -37,8 +38,9 @@ class DeformPass {
     VkDeviceAddress skinJoints = 0;    // uint[N][influences]
     VkDeviceAddress skinWeights = 0;   // float[N][influences]
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
-    VkDeviceAddress capsules = 0;      // float[instances][capsuleCount][8], runtime::poseBodyProxy's layout
-    uint32_t capsuleCount = 0;         // per instance; 0: no push-out
+    // The push-out: word[N][SWISH_ANCHOR_WORDS], packAnchors' layout (the model's, GpuModel::anchors);
+    // 0: no push-out. Only with skinning applied (the anchors are skinned like the vertices).
+    VkDeviceAddress anchors = 0;
     VkDescriptorSet instanceInputs = VK_NULL_HANDLE;  // from bindInstanceInputs
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;
@@ -90,6 +92,11 @@ class DeformPass {
   }
   // Writes `count` matrices (instance-major, as FrameKernelInputs holds them) in that layout.
   static void packSkinMatrices(const Mat4f* matrices, size_t count, float* out);
+  // The body anchors (one per vertex) in the push-out's layout: word[N][SWISH_ANCHOR_WORDS], float ball
+  // centre xyz (BodyAnchor::centre()), reach (BodyAnchor::reach()), weights[4], then uint joints[4]. Throws Error
+  // naming the vertex for a joint
+  // >= jointCount (the kernel fetches every influence's matrix, even at weight 0).
+  static std::vector<uint32_t> packAnchors(const BodyAnchors& anchors, uint32_t jointCount);
 
   DeformPass() = default;
   // meshComponents (K) in 1..SWISH_MAX_MESH_COMPONENTS; influences in 1..8. applySkinning = false writes

@@ -9,7 +9,6 @@
 #include "swish/gpu/context.hpp"
 #include "swish/gpu/gpu_model.hpp"
 #include "swish/gpu/vk_check.hpp"
-#include "swish/runtime/reference_push_out.hpp"
 
 namespace swish::gpu {
 
@@ -119,13 +118,7 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
   matrixRows_.resize(in.skinMatrices.size() * 12);
   DeformPass::packSkinMatrices(in.skinMatrices.data(), in.skinMatrices.size(), matrixRows_.data());
   f.skinMatrices.upload(*ctx_, matrixRows_.data(), matrixRows_.size() * sizeof(float));
-  const bool pushOut = in.pushOut && m.capsuleCount() > 0;
-  if (pushOut) {
-    posedCapsules_.clear();
-    for (uint32_t i = 0; i < in.instanceCount; ++i)
-      runtime::poseBodyProxy(m.bodyProxy(), std::span(in.skinMatrices).subspan(i * j, j), posedCapsules_);
-    f.posedCapsules.upload(*ctx_, posedCapsules_.data(), posedCapsules_.size() * sizeof(float));
-  }
+  const bool pushOut = in.pushOut && m.hasBodyAnchors();
 
   // Orders this frame after earlier frames' GPU work on the queue: their writes of the normal maps this
   // frame blends from, and their reads of buffers this frame overwrites.
@@ -135,8 +128,7 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
 
   DeformPass::Args d = m.deformArgs(f.deformInputs.get(), f.positions, in.instanceCount);
   if (pushOut) {
-    d.capsules = f.posedCapsules.address();
-    d.capsuleCount = m.capsuleCount();
+    d.anchors = m.anchors.address();
   }
   if (levels) {
     d.instanceOrder = f.instanceOrder.address();

@@ -91,7 +91,7 @@ class FrameRecorder {
   VqDecodePass decode_;
   NormalMapBlendPass blend_;
   std::vector<FrameResources> frames_;
-  std::vector<float> weightRows_, matrixRows_, posedCapsules_;  // inputs in DeformPass's layouts
+  std::vector<float> weightRows_, matrixRows_;  // inputs in DeformPass's layouts
   uint64_t records_ = 0;  // record() calls that decoded: the clock of FrameResources::slotLastUsed
   // Per instance (layer): the version of its current map, set by each blend or upload from versionClock_;
   // FrameResources::layerVersion says which slots hold it.

@@ -18,16 +18,15 @@ namespace {
 // The bytes of one frame in flight's buffers: the constructor allocates these and frameAllocations()
 // lists them. Counts as GpuModel holds them (kernelComponents = max(K, 1)); 0 for what is not allocated.
 struct FrameSizes {
-  VkDeviceSize meshWeights = 0, instanceOrder = 0, skinMatrices = 0, posedCapsules = 0, positions = 0;
+  VkDeviceSize meshWeights = 0, instanceOrder = 0, skinMatrices = 0, positions = 0;
   VkDeviceSize normals = 0, tangents = 0, triangleTerms = 0;                      // with tangent frames
   VkDeviceSize decodeJobs = 0, blendCharacters = 0, decodedMaps = 0, texels = 0;  // with normal maps
-  FrameSizes(uint32_t vertices, uint32_t triangles, uint32_t joints, uint32_t kernelComponents, uint32_t capsules,
-             uint32_t mapWidth, uint32_t mapHeight, uint32_t instances, bool frames, bool maps) {
+  FrameSizes(uint32_t vertices, uint32_t triangles, uint32_t joints, uint32_t kernelComponents, uint32_t mapWidth,
+             uint32_t mapHeight, uint32_t instances, bool frames, bool maps) {
     const VkDeviceSize n = vertices, c = std::max(1u, instances);
     meshWeights = DeformPass::weightsBytes(uint32_t(c), kernelComponents);
     instanceOrder = DeformPass::orderBytes(uint32_t(c));
     skinMatrices = std::max<VkDeviceSize>(16, DeformPass::skinMatricesBytes(uint32_t(c), joints));
-    posedCapsules = c * capsules * 8 * sizeof(float);
     positions = c * n * 3 * sizeof(float);
     if (frames) {
       normals = c * n * 3 * sizeof(float);
@@ -48,9 +47,8 @@ struct FrameSizes {
 std::vector<Allocation> frameAllocations(const Model& m, uint32_t instances, bool frames, bool maps, bool shareTexels) {
   maps = maps && !m.normalMaps.empty();
   const FrameSizes z(uint32_t(m.gameMesh.vertexCount()), uint32_t(m.gameMesh.triangleCount()),
-                     uint32_t(m.skeleton.size()), std::max(1u, uint32_t(m.meshComponents())),
-                     uint32_t(m.bodyProxy.capsules.size()), m.normalMaps.width, m.normalMaps.height, instances, frames,
-                     maps);
+                     uint32_t(m.skeleton.size()), std::max(1u, uint32_t(m.meshComponents())), m.normalMaps.width,
+                     m.normalMaps.height, instances, frames, maps);
   std::vector<Allocation> a;
   auto add = [&](const char* name, VkDeviceSize bytes, bool image = false) {
     a.push_back({name, bytes == 0 ? 4 : bytes, image});
@@ -58,7 +56,6 @@ std::vector<Allocation> frameAllocations(const Model& m, uint32_t instances, boo
   add("mesh weights", z.meshWeights);
   add("instance order", z.instanceOrder);
   add("skin matrices", z.skinMatrices);
-  if (z.posedCapsules > 0) add("posed capsules", z.posedCapsules);
   add("positions", z.positions);
   if (frames) {
     add("normals", z.normals);
@@ -81,14 +78,12 @@ std::vector<Allocation> frameAllocations(const Model& m, uint32_t instances, boo
 FrameResources::FrameResources(Context& ctx, const GpuModel& m, uint32_t cap, bool withFrames, bool withMaps,
                                uint32_t slot, bool shareTexels) {
   const std::string tag = m.name() + " frame " + std::to_string(slot) + ": ";
-  const FrameSizes z(m.vertexCount(), m.triangleCount(), m.jointCount(), m.kernelMeshComponents(), m.capsuleCount(),
-                     m.mapWidth(), m.mapHeight(), cap, withFrames, withMaps);
+  const FrameSizes z(m.vertexCount(), m.triangleCount(), m.jointCount(), m.kernelMeshComponents(), m.mapWidth(),
+                     m.mapHeight(), cap, withFrames, withMaps);
   const uint32_t c = std::max(1u, cap);
   meshWeights = Buffer(ctx, z.meshWeights, MemoryKind::HostVisible, tag + "mesh weights");
   instanceOrder = Buffer(ctx, z.instanceOrder, MemoryKind::HostVisible, tag + "instance order");
   skinMatrices = Buffer(ctx, z.skinMatrices, MemoryKind::HostVisible, tag + "skin matrices");
-  if (z.posedCapsules > 0)
-    posedCapsules = Buffer(ctx, z.posedCapsules, MemoryKind::HostVisible, tag + "posed capsules");
   positions = Buffer(ctx, z.positions, MemoryKind::DeviceLocal, tag + "positions");
   if (withFrames) {
     normals = Buffer(ctx, z.normals, MemoryKind::DeviceLocal, tag + "normals");

@@ -36,7 +36,6 @@ struct FrameResources {
   Buffer meshWeights;     // float[instances][K4] (DeformPass::packWeights), zero beyond each instance's k
   Buffer instanceOrder;   // uint[instances]: the deform's instances by quality band (DeformPass::packLevels)
   Buffer skinMatrices;    // vec4[instances][joints][3] (DeformPass::packSkinMatrices)
-  Buffer posedCapsules;   // float[instances][capsules][8] (runtime::poseBodyProxy); empty without a proxy
   Buffer decodeSlotMaps;  // the VQ decode jobs: uint[2][instances], maps then the slots they go to
   // layout::NormalMapBlendCharacter[instances], then uint[instances]: the layer of each (the blend's
   // characters are the instances with a map this frame)

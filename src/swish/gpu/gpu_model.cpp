@@ -30,6 +30,7 @@ struct ModelUploads {
   std::vector<uint32_t> frameTriangles;
   std::vector<int8_t> codebook;
   std::vector<uint16_t> indices;
+  std::vector<uint32_t> anchors;
 
   ModelUploads(const Model& m, bool withNormalMaps) {
     const Mesh& g = m.gameMesh;
@@ -73,6 +74,10 @@ struct ModelUploads {
       indices.resize((indices.size() + 1) / 2 * 2, 0);
       add(&GpuModel::indices, "VQ indices", indices.data(), indices.size() * 2);
     }
+    if (!m.bodyAnchors.empty()) {
+      anchors = DeformPass::packAnchors(m.bodyAnchors, uint32_t(m.skeleton.size()));
+      add(&GpuModel::anchors, "body anchors", anchors.data(), anchors.size() * 4);
+    }
   }
 };
 
@@ -85,7 +90,7 @@ std::vector<Allocation> modelAllocations(const Model& model, bool withNormalMaps
   return out;
 }
 
-GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name_(name), bodyProxy_(m.bodyProxy) {
+GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name_(name) {
   const Mesh& g = m.gameMesh;
   const auto fail = [&](const std::string& what) { throw Error(name + ": cannot upload to the GPU: " + what); };
   vertexCount_ = uint32_t(g.vertexCount());
@@ -124,6 +129,17 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
     mapWidth_ = db.width;
     mapHeight_ = db.height;
     codebookSize_ = db.codebookSize;
+  }
+
+  if (!m.bodyAnchors.empty()) {
+    if (m.bodyAnchors.anchors.size() != n)
+      fail(std::to_string(m.bodyAnchors.anchors.size()) + " body anchors for " + std::to_string(n) + " vertices");
+    for (size_t v = 0; v < n; ++v)
+      for (const uint16_t j : m.bodyAnchors.anchors[v].joints)
+        if (j >= jointCount_)  // the kernel fetches every influence's matrix, even at weight 0
+          fail("body anchor joint " + std::to_string(j) + " of vertex " + std::to_string(v) +
+               " is not in the skeleton of " + std::to_string(jointCount_) + " joints");
+    hasAnchors_ = true;
   }
 
   const ModelUploads uploads(m, true);

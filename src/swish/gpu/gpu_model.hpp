@@ -35,9 +35,8 @@ class GpuModel {
   uint32_t mapWidth() const { return mapWidth_; }
   uint32_t mapHeight() const { return mapHeight_; }
   uint32_t codebookSize() const { return codebookSize_; }
-  // The body proxy the deform kernel's push-out poses each frame (on the CPU; no GPU copy of its own).
-  const BodyProxy& bodyProxy() const { return bodyProxy_; }
-  uint32_t capsuleCount() const { return uint32_t(bodyProxy_.capsules.size()); }
+  // The push-out's body anchors (`anchors`, DeformPass::packAnchors' layout).
+  bool hasBodyAnchors() const { return hasAnchors_; }
 
   // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
   // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
@@ -47,10 +46,11 @@ class GpuModel {
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;
   Buffer frameTriangles;  // TangentFramesPass::frameTriangles: the two-pass gather's one walk of both adjacencies
   Buffer codebook, indices;
+  Buffer anchors;  // word[N][SWISH_ANCHOR_WORDS]; empty without body anchors
 
  private:
   std::string name_;
-  BodyProxy bodyProxy_;
+  bool hasAnchors_ = false;
   uint32_t vertexCount_ = 0, triangleCount_ = 0, jointCount_ = 0, meshComponents_ = 0, kernelComponents_ = 1;
   uint32_t influences_ = 1;
   bool hasUvs_ = false;

@@ -85,16 +85,41 @@ void Model::validate(const std::string& what) const {
   } else if (db.codeDims() != 0) {
     fail("normal maps", "keys have dimensions but no maps");
   }
-  if (bodyProxy.capsules.size() > kMaxBodyCapsules)
-    fail("body proxy", n2s(bodyProxy.capsules.size()) + " capsules; at most " + n2s(kMaxBodyCapsules));
-  for (size_t c = 0; c < bodyProxy.capsules.size(); ++c) {
-    const BodyCapsule& cap = bodyProxy.capsules[c];
-    if (cap.joint >= skeleton.size())
-      fail("body proxy", "capsule " + n2s(c) + " joint " + n2s(cap.joint) + " >= joint count " + n2s(skeleton.size()));
-    if (!cap.a.allFinite() || !cap.b.allFinite())
-      fail("body proxy", "capsule " + n2s(c) + " has non-finite end points");
-    if (!(cap.radius > 0.f) || !(cap.radius < 10.f))
-      fail("body proxy", "capsule " + n2s(c) + " radius must be in (0, 10) metres");
+  if (!bodyAnchors.empty()) {
+    const BodyAnchors& ba = bodyAnchors;
+    if (ba.anchors.size() != n)
+      fail("body anchors",
+           n2s(ba.anchors.size()) + " anchors for " + n2s(n) + " game-mesh vertices (one each, or none)");
+    if (!(ba.margin >= 0.f && ba.margin <= kMaxAnchorMargin))
+      fail("body anchors", "margin " + std::to_string(ba.margin) + " m is not in [0, 0.05] metres");
+    for (size_t v = 0; v < n; ++v) {
+      const BodyAnchor& a = ba.anchors[v];
+      const std::string which = "anchor of vertex " + n2s(v);
+      if (!a.present()) {
+        if (a.position != Vec3f::Zero() || a.normal != Vec3f::Zero() || a.radius != 0.f || a.clearance != 0.f)
+          fail("body anchors", which + " has no weights (no anchor) but a position, normal, radius or clearance");
+        continue;
+      }
+      if (!a.position.allFinite()) fail("body anchors", which + " has a non-finite position");
+      if (!a.normal.allFinite() || !(std::abs(a.normal.norm() - 1.f) <= 1e-3f))
+        fail("body anchors", which + " has a normal that is not of unit length");
+      if (!(a.radius >= kMinAnchorRadius && a.radius <= kMaxAnchorRadius))
+        fail("body anchors", which + " has radius " + std::to_string(a.radius) + " m, not in [0.001, 1]");
+      if (!(a.clearance <= ba.margin && a.clearance >= -kMaxAnchorDepth && a.reach() > 0.f))
+        fail("body anchors", which + " has clearance " + std::to_string(a.clearance) +
+                                 " m, not in [-0.2 m, margin] or not above minus its radius");
+      float sum = 0.f;
+      for (int i = 0; i < kAnchorInfluences; ++i) {
+        if (!(a.weights[size_t(i)] >= 0.f) || !std::isfinite(a.weights[size_t(i)]))
+          fail("body anchors", which + " has a negative or non-finite weight");
+        if (a.joints[size_t(i)] >= skeleton.size())  // the kernel fetches every influence's matrix
+          fail("body anchors",
+               which + " joint " + n2s(a.joints[size_t(i)]) + " >= joint count " + n2s(skeleton.size()));
+        sum += a.weights[size_t(i)];
+      }
+      if (!(std::abs(sum - 1.f) <= 1e-3f))
+        fail("body anchors", which + " has weights summing to " + std::to_string(sum) + ", not 1");
+    }
   }
   const NoveltyGuard& g = noveltyGuard;
   if (!g.empty()) {
@@ -122,6 +147,12 @@ void Model::validate(const std::string& what) const {
                                 " triangles");
   if (!(temporalFilter.timeConstantSeconds >= 0.f) || !std::isfinite(temporalFilter.timeConstantSeconds))
     fail("temporal filter", "time constant must be finite and >= 0");
+}
+
+size_t BodyAnchors::anchored() const {
+  size_t k = 0;
+  for (const BodyAnchor& a : anchors) k += a.present() ? 1 : 0;
+  return k;
 }
 
 }  // namespace swish

@@ -8,6 +8,7 @@
 //   mesh weights = Lambda[0 .. K), normal code = Lambda[K .. K + C)
 //   pre-skin shape = meshPca.mean + meshPca.basis * weights  ->  linear blend skinning
 //   normal map = database map whose key is nearest the code  ->  VQ decode -> temporal blend
+#include <array>
 #include <string>
 #include <vector>
 
@@ -65,24 +66,59 @@ struct TemporalFilterParams {
   float timeConstantSeconds = 0.1f;
 };
 
-// A cheap stand-in for the body under the garment, for the run-time push-out (paper 2.3 has none; see
-// runtime/reference_push_out.hpp): capsules that ride on skinning joints. Each capsule is the set of
-// points within `radius` of the segment a..b, given in REST (bind) character space; it is posed rigidly
-// with its joint's skinning matrix. Fitted INSIDE the body (bake/training/body_proxy_fit.hpp), so that pushing a
-// garment vertex out of a capsule never carries it past the real body surface.
-struct BodyCapsule {
-  uint32_t joint = 0;
-  Vec3f a = Vec3f::Zero(), b = Vec3f::Zero();
-  float radius = 0.f;  // metres, > 0
+// The run-time push-out's hold on the body (format 1.3; runtime/reference_push_out.hpp, fitted by
+// bake/training/body_anchor_fit.hpp): per game-mesh vertex, the closest point of the body it was baked
+// on, at rest, with the body's outward normal there, the body's skin at that point (its triangle's
+// three vertices' weights interpolated barycentrically, the kAnchorInfluences largest kept and
+// renormalised), and the radius of the largest ball inside the body's part that touches the surface
+// there (centre = position - radius * normal): the body under the vertex, as seen from the vertex. At
+// run time the ball's centre is skinned like the garment and the vertex is kept outside the ball, its
+// `clearance` off the surface, by a radial push: one ball per vertex. A vertex answers to its own
+// anchor only, so a sleeve anchored on the arm is never pushed out of the torso (the capsules of
+// formats 1.1 and 1.2 did that, and made the error worse).
+//
+// Why a ball and not the tangent plane at the anchor: cloth slides over the body, and a sleeve vertex
+// that has turned 3 cm around the arm is behind the plane of its anchor while well outside the arm.
+// Pushed to the plane, such vertices moved away from the simulated truth (measured on the default
+// model: +1.0 mm mean vertex error); the ball inscribed in the arm follows the arm's round section
+// (a flat chest gets a large ball, a plane in the limit), and the same push then kept the error.
+//
+// The clearance is the model's margin, or lower where pushing the network's garment to the margin
+// took it away from the source simulation in the poses the anchors were calibrated on
+// (calibrateBodyAnchors): then the push-out removes what the network adds beyond what the simulation
+// does, and never pushes against the simulation there.
+inline constexpr int kAnchorInfluences = 4;
+struct BodyAnchor {
+  Vec3f position = Vec3f::Zero();  // on the body surface, rest character space, metres
+  Vec3f normal = Vec3f::Zero();    // unit, out of the body (rest)
+  float radius = 0.f;              // of the ball inside the body touching it at `position` (metres, > 0)
+  float clearance = 0.f;           // metres off the ball the vertex is kept: <= margin, > -radius, >= -kMaxAnchorDepth
+  std::array<uint16_t, kAnchorInfluences> joints{};
+  std::array<float, kAnchorInfluences> weights{};  // >= 0, summing to 1; ALL 0 (and everything else 0): no anchor
+  bool present() const { return weights[0] != 0.f || weights[1] != 0.f || weights[2] != 0.f || weights[3] != 0.f; }
+  // The ball's centre at rest (every user computes it by this one expression, so that it rounds alike).
+  Vec3f centre() const { return position - normal * radius; }
+  // Distance from the centre the push-out keeps a vertex at: radius + clearance (0 without an anchor).
+  float reach() const { return radius + clearance; }
 };
 
-struct BodyProxy {
-  std::vector<BodyCapsule> capsules;  // applied in this order; empty: no push-out
-  bool empty() const { return capsules.empty(); }
+struct BodyAnchors {
+  // The clearance an anchor starts with (metres): the cloth's own half thickness, so that a pushed
+  // vertex does not sit exactly on the body surface and z-fight with it; no anchor's is above it.
+  float margin = 0.002f;
+  std::vector<BodyAnchor> anchors;  // empty (no push-out) or one per game-mesh vertex
+  bool empty() const { return anchors.empty(); }
+  size_t anchored() const;  // vertices with an anchor
 };
 
-// Most capsules a proxy may hold (the deform kernel loops over all of them per vertex and instance).
-inline constexpr size_t kMaxBodyCapsules = 64;
+// Largest margin a model may ask for (metres): beyond a few centimetres the push-out would hold
+// the garment visibly off the body, which is not what it is for.
+inline constexpr float kMaxAnchorMargin = 0.05f;
+// Deepest an anchor's clearance may go into its ball (metres): beyond that the anchor says nothing
+// (the calibration drops such anchors instead).
+inline constexpr float kMaxAnchorDepth = 0.2f;
+// Range of an anchor's ball radius (metres): from a crease of the body to a flat back.
+inline constexpr float kMinAnchorRadius = 0.001f, kMaxAnchorRadius = 1.f;
 
 // The run-time novelty guard (format 1.2; runtime/novelty_guard.hpp): how far a frame's network input
 // lies from the poses the model was trained on, and what the run time does when it is far. Novelty is
@@ -121,7 +157,7 @@ struct Model {
   Mesh gameMesh;                 // rest positions, triangles, UVs, skin, rest normals+tangents
   NormalMapDatabase normalMaps;  // may be empty (a model without normal maps)
   TemporalFilterParams temporalFilter;
-  BodyProxy bodyProxy;          // may be empty (models of format 1.0, or baked without a body)
+  BodyAnchors bodyAnchors;      // may be empty (models before format 1.3, or baked without a body)
   NoveltyGuard noveltyGuard;    // may be empty (models before format 1.2)
   BodyCoverage bodyCoverage;    // may be empty (models before format 1.2, or baked without a body)
   std::string metadata = "{}";  // free-form JSON: bake settings, errors measured at bake time

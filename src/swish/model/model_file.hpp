@@ -1,7 +1,7 @@
 #pragma once
 // The .swish model file: everything the run time needs for one garment, in one checked binary file.
 //
-// ==================================== Layout, format version 1.2 ====================================
+// ==================================== Layout, format version 1.3 ====================================
 // All integers are unsigned little-endian unless marked i32 (two's complement). f32 is IEEE-754
 // binary32, little-endian, bit pattern kept exactly. There is no padding or alignment anywhere: fields
 // follow each other byte after byte. Matrices are column-major (Eigen's order) unless said otherwise.
@@ -9,7 +9,7 @@
 // File header, 32 bytes:
 //   0   u8[8]  magic: 0x89 'S' 'W' 'I' 'S' 'H' 0x0D 0x0A  (0x89 and CR LF catch text-mode mangling)
 //   8   u16    major version = 1. A reader refuses a larger major version.
-//   10  u16    minor version = 2. Minor versions only ADD sections; a reader skips tags it does not
+//   10  u16    minor version = 3. Minor versions only ADD sections; a reader skips tags it does not
 //              know when the file's minor version is newer than its own, and refuses them otherwise.
 //   12  u32    section count
 //   16  u64    total file size in bytes, header included (catches truncation before anything else)
@@ -22,7 +22,7 @@
 //   16  u8[payload size] payload; every payload must be read to its last byte (trailing bytes = error)
 //
 // Sections of version 1.0: each exactly once, all required, any order (the writer uses this one and
-// puts BPRX, NOVG and BCOV before META).
+// puts BPRX, NOVG, BCOV and BANC before META).
 //   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
 //          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
 //          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
@@ -48,8 +48,11 @@
 //   "META" free-form metadata, UTF-8 JSON text, the whole payload, no terminator.
 // Added in version 1.1 (required in 1.1 files; a 1.0 file has none and loads with an empty proxy; a
 // 1.0 file that holds one is refused):
-//   "BPRX" body proxy for the run-time push-out: u32 C capsules (0..64), then per capsule u32 joint,
-//          f32[3] end a, f32[3] end b (rest character space), f32 radius (metres). See BodyProxy.
+//   "BPRX" body proxy of the first run-time push-out: u32 C capsules (0..64), then per capsule u32
+//          joint, f32[3] end a, f32[3] end b (rest character space), f32 radius (metres). LEGACY since
+//          1.3: the capsules were replaced by the body anchors (BANC); a 1.3 writer still writes the
+//          section with C = 0 (so that 1.1 and 1.2 readers, which require it, load the file without a
+//          push-out), and a reader checks the capsules' size and drops them.
 // Added in version 1.2 (required in 1.2 files; older files load with an empty guard):
 //   "NOVG" novelty guard: u32 C centres, u32 D inputs (C = 0: none; else D = Theta's size), f32[C*D]
 //          centres (centre after centre), f32 unit, u32 K weight ranges (0 or the mesh components),
@@ -57,6 +60,12 @@
 //          NoveltyGuard.
 //   "BCOV" body coverage: u32 body triangle count B, u32 n, u32[n] covered triangle indices
 //          (ascending, < B). See BodyCoverage.
+// Added in version 1.3 (required in 1.3 files; older files load without anchors, i.e. no push-out):
+//   "BANC" body anchors of the run-time push-out: u32 A (0, or the game mesh's vertex count N), f32
+//          margin (metres, 0..0.05), then f32[3A] rest positions, f32[3A] rest normals (unit),
+//          f32[A] ball radii (metres, 0.001..1), f32[A] clearances (metres, -0.2..margin, above minus
+//          the radius), u16[4A] joints, f32[4A] weights (4 influences per anchor, each vertex's after
+//          the previous one's). A vertex without an anchor has all of its values 0. See BodyAnchor.
 // After parsing, Model::validate checks every index and size the run time relies on.
 // =====================================================================================================
 #include <array>
@@ -71,7 +80,7 @@
 namespace swish {
 
 constexpr uint16_t kModelFileMajorVersion = 1;
-constexpr uint16_t kModelFileMinorVersion = 2;
+constexpr uint16_t kModelFileMinorVersion = 3;
 constexpr std::array<uint8_t, 8> kModelFileMagic = {0x89, 'S', 'W', 'I', 'S', 'H', 0x0D, 0x0A};
 constexpr size_t kModelFileHeaderBytes = 32;
 constexpr size_t kModelSectionHeaderBytes = 16;

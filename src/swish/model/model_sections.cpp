@@ -252,27 +252,48 @@ void readNormalMaps(ByteReader& r, Model& m) {
   r.u16s(db.indices.data(), indices, "block index");
 }
 
-// ---- BPRX (format 1.1) ------------------------------------------------------------------------
+// ---- BPRX (formats 1.1 and 1.2; legacy since 1.3) ---------------------------------------------
+// The capsule proxy of the first push-out, replaced by the body anchors (BANC). Still written, empty,
+// so that a reader of 1.1 or 1.2 (which requires the section) loads a newer file without a push-out;
+// capsules in an older file are checked for structure and dropped (nothing runs on them any more).
 constexpr uint64_t kCapsuleBytes = 4 + 12 + 12 + 4;
+constexpr uint32_t kMaxLegacyCapsules = 64;
 
-void writeBodyProxy(const Model& m, ByteWriter& w) {
-  w.u32(count32(m.bodyProxy.capsules.size(), "body capsule"));
-  for (const BodyCapsule& c : m.bodyProxy.capsules) {
-    w.u32(c.joint);
-    w.f32s({c.a.data(), 3});
-    w.f32s({c.b.data(), 3});
-    w.f32(c.radius);
-  }
+void writeLegacyBodyProxy(const Model&, ByteWriter& w) { w.u32(0); }
+
+void readLegacyBodyProxy(ByteReader& r, Model&) {
+  const uint32_t count = r.u32("body capsule count");
+  if (count > kMaxLegacyCapsules)
+    r.fail(std::to_string(count) + " body capsules; at most " + std::to_string(kMaxLegacyCapsules));
+  r.checkCount(count, kCapsuleBytes, "body capsule");
+  r.skip(size_t(count * kCapsuleBytes), "body capsules");
 }
 
-void readBodyProxy(ByteReader& r, Model& m) {
-  m.bodyProxy.capsules.resize(r.checkCount(r.u32("body capsule count"), kCapsuleBytes, "body capsule"));
-  for (BodyCapsule& c : m.bodyProxy.capsules) {
-    c.joint = r.u32("body capsule joint");
-    r.f32s(c.a.data(), 3, "body capsule end a");
-    r.f32s(c.b.data(), 3, "body capsule end b");
-    c.radius = r.f32("body capsule radius");
-  }
+// ---- BANC (format 1.3) ------------------------------------------------------------------------
+void writeBodyAnchors(const Model& m, ByteWriter& w) {
+  const BodyAnchors& b = m.bodyAnchors;
+  w.u32(count32(b.anchors.size(), "body anchor"));
+  w.f32(b.margin);
+  for (const BodyAnchor& a : b.anchors) w.f32s({a.position.data(), 3});
+  for (const BodyAnchor& a : b.anchors) w.f32s({a.normal.data(), 3});
+  for (const BodyAnchor& a : b.anchors) w.f32(a.radius);
+  for (const BodyAnchor& a : b.anchors) w.f32(a.clearance);
+  for (const BodyAnchor& a : b.anchors) w.u16s(a.joints);
+  for (const BodyAnchor& a : b.anchors) w.f32s(a.weights);
+}
+
+void readBodyAnchors(ByteReader& r, Model& m) {
+  BodyAnchors& b = m.bodyAnchors;
+  constexpr uint64_t kAnchorBytes = 12 + 12 + 4 + 4 + 2 * kAnchorInfluences + 4 * kAnchorInfluences;
+  const uint32_t count = r.u32("body anchor count");
+  b.margin = r.f32("body anchor margin");
+  b.anchors.resize(r.checkCount(count, kAnchorBytes, "body anchor"));
+  for (BodyAnchor& a : b.anchors) r.f32s(a.position.data(), 3, "body anchor position");
+  for (BodyAnchor& a : b.anchors) r.f32s(a.normal.data(), 3, "body anchor normal");
+  for (BodyAnchor& a : b.anchors) a.radius = r.f32("body anchor radius");
+  for (BodyAnchor& a : b.anchors) a.clearance = r.f32("body anchor clearance");
+  for (BodyAnchor& a : b.anchors) r.u16s(a.joints.data(), a.joints.size(), "body anchor joint");
+  for (BodyAnchor& a : b.anchors) r.f32s(a.weights.data(), a.weights.size(), "body anchor weight");
 }
 
 // ---- NOVG (format 1.2) ------------------------------------------------------------------------
@@ -347,9 +368,10 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {"SKIN", writeSkin, readSkin},
       {"NMDB", writeNormalMaps, readNormalMaps},
       {"TFLT", writeTemporalFilter, readTemporalFilter},
-      {"BPRX", writeBodyProxy, readBodyProxy, 1},
+      {"BPRX", writeLegacyBodyProxy, readLegacyBodyProxy, 1},
       {"NOVG", writeNoveltyGuard, readNoveltyGuard, 2},
       {"BCOV", writeBodyCoverage, readBodyCoverage, 2},
+      {"BANC", writeBodyAnchors, readBodyAnchors, 3},
       {"META", writeMetadata, readMetadata},
   };
   return codecs;

@@ -46,7 +46,7 @@ struct PreviewOptions {
   std::array<float, 3> background{0.93f, 0.94f, 0.96f};      // used when flattening to RGB
   std::array<float, 3> lightDirection{0.45f, 0.55f, 0.70f};  // towards the key light
   uint32_t framesInFlight = 2;
-  bool pushOut = true;  // api::BatchOptions::pushOut: the garment pushed out of the model's body proxy
+  bool pushOut = true;  // api::BatchOptions::pushOut: the garment kept off the body by the model's body anchors
 };
 
 struct PreviewImage {

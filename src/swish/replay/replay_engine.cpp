@@ -101,7 +101,8 @@ struct TruthJob {
   const ModelTruth* truth = nullptr;
   Pose pose;
   Points3f positions;
-  std::optional<Points3f> withoutPushOut;  // the CPU reference's positions without the push-out (models with a proxy)
+  std::optional<Points3f>
+      withoutPushOut;  // the CPU reference's positions without the push-out (models with body anchors)
   std::optional<runtime::BlendedNormalMap> normalMap;
   size_t batch = 0;
   std::vector<Points3f> levelPositions;  // per level of the batch's ladder: the CPU reference's positions
@@ -512,7 +513,7 @@ FrameRecord ReplayEngine::Impl::runFrame(uint32_t index, ReplayResult& result) {
             job.truth = B.truth.get();
             job.pose = B.poses[i];
             job.positions = gpuOut.positions[i];
-            if (B.inputs.pushOut && !B.uploaded().bodyProxy.empty())
+            if (B.inputs.pushOut && !B.uploaded().bodyAnchors.empty())
               job.withoutPushOut = runtime::referencePositions(B.uploaded(), B.inputs, i, false);
             if (B.truth->normalMaps() && i < gpuOut.normalMaps.size() && B.inputs.selectedMaps.size() > i &&
                 B.inputs.selectedMaps[i] != runtime::kNoMap)
@@ -546,7 +547,7 @@ void ReplayEngine::Impl::measurePenetration(FrameRecord& rec) {
     if (B.colliders.empty()) continue;
     const Model& m = B.uploaded();
     const uint32_t n = uint32_t(B.planned->characters.size()), jc = uint32_t(m.skeleton.size());
-    const bool pushed = B.inputs.pushOut && !m.bodyProxy.empty();
+    const bool pushed = B.inputs.pushOut && !m.bodyAnchors.empty();
     std::vector<CharacterPenetration> out(n);
     tbb::parallel_for(uint32_t(0), n, [&](uint32_t i) {
       bake::BodyCollider& c = B.colliders[i];
@@ -651,7 +652,7 @@ ReplayResult ReplayEngine::run() {
   r.penetrationEvery = I.options.penetrationEvery;
   r.noveltyGuard = I.options.noveltyGuard;
   for (const Batch& B : I.batches)
-    if (I.options.pushOut && I.plan.gpuWork && !B.model->bodyProxy.empty()) r.pushOut = true;
+    if (I.options.pushOut && I.plan.gpuWork && !B.model->bodyAnchors.empty()) r.pushOut = true;
   if (I.options.penetrationEvery == 0) {
     r.penetrationNote = "not measured (--penetration-every 0)";
   } else {

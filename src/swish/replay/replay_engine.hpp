@@ -45,7 +45,7 @@ struct ReplayOptions {
   gpu::ContextOptions device;
   gpu::Context* context = nullptr;  // use this device instead of creating one (tests, hosts)
   TruthOptions truth;               // truth.every 0: none; N: ground truth on every Nth frame
-  bool pushOut = false;             // the run time's push-out of the body proxy (models that have one; --push-out)
+  bool pushOut = false;             // the run time's push-out to the body anchors (models that have them; --push-out)
   bool noveltyGuard = true;         // apply the models' novelty guards (measured either way; --no-guard)
   // Penetration of the garment into the body it was baked on (the CPU reference's positions, with and
   // without the push-out) on every Nth frame; 0: not measured.
@@ -82,7 +82,7 @@ struct CharacterCheck {
 };
 
 // One character's penetration on one frame (bake/report/penetration.hpp): the model's reconstruction as it
-// comes out of skinning, and after the push-out (when the model has a body proxy and it is on).
+// comes out of skinning, and after the push-out (when the model has body anchors and it is on).
 struct CharacterPenetration {
   uint32_t character = 0;
   bake::PenetrationStats model;
@@ -163,8 +163,8 @@ struct ReplayResult {
   TruthSummary truthOverall;
   // Penetration (ReplayOptions::penetrationEvery).
   uint32_t penetrationEvery = 0;
-  std::string penetrationNote;                              // which body, or why none
-  bool pushOut = false;                                     // the push-out ran (some model has a proxy and it was on)
+  std::string penetrationNote;  // which body, or why none
+  bool pushOut = false;         // the push-out ran (some model has body anchors and it was on)
   std::vector<PenetrationSummary> penetrationPerCharacter;  // per scene character (empty when none measured)
   PenetrationSummary penetrationOverall;
   double penetrationSeconds = 0;  // wall time of the measurements

@@ -542,7 +542,7 @@ std::string reportMarkdown(const json& j) {
                               : std::string(" every frame"))
       << ", per character: vertices inside the body (signed distance < 0), those deeper than "
       << fmt(num(p["visibleDepthMm"]), "%g")
-      << " mm (visible), the deepest. The run time's push-out of the body proxy was "
+      << " mm (visible), the deepest. The run time's push-out to the body anchors was "
       << (p["pushOut"].get<bool>() ? "ON (what the GPU drew and the truth measured)" : "OFF") << ".\n\n";
     if (p.contains("overall")) {
       s << "| positions | frames x characters | with any inside | with visible (> "

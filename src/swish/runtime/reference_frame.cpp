@@ -53,11 +53,7 @@ Points3f referencePositions(const Model& m, const FrameKernelInputs& in, uint32_
   const Points3f pre = referencePcaReconstruct(m.meshPca, std::span(in.meshWeights).subspan(i * k, k), components);
   const std::span<const Mat4f> mats = std::span(in.skinMatrices).subspan(i * j, j);
   Points3f out = referenceSkin(pre, m.gameMesh.skin, std::vector<Mat4f>(mats.begin(), mats.end()));
-  if (pushOut && !m.bodyProxy.empty()) {
-    std::vector<float> posed;
-    poseBodyProxy(m.bodyProxy, mats, posed);
-    referencePushOut(out, posed);
-  }
+  if (pushOut && !m.bodyAnchors.empty()) referencePushOut(out, m.bodyAnchors, mats);
   return out;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // The inputs of one frame of the GPU kernels for a batch of instances of one model, and the CPU
-// reference of the whole frame: PCA reconstruction -> skinning -> push-out of the body proxy ->
+// reference of the whole frame: PCA reconstruction -> skinning -> push-out to the body anchors ->
 // normals and tangents per instance;
 // VQ decode of each selected map -> temporal blend into each character's normal map. The GPU frame
 // (gpu/frame_recorder.hpp) must reproduce every output within the per-kernel tolerances.
@@ -28,8 +28,8 @@ struct FrameKernelInputs {
   // Per instance: the leading mesh components its deform reads (its quality level's k, 0..K; the weights
   // beyond it count as 0 whatever meshWeights holds). Empty: K for every instance.
   std::vector<uint32_t> meshComponents;
-  // Push the skinned garment out of the model's body proxy (reference_push_out.hpp); no effect for a
-  // model without one.
+  // Push the skinned garment out to the model's body anchors (reference_push_out.hpp); no effect for
+  // a model without them.
   bool pushOut = true;
 
   // Throws Error naming the problem if sizes or map indices do not fit `model`.
@@ -45,7 +45,7 @@ struct ReferenceFrameOutputs {
 };
 
 // The skinned positions of one instance alone (PCA of its meshComponents -> skinning -> push-out when
-// `pushOut` and the model has a proxy): what referenceFrame's positions are, without the rest of the frame.
+// `pushOut` and the model has body anchors): what referenceFrame's positions are, without the rest of the frame.
 Points3f referencePositions(const Model& model, const FrameKernelInputs& inputs, uint32_t instance, bool pushOut);
 
 // prevMaps: each character's normal map after the previous frame (empty: all zeros, as the GPU images

@@ -1,39 +1,47 @@
 #pragma once
-// The run-time push-out (a step at the end of shaders/deform.glsl) and its CPU reference: garment
-// vertices that the reconstruction put inside the model's body proxy (BodyProxy in model/model.hpp,
-// capsules fitted inside the body at bake time) are moved out to the proxy's surface.
+// The run-time push-out (a step at the end of shaders/deform.glsl) and its CPU reference: each skinned
+// garment vertex is kept outside its body anchor's ball (BodyAnchor in model/model.hpp, fitted at bake
+// time by bake/training/body_anchor_fit.hpp: the largest ball inside the body touching it at the
+// vertex's closest point), its clearance off the ball's surface.
 //
-// Posing is done on the CPU, once per instance and capsule (a few dozen matrix products a frame): each
-// capsule's ends go through its joint's skinning matrix, and the GPU reads the posed capsules as
-// kPosedCapsuleFloats floats each: a.xyz, radius, d.xyz = b - a, invLenSq = 1 / |d|^2 (0 for a sphere).
-// Then, per skinned vertex x and per capsule in the proxy's order:
-//   w = x - a;  t = clamp(((w.x d.x + w.y d.y) + w.z d.z) * invLenSq, 0, 1);  q = a + d t;  e = x - q
-//   s = (e.x e.x + e.y e.y) + e.z e.z
-//   if kMinPushDistanceSq < s < r^2:  x = q + e * (r / sqrt(s))
-// A vertex on a capsule's axis (s below kMinPushDistanceSq) has no outward direction and stays. The
-// result is continuous in x (the push is 0 on the capsule surface), so a device whose rounding differs
-// near the surface differs by rounding only.
+// Per instance and vertex x (skinned, character space) with anchor (rest centre q = centre(), reach
+// r = reach() = radius + clearance, joints j_i, weights w_i):
+//   B = sum over i = 0..3 with w_i != 0 of w_i * M[j_i]           (elementwise, i ascending, from 0)
+//   c = ((B.col0 * q.x + B.col1 * q.y) + B.col2 * q.z) + B.col3     (the skinned centre)
+//   e = x - c;  s = (e.x e.x + e.y e.y) + e.z e.z
+//   if kMinAnchorDistanceSq < s < r^2:  x = c + e * (r / sqrt(s))
+// That is the garment's own linear blend skinning (runtime/reference_skinning.hpp) applied to the
+// centre with the anchor's influences, then a radial push to the sphere of radius r: it never pulls a
+// vertex in, and it is continuous in x (the move is 0 on the sphere), so a device whose rounding
+// differs near the sphere differs by rounding only. A vertex without an anchor has r = 0 and stays, as
+// does one whose anchor matrices are not finite (s is NaN) or that sits on the centre (no direction).
 //
-// Why a proxy and not the body: the run time has no body mesh (a game's body is the host's), and a
-// capsule test is a dozen flops: the step costs O(capsules) per vertex and instance, no memory but the
-// posed capsules, which every thread of a dispatch reads alike.
+// Why per-vertex anchors and not a proxy of the whole body (capsules, formats 1.1 and 1.2): a vertex
+// pushed out of the nearest of several overlapping shapes can land inside another, or inside the real
+// body elsewhere (measured: it raised the deepest penetration and the error); an anchor is local,
+// so a sleeve vertex anchored on the arm is never pushed out of the torso. The cost is a second
+// blend of four skinning matrices per vertex and instance, and no per-frame CPU work.
 #include <span>
-#include <vector>
 
 #include "swish/model/model.hpp"
 
 namespace swish::runtime {
 
-inline constexpr size_t kPosedCapsuleFloats = 8;
-// Below this squared distance (m^2, 1 micrometre) from the axis a vertex is not moved (no direction).
-inline constexpr float kMinPushDistanceSq = 1e-12f;
+// Below this squared distance (m^2, 1 micrometre) from the centre a vertex is not moved (no direction).
+inline constexpr float kMinAnchorDistanceSq = 1e-12f;
 
-// The proxy posed by one instance's skinning matrices (one per joint): kPosedCapsuleFloats per capsule
-// appended to `out`. Throws Error when a capsule's joint has no matrix.
-void poseBodyProxy(const BodyProxy& proxy, std::span<const Mat4f> skinMatrices, std::vector<float>& out);
+// The anchor's ball centre skinned by `skinMatrices` (the formula above). Throws Error for a weighted
+// joint without a matrix.
+Vec3f skinAnchorCentre(const BodyAnchor& anchor, std::span<const Mat4f> skinMatrices);
 
-// Pushes `positions` (one instance, skinned, character space) out of the posed capsules, in place.
-// Returns how many vertices moved.
-size_t referencePushOut(Points3f& positions, std::span<const float> posedCapsules);
+// Where the push-out puts x for an anchor whose skinned centre is c (the formula above); x itself
+// when it is not moved.
+Vec3f pushedOutOfBall(const Vec3f& x, const Vec3f& c, float reach);
+
+// Pushes `positions` (one instance, skinned, character space; one row per game-mesh vertex) out of
+// their anchors' balls, in place. `skinMatrices`: that instance's, one per joint. Returns how many
+// vertices moved. Throws Error when the anchors do not match the positions or name a joint without a
+// matrix; empty anchors do nothing.
+size_t referencePushOut(Points3f& positions, const BodyAnchors& anchors, std::span<const Mat4f> skinMatrices);
 
 }  // namespace swish::runtime

@@ -206,12 +206,14 @@ void expectBitwiseEqual(const Model& a, const Model& b) {
   EXPECT_EQ(da.codebook, db.codebook);
   EXPECT_EQ(da.indices, db.indices);
   EXPECT_EQ(std::memcmp(&a.temporalFilter.timeConstantSeconds, &b.temporalFilter.timeConstantSeconds, 4), 0);
-  ASSERT_EQ(a.bodyProxy.capsules.size(), b.bodyProxy.capsules.size());
-  for (size_t c = 0; c < a.bodyProxy.capsules.size(); ++c) {
-    const auto &ca = a.bodyProxy.capsules[c], &cb = b.bodyProxy.capsules[c];
-    EXPECT_EQ(ca.joint, cb.joint) << "capsule " << c;
-    EXPECT_TRUE(sameBits(ca.a, cb.a) && sameBits(ca.b, cb.b)) << "capsule " << c;
-    EXPECT_EQ(std::memcmp(&ca.radius, &cb.radius, 4), 0) << "capsule " << c;
+  EXPECT_EQ(std::memcmp(&a.bodyAnchors.margin, &b.bodyAnchors.margin, 4), 0);
+  ASSERT_EQ(a.bodyAnchors.anchors.size(), b.bodyAnchors.anchors.size());
+  for (size_t v = 0; v < a.bodyAnchors.anchors.size(); ++v) {
+    const swish::BodyAnchor &aa = a.bodyAnchors.anchors[v], &ab = b.bodyAnchors.anchors[v];
+    EXPECT_TRUE(sameBits(aa.position, ab.position) && sameBits(aa.normal, ab.normal)) << "anchor " << v;
+    EXPECT_EQ(std::memcmp(&aa.clearance, &ab.clearance, 4), 0) << "anchor " << v;
+    EXPECT_EQ(aa.joints, ab.joints) << "anchor " << v;
+    EXPECT_EQ(std::memcmp(aa.weights.data(), ab.weights.data(), sizeof aa.weights), 0) << "anchor " << v;
   }
   const auto &na = a.noveltyGuard, &nb = b.noveltyGuard;
   EXPECT_TRUE(sameBits(na.centres, nb.centres));
@@ -336,8 +338,10 @@ TEST(ModelFile, RoundTripIsBitwiseExactForManyShapes) {
   s.hiddenLayers = 0;
   shapes.push_back({"1 influence, linear MLP", s});
   s = {};
-  s.bodyCapsules = 7;
-  shapes.push_back({"body proxy of 7 capsules", s});
+  s.bodyAnchors = true;
+  shapes.push_back({"body anchors", s});
+  s.vertices = 1;
+  shapes.push_back({"one vertex with an anchor", s});
   s = {};
   s.joints = 40;
   s.inputJoints = 16;
@@ -374,14 +378,14 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   auto u16 = [&](size_t at) { return uint32_t(bytes[at] | bytes[at + 1] << 8); };
   auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
   EXPECT_EQ(u16(8), 1u);
-  EXPECT_EQ(u16(10), 2u);
-  EXPECT_EQ(u32(12), 14u);
+  EXPECT_EQ(u16(10), 3u);
+  EXPECT_EQ(u32(12), 15u);
   EXPECT_EQ(uint64_t(u32(16)) | uint64_t(u32(20)) << 32, bytes.size());
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
-  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH",
-                                "SKIN", "NMDB", "TFLT", "BPRX", "NOVG", "BCOV", "META"};
+  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN",
+                                "NMDB", "TFLT", "BPRX", "NOVG", "BCOV", "BANC", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());
@@ -397,6 +401,14 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
       EXPECT_EQ(u32(at + 16), m.gameMesh.vertexCount());
       EXPECT_EQ(u32(at + 20), m.gameMesh.triangleCount());
       EXPECT_EQ(u32(at + 24), 7u) << "normals, tangents and UVs present";
+    }
+    if (std::string(tag) == "BPRX") {
+      EXPECT_EQ(size, 4u);
+      EXPECT_EQ(u32(at + 16), 0u) << "the legacy capsule proxy is written empty";
+    }
+    if (std::string(tag) == "BANC") {
+      EXPECT_EQ(size, 8u) << "no anchors: the count and the margin";
+      EXPECT_EQ(u32(at + 16), 0u);
     }
     if (std::string(tag) == "META") {
       EXPECT_EQ(std::string(reinterpret_cast<const char*>(&bytes[at + 16]), size), m.metadata);
@@ -491,40 +503,113 @@ TEST(ModelFile, WrongMagicAndVersionsAreClearErrors) {
   const auto info = swish::readModelFileInfo(assemble(extended, 1, 7), "newer.swish");
   EXPECT_FALSE(info.sections[3].known);
   // The same unknown section in a file claiming the current version is corruption.
-  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.2 file");
+  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.3 file");
 }
 
-// Format 1.1 added the body proxy: a 1.0 file (no BPRX) still loads, with no proxy; a 1.1 file without
-// it, or a 1.0 file with it, is refused; a bad capsule is refused naming it.
-TEST(ModelFile, BodyProxySectionOfVersion11) {
+// Format 1.1 added the capsule proxy (BPRX), legacy since 1.3: a 1.0 file (no BPRX) still loads; a 1.1
+// or 1.2 file's capsules are read and dropped (nothing runs on them any more); a 1.1 file without the
+// section, or a 1.0 file with it, is refused; a hostile capsule count is refused naming it. A 1.3 file
+// writes it empty.
+TEST(ModelFile, LegacyCapsuleSectionOfVersion11) {
   swish::Rng rng(11);
   RandomModelSpec spec;
   spec.vertices = 9;
-  spec.bodyCapsules = 3;
   const Model m = swish::test::makeRandomModel(rng, spec);
   auto sections = splitSections(swish::serializeModel(m));
-  expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
+  // A 1.2 file as 1.2 wrote it: no BANC, two capsules in BPRX.
+  auto v12 = sections;
+  v12.erase(std::find_if(v12.begin(), v12.end(), [](const RawSection& s) { return s.tag == "BANC"; }));
+  swish::ByteWriter capsules;
+  capsules.u32(2);
+  for (int c = 0; c < 2; ++c) {
+    capsules.u32(uint32_t(c));
+    const float ends[7] = {0.f, 1.f, 0.f, 0.f, 1.5f, 0.f, 0.1f};
+    capsules.f32s(ends);
+  }
+  sectionOf(v12, "BPRX").payload = capsules.take();
+  expectBitwiseEqual(swish::deserializeModel(assemble(v12, 1, 2), "v12.swish"), m);
 
-  auto without = sections;
+  auto without = v12;
   for (const char* tag : {"BPRX", "NOVG", "BCOV"})  // a 1.0 file has none of them
     without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
-  Model old = m;
-  old.bodyProxy = {};
-  expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 0), "old.swish"), old);
-  EXPECT_CONTAINS(loadError(assemble(without)), "section 'BPRX' is missing");
-  EXPECT_CONTAINS(loadError(assemble(sections, 1, 0)), "a section of format 1.1 in a version 1.0 file");
+  expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 0), "old.swish"), m);
+  EXPECT_CONTAINS(loadError(assemble(without, 1, 2)), "section 'BPRX' is missing");
+  EXPECT_CONTAINS(loadError(assemble(v12, 1, 0)), "a section of format 1.1 in a version 1.0 file");
 
-  auto bad = sections;
-  auto& proxy = sectionOf(bad, "BPRX").payload;
-  putU32(proxy, 4 + 32 + 0, 99);  // capsule 1's joint
-  EXPECT_CONTAINS(loadError(assemble(bad)), "body proxy: capsule 1 joint 99 >= joint count");
-  bad = sections;
-  const float negative = -0.5f;
-  std::memcpy(&sectionOf(bad, "BPRX").payload[4 + 28], &negative, 4);  // capsule 0's radius
-  EXPECT_CONTAINS(loadError(assemble(bad)), "body proxy: capsule 0 radius must be in (0, 10) metres");
-  bad = sections;
-  putU32(sectionOf(bad, "BPRX").payload, 0, 0x10000000u);
-  EXPECT_CONTAINS(loadError(assemble(bad)), "body capsule");
+  auto bad = v12;
+  putU32(sectionOf(bad, "BPRX").payload, 0, 65);
+  EXPECT_CONTAINS(loadError(assemble(bad, 1, 2)), "section 'BPRX': 65 body capsules; at most 64");
+  bad = v12;
+  putU32(sectionOf(bad, "BPRX").payload, 0, 3);  // one capsule more than the payload holds
+  EXPECT_CONTAINS(loadError(assemble(bad, 1, 2)), "body capsule count 3 needs");
+}
+
+// Format 1.3 added the body anchors (BANC): round trip; older files load without them; a 1.3 file
+// without the section, or a 1.2 file with it, is refused; anchors that do not fit the model are refused
+// naming the file, the part and the vertex; hostile counts fail before allocating.
+TEST(ModelFile, BodyAnchorSectionOfVersion13) {
+  swish::Rng rng(13);
+  RandomModelSpec spec;
+  spec.vertices = 9;
+  spec.bodyAnchors = true;
+  const Model m = swish::test::makeRandomModel(rng, spec);
+  ASSERT_EQ(m.bodyAnchors.anchors.size(), 9u);
+  ASSERT_FALSE(m.bodyAnchors.anchors[3].present());  // (every 7th from 3 has none)
+  auto sections = splitSections(swish::serializeModel(m));
+  expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
+  EXPECT_EQ(sectionOf(sections, "BANC").payload.size(), 8u + 9u * (12 + 12 + 4 + 4 + 8 + 16));
+
+  auto without = sections;
+  without.erase(std::find_if(without.begin(), without.end(), [](const RawSection& s) { return s.tag == "BANC"; }));
+  Model old = m;
+  old.bodyAnchors = {};
+  expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 2), "old.swish"), old);
+  EXPECT_CONTAINS(loadError(assemble(without)), "section 'BANC' is missing");
+  EXPECT_CONTAINS(loadError(assemble(sections, 1, 2)), "a section of format 1.3 in a version 1.2 file");
+
+  // Payload offsets: count at 0, margin at 4, then the arrays (model_file.hpp).
+  const size_t n = 9, positions = 8, normals = positions + 12 * n, radii = normals + 12 * n, clearances = radii + 4 * n,
+               joints = clearances + 4 * n, weights = joints + 8 * n;
+  auto edited = [&](auto&& edit) {
+    auto e = sections;
+    edit(sectionOf(e, "BANC").payload);
+    return loadError(assemble(e), "anchored.swish");
+  };
+  auto putF32 = [](std::vector<uint8_t>& p, size_t at, float f) { std::memcpy(&p[at], &f, 4); };
+  EXPECT_CONTAINS(edited([&](auto& p) { putU32(p, 0, 8); }), "section 'BANC'");  // fewer than the payload holds
+  EXPECT_CONTAINS(edited([&](auto& p) { putU32(p, 0, 0x10000000u); }),
+                  "anchored.swish: section 'BANC': body anchor count 268435456 needs");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, 4, 0.5f); }),
+                  "anchored.swish: body anchors: margin 0.500000 m is not in [0, 0.05] metres");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, normals + 12 * 1, 2.f); }),
+                  "anchored.swish: body anchors: anchor of vertex 1 has a normal that is not of unit length");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, clearances + 4 * 2, 0.01f); }),
+                  "body anchors: anchor of vertex 2 has clearance");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, radii + 4 * 7, 0.f); }),
+                  "body anchors: anchor of vertex 7 has radius 0.000000 m, not in [0.001, 1]");
+  EXPECT_CONTAINS(
+      edited([&](auto& p) {
+        putF32(p, radii + 4 * 8, 0.002f);
+        putF32(p, clearances + 4 * 8, -0.005f);
+      }),
+      "anchor of vertex 8 has clearance -0.005000 m, not in [-0.2 m, margin] or not above minus its radius");
+  EXPECT_CONTAINS(edited([&](auto& p) { p[joints + 8 * 4] = 99; }),
+                  "body anchors: anchor of vertex 4 joint 99 >= joint count");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, weights + 16 * 5, 7.f); }),
+                  "body anchors: anchor of vertex 5 has weights summing to");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, weights + 16 * 6, -0.5f); }),
+                  "body anchors: anchor of vertex 6 has a negative or non-finite weight");
+  EXPECT_CONTAINS(edited([&](auto& p) { putF32(p, positions + 12 * 3, 1.f); }),
+                  "body anchors: anchor of vertex 3 has no weights (no anchor) but a position");
+  EXPECT_CONTAINS(edited([&](auto& p) { p.pop_back(); }), "section 'BANC'");
+  Model bad = m;
+  bad.bodyAnchors.anchors.pop_back();
+  try {
+    bad.validate("m");
+    ADD_FAILURE() << "anchors for another vertex count were accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "m: body anchors: 8 anchors for 9 game-mesh vertices");
+  }
 }
 
 // Format 1.2 added the novelty guard: older files load without one; a 1.2 file without it, or a 1.1
@@ -540,7 +625,7 @@ TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
 
   auto without = sections;
-  for (const char* tag : {"NOVG", "BCOV"})
+  for (const char* tag : {"NOVG", "BCOV", "BANC"})
     without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
   Model old = m;
   old.noveltyGuard = {};

@@ -92,7 +92,7 @@ class ReplayTruth : public test::GpuTest {
     replay::ReplayOptions o;
     o.context = &ctx();
     o.truth = truth;
-    o.pushOut = true;        // runs where the model has a proxy (the committed one has none)
+    o.pushOut = true;        // runs where the model has body anchors (the committed one has none)
     o.penetrationEvery = 1;  // every frame, every character
     replay::ReplayEngine engine(s, lib, o);
     return engine.run();
@@ -108,7 +108,7 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
   jo.quiet = true;
   jo.engine.context = &ctx();
   jo.engine.truth = cheaperTruth(2);
-  jo.engine.pushOut = true;        // runs where the model has a proxy (the committed one has none)
+  jo.engine.pushOut = true;        // runs where the model has body anchors (the committed one has none)
   jo.engine.penetrationEvery = 1;  // every frame, every character
   uint32_t progressCalls = 0, lastDone = 0, lastTotal = 0;
   jo.engine.truthProgress = [&](uint32_t done, uint32_t total) { ++progressCalls, lastDone = done, lastTotal = total; };
@@ -179,11 +179,11 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
   EXPECT_TRUE(fs::exists(job.directory / "plots/truth_error_per_frame.svg"));
 
   // Penetration into the bake's body, every frame, every character: the model's reconstruction and,
-  // when the model carries a body proxy, the same after the push-out, which the GPU ran and the truth
+  // when the model carries body anchors, the same after the push-out, which the GPU ran and the truth
   // measured (beside the error without it). The committed model has none (see README): its figures
   // are measured on a copy given one by `swish body-proxy`.
   EXPECT_NE(r.penetrationNote.find("the body of the bake's character"), std::string::npos) << r.penetrationNote;
-  const bool proxy = !model_.bodyProxy.empty();
+  const bool proxy = !model_.bodyAnchors.empty();
   EXPECT_EQ(r.pushOut, proxy);
   for (const auto& f : r.frames) {
     ASSERT_EQ(f.penetration.size(), 2u) << "frame " << f.frame;

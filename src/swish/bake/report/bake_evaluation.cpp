@@ -71,11 +71,7 @@ Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut) {
       runtime::referenceSkin(runtime::referencePcaReconstruct(
                                  model.meshPca, std::span<const float>(lambda.data(), size_t(model.meshComponents()))),
                              model.gameMesh.skin, mats);
-  if (pushOut && !model.bodyProxy.empty()) {
-    std::vector<float> posed;
-    runtime::poseBodyProxy(model.bodyProxy, mats, posed);
-    runtime::referencePushOut(p, posed);
-  }
+  if (pushOut && !model.bodyAnchors.empty()) runtime::referencePushOut(p, model.bodyAnchors, mats);
   return p;
 }
 
@@ -88,7 +84,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
     collider.emplace(*body, 0.05f, "bake evaluation: body");
     ev.penetrationMeasured = true;
   }
-  ev.pushOut = !model.bodyProxy.empty();
+  ev.pushOut = !model.bodyAnchors.empty();
   std::vector<double> totalPushed;
   ev.poses = heldOut.size();
   const size_t n = model.gameMesh.vertexCount();
@@ -157,9 +153,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
     std::optional<Points3f> pushed;
     if (ev.pushOut) {
       pushed = predicted;
-      std::vector<float> posed;
-      runtime::poseBodyProxy(model.bodyProxy, mats, posed);
-      runtime::referencePushOut(*pushed, posed);
+      runtime::referencePushOut(*pushed, model.bodyAnchors, mats);
       for (size_t v = 0; v < n; ++v)
         totalPushed.push_back(1000.0 *
                               double((pushed->row(Eigen::Index(v)) - p->gameMeshWorld.row(Eigen::Index(v))).norm()));

@@ -18,7 +18,7 @@
 //                temporal filter), and vqAdded = selection map uncompressed vs VQ-decoded.
 // Penetration into the body (when the body is given, bake/report/penetration.hpp), per held-out pose, side by
 // side: the truth (the dataset's game mesh), the model's prediction, and the prediction after the
-// run-time push-out of the model's body proxy (when it has one; then also its vertex error).
+// run-time push-out to the model's body anchors (when it has them; then also its vertex error).
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -62,7 +62,7 @@ struct BakeEvaluation {
   std::vector<PoseEvaluation> perPose;
   bool penetrationMeasured = false;
   PenetrationPool truthPenetration, modelPenetration;
-  bool pushOut = false;  // the model has a body proxy: the pushed figures below are measured
+  bool pushOut = false;  // the model has body anchors: the pushed figures below are measured
   PenetrationPool pushedPenetration;
   DistanceStats totalPushedMm;
 };
@@ -74,7 +74,7 @@ struct BakeEvaluation {
 nlohmann::json penetrationJson(const BakeEvaluation& ev);
 
 // The model's skinned garment for a pose through the runtime path (Theta -> MLP -> PCA -> skinning, then
-// the push-out when asked and the model has a proxy).
+// the push-out when asked and the model has body anchors).
 Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut);
 
 // body (optional): the character's body, skinned to the model's skeleton: penetration is measured.

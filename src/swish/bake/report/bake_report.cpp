@@ -206,7 +206,7 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
          << " mm (without: " << f2(ev.totalMm.mean) << " / " << f2(ev.totalMm.p95) << " / " << f2(ev.totalMm.max)
          << " mm).\n";
     } else {
-      md << "\nThe model has no body proxy: no push-out at run time.\n";
+      md << "\nThe model has no body anchors: no push-out at run time.\n";
     }
     md << "\n";
   }
@@ -242,7 +242,7 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
     md << "\n\n";
   }
   md << "## Worst held-out poses\n\nThe gallery shows, per pose, the model (as the run time shows it"
-     << (out.model.bodyProxy.empty() ? "" : ", after the push-out")
+     << (out.model.bodyAnchors.empty() ? "" : ", after the push-out")
      << ") beside the truth and an error heat map "
         "(per-vertex distance to the truth, 0 to 10 mm and beyond), then the truth's and the run time's normal "
         "maps.\n\n"

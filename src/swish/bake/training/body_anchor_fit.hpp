@@ -1,0 +1,97 @@
+#pragma once
+// Fits the body anchors of the run-time push-out (BodyAnchors in model/model.hpp) to a character's
+// body: for each garment (game-mesh) vertex at rest, the closest point on the body's triangles (the
+// BodyCollider's grid search over the rest body, whose union-of-parts answer is the visible surface
+// for a point outside it), with
+//   - the body's outward normal there: the corners' area-weighted vertex normals (seam copies welded)
+//     interpolated barycentrically and normalised, turned to agree with the collider's pseudo-normal
+//     of the closest feature (which is outward for every closed part) where they disagree;
+//   - the body's skin there: the three corners' weights interpolated barycentrically, the
+//     kAnchorInfluences largest kept (ties: the lower joint) and renormalised;
+//   - the radius of the largest ball inside that point's part of the body that touches the surface
+//     there (bisection on the part's signed distance; a limb's own radius on a limb, a large ball on
+//     a flat trunk, a small one in a crease).
+//
+// A vertex farther than maxDistance from the rest body gets no anchor. Why a bound: the ball stands
+// for the body under the vertex, as seen from the vertex. A vertex that hangs free of the body (a hem
+// below the waist, a loose cuff) has its closest body point at a steep angle and far off, and in
+// motion it swings past where that point goes (the hem past the hip): a constraint there would push
+// cloth where the simulation has it. 4 cm is well beyond where a tight garment sits on the body at
+// rest (the default jersey: 26 mm at most, 17 mm median) and about a limb's radius.
+#include <cstddef>
+
+#include <nlohmann/json.hpp>
+
+#include "swish/core/mesh.hpp"
+#include "swish/core/skeleton.hpp"
+#include "swish/model/model.hpp"
+
+namespace swish::bake {
+
+struct BodyAnchorFitSettings {
+  float maxDistance = 0.04f;  // metres from the rest body; farther vertices get no anchor (see above)
+  float margin = 0.002f;      // BodyAnchors::margin written into the result
+  float maxRadius = 0.3f;     // metres: the largest ball tried (a trunk is not thicker)
+};
+
+struct BodyAnchorFit {
+  BodyAnchors anchors;
+  size_t anchored = 0;        // vertices with an anchor
+  size_t tooFar = 0;          // vertices beyond maxDistance (no anchor)
+  size_t insideAtRest = 0;    // anchored vertices inside the body at rest (the push-out moves them at rest)
+  size_t withinMargin = 0;    // anchored vertices nearer their ball than the margin at rest (pushed at rest)
+  size_t flippedNormals = 0;  // interpolated normals turned to agree with the pseudo-normal
+  // Distance of the anchored vertices to their anchors at rest (mm): median, 95th percentile, largest.
+  float medianMm = 0, p95Mm = 0, maxMm = 0;
+  float maxDistanceMm = 0;                    // the bound used (settings.maxDistance)
+  float radiusP10Mm = 0, radiusMedianMm = 0;  // of the anchors' balls
+};
+
+// `body` skinned to `skeleton` (rest positions, triangles, skin; validated, errors name the problem),
+// `garment` the game mesh at rest (character space, as the body). Deterministic.
+BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const Mesh& garment,
+                             const BodyAnchorFitSettings& settings = {});
+
+// Calibration against the source simulation. The ball stands for the body, but the bake's own
+// simulated garment (the truth the network learns) lies inside it in places: cloth squeezed between an
+// arm and the trunk that overlap in a pose, a hem over the thigh, a sleeve the transfer's smoothing
+// draws into the arm. There, pushing the network's garment out to the ball moves it away from the
+// truth; and the truth's depth follows the pose (where the network puts a vertex deep, the truth is
+// mostly deep there too), so no per-vertex bound taken from the truth alone serves.
+//
+// So the calibration measures the push-out itself: on each calibration pose it has the network's garment
+// (without the push-out) and the truth, and per anchor it takes the HIGHEST clearance, from the margin
+// down in `step`s, at which pushing that vertex out on every calibration pose does not raise the sum of
+// its distances to the truth over those poses. A clearance below every calibration pose's distance
+// pushes nothing there and qualifies, so one is found unless the network put the vertex deeper than
+// its ball's radius or kMaxAnchorDepth; such an anchor is dropped. The push-out then removes what it can
+// without making any vertex worse on the calibration poses.
+struct BodyAnchorCalibrationSettings {
+  float step = 0.001f;  // metres between the clearances tried
+};
+
+struct BodyAnchorCalibrationPose {
+  std::vector<Mat4f> skinMatrices;      // the pose's, one per joint
+  const Points3f* truth = nullptr;      // the simulated garment, character space, posed
+  const Points3f* predicted = nullptr;  // the network's garment there, without the push-out (the run time's)
+};
+
+struct BodyAnchorCalibration {
+  size_t poses = 0;
+  size_t lowered = 0;         // anchors whose clearance went below the margin
+  size_t dropped = 0;         // anchors dropped (see above)
+  float medianLoweredMm = 0;  // median clearance of the lowered anchors (mm, negative: inside the ball)
+  // Over the calibration poses and every vertex: mean distance to the truth (mm) without and with the
+  // calibrated push-out, and the share of (pose, vertex) pairs it moves.
+  double meanMmWithout = 0, meanMmWith = 0, pushedShare = 0;
+};
+
+// Throws Error naming the problem for sizes that do not fit the anchors. Deterministic.
+BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vector<BodyAnchorCalibrationPose>& poses,
+                                           const BodyAnchorCalibrationSettings& settings = {});
+
+// The fit's figures for the model's metadata ("body_anchors") and reports.
+nlohmann::json toJson(const BodyAnchorFit& fit);
+nlohmann::json toJson(const BodyAnchorCalibration& calibration);
+
+}  // namespace swish::bake

@@ -1,0 +1,370 @@
+// The body anchors of the run-time push-out and the penetration measure: bake::fitBodyAnchors and
+// bake::calibrateBodyAnchors on a box body (known weights and normals), the analytic capsule character
+// (exact distances, support/cloth_fixture.hpp) and the embedded default character;
+// runtime::referencePushOut on hand-made anchors; bake::measurePenetration.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "support/cloth_fixture.hpp"
+#include "swish/bake/character/default_character.hpp"
+#include "swish/bake/cloth/body_collider.hpp"
+#include "swish/bake/report/penetration.hpp"
+#include "swish/bake/training/body_anchor_fit.hpp"
+#include "swish/core/error.hpp"
+#include "swish/runtime/reference_push_out.hpp"
+
+namespace swish {
+namespace {
+
+std::vector<Mat4f> identities(size_t joints) { return std::vector<Mat4f>(joints, Mat4f::Identity()); }
+
+float weightSum(const BodyAnchor& a) { return a.weights[0] + a.weights[1] + a.weights[2] + a.weights[3]; }
+
+TEST(Penetration, CountsAndDepthOnAnAnalyticBody) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  bake::BodyCollider collider(ch.body, 0.05f);
+  collider.pose(identities(ch.skeleton.size()));
+  Points3f p(4, 3);
+  p.row(0) << 0.f, 0.35f, spec.radius - 0.001f;  // 1 mm inside: inside, not visible
+  p.row(1) << 0.f, 0.35f, spec.radius - 0.010f;  // 10 mm inside: visible
+  p.row(2) << 0.f, 0.35f, spec.radius + 0.005f;  // outside
+  p.row(3) << spec.radius - 0.004f, 0.5f, 0.f;   // 4 mm inside: visible
+  const bake::PenetrationStats s = bake::measurePenetration(collider, p);
+  EXPECT_EQ(s.vertices, 4u);
+  EXPECT_EQ(s.inside, 3u);
+  EXPECT_EQ(s.visible, 2u);
+  // The tessellated surface lies inside the analytic one by at most r (1 - cos(pi / 32)) = 0.6 mm.
+  EXPECT_NEAR(s.deepestMm, 10.0, 0.7);
+  bake::PenetrationPool pool;
+  pool.add(s);
+  pool.add({});
+  EXPECT_EQ(pool.frames, 2u);
+  EXPECT_EQ(pool.framesVisible, 1u);
+  EXPECT_NEAR(pool.deepestPercentileMm(0.5), 0.0, 1e-12);
+  EXPECT_NEAR(pool.deepestPercentileMm(1.0), s.deepestMm, 1e-12);
+}
+
+// A closed box [-0.1, 0.1]^3 (outward winding) on a chain of 8 joints; corner c is skinned 0.6 to joint
+// c and 0.4 to joint c + 1 (mod 8), so a point on a face mixes up to six joints and the fit must keep
+// four.
+struct BoxBody {
+  Skeleton skeleton;
+  Mesh body;
+};
+BoxBody boxBody() {
+  BoxBody b;
+  for (int j = 0; j < 8; ++j)
+    b.skeleton.joints.push_back(
+        {std::string(1, char('a' + j)), j - 1, {Quatf::Identity(), Vec3f(0, j ? 0.01f : 0.f, 0)}});
+  b.skeleton.computeInverseBindFromRest();
+  Mesh& m = b.body;
+  m.positions.resize(8, 3);
+  for (int c = 0; c < 8; ++c)
+    m.positions.row(c) << (c & 1 ? 0.1f : -0.1f), (c & 2 ? 0.1f : -0.1f), (c & 4 ? 0.1f : -0.1f);
+  // Faces as quads (counter-clockwise seen from outside), two triangles each.
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  m.triangles.resize(12, 3);
+  for (int f = 0; f < 6; ++f) {
+    m.triangles.row(2 * f) << quads[f][0], quads[f][1], quads[f][2];
+    m.triangles.row(2 * f + 1) << quads[f][0], quads[f][2], quads[f][3];
+  }
+  m.skin.influences = 2;
+  for (uint16_t c = 0; c < 8; ++c) {
+    m.skin.joints.insert(m.skin.joints.end(), {c, uint16_t((c + 1) % 8)});
+    m.skin.weights.insert(m.skin.weights.end(), {0.6f, 0.4f});
+  }
+  return b;
+}
+
+Mesh pointsMesh(std::initializer_list<Vec3f> pts) {
+  Mesh g;
+  g.positions.resize(Eigen::Index(pts.size()), 3);
+  Eigen::Index i = 0;
+  for (const Vec3f& p : pts) g.positions.row(i++) = p.transpose();
+  return g;
+}
+
+TEST(BodyAnchorFit, BoxBodyPointsNormalsAndWeights) {
+  const BoxBody box = boxBody();
+  const Mesh garment = pointsMesh({
+      Vec3f(0.12f, 0.12f, 0.12f),   // off corner 7: the corner itself
+      Vec3f(0.f, 0.12f, 0.12f),     // off the edge between corners 6 and 7: its midpoint
+      Vec3f(0.03f, 0.02f, 0.125f),  // off face z = +0.1
+      Vec3f(0.f, 0.f, 0.2f),        // 10 cm off: beyond the 4 cm bound
+      Vec3f(0.f, 0.f, 0.09f),       // inside the box, 1 cm under face z = +0.1
+  });
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(box.body, box.skeleton, garment);
+  ASSERT_EQ(fit.anchors.anchors.size(), 5u);
+  EXPECT_EQ(fit.anchored, 4u);
+  EXPECT_EQ(fit.tooFar, 1u);
+  EXPECT_EQ(fit.insideAtRest, 1u);
+  const auto& a = fit.anchors.anchors;
+
+  // The corner: its own weights exactly (joint 7 at 0.6, joint 0 at 0.4), its normal pointing out.
+  EXPECT_LT((a[0].position - Vec3f(0.1f, 0.1f, 0.1f)).norm(), 1e-6f);
+  EXPECT_EQ(a[0].joints[0], 7);
+  EXPECT_EQ(a[0].joints[1], 0);
+  EXPECT_NEAR(a[0].weights[0], 0.6f, 1e-6f);
+  EXPECT_NEAR(a[0].weights[1], 0.4f, 1e-6f);
+  EXPECT_EQ(a[0].weights[2], 0.f);
+  EXPECT_GT(a[0].normal.dot(Vec3f(1, 1, 1).normalized()), 0.9f);
+  EXPECT_LT(a[0].radius, 0.005f) << "no ball of any size fits into a corner";
+
+  // The edge midpoint: half of corner 6 (joints 6, 7) and half of corner 7 (joints 7, 0).
+  EXPECT_LT((a[1].position - Vec3f(0.f, 0.1f, 0.1f)).norm(), 1e-6f);
+  EXPECT_EQ(a[1].joints[0], 7);  // 0.5 * 0.4 + 0.5 * 0.6
+  EXPECT_NEAR(a[1].weights[0], 0.5f, 1e-6f);
+  EXPECT_NEAR(a[1].weights[1], 0.3f, 1e-6f);  // joint 6
+  EXPECT_NEAR(a[1].weights[2], 0.2f, 1e-6f);  // joint 0
+  EXPECT_EQ(a[1].joints[1], 6);
+  EXPECT_EQ(a[1].joints[2], 0);
+
+  // On the face: the closest point straight below, normal mostly +z, four weights summing to 1, largest
+  // first (the corner-averaged vertex normals tilt it towards the corners).
+  EXPECT_LT((a[2].position - Vec3f(0.03f, 0.02f, 0.1f)).norm(), 1e-6f);
+  EXPECT_GT(a[2].normal.z(), 0.7f);
+  // A face holds a large ball, if not the box's own 10 cm one: on so coarse a mesh the interpolated
+  // normal leans towards the corners, and so does the ball.
+  EXPECT_GT(a[2].radius, 0.01f);
+  EXPECT_LE(a[2].radius, 0.101f) << "the box's own inscribed ball is the largest";
+  for (int i = 0; i < 4; ++i) EXPECT_GT(a[2].weights[size_t(i)], 0.f) << i;
+  for (int i = 0; i < 3; ++i) EXPECT_GE(a[2].weights[size_t(i)], a[2].weights[size_t(i + 1)]) << i;
+
+  EXPECT_FALSE(a[3].present());
+  EXPECT_EQ(a[3].position, Vec3f::Zero());
+
+  // Inside: anchored on the nearest face, its normal out of the box, so the vertex is behind its plane.
+  EXPECT_LT((a[4].position - Vec3f(0.f, 0.f, 0.1f)).norm(), 1e-6f);
+  EXPECT_GT(a[4].normal.z(), 0.7f);
+
+  for (const BodyAnchor& an : a) {
+    if (!an.present()) continue;
+    EXPECT_NEAR(an.normal.norm(), 1.f, 1e-5f);
+    EXPECT_NEAR(weightSum(an), 1.f, 1e-5f);
+    EXPECT_EQ(an.clearance, fit.anchors.margin);
+  }
+  EXPECT_NO_THROW(bake::fitBodyAnchors(box.body, box.skeleton, garment, {0.2f, 0.001f}));
+  EXPECT_THROW(bake::fitBodyAnchors(box.body, box.skeleton, garment, {-1.f, 0.002f}), Error);
+  EXPECT_THROW(bake::fitBodyAnchors(box.body, box.skeleton, garment, {0.04f, 0.5f}), Error);
+}
+
+// On the analytic capsule body every garment vertex (a tube 12 mm off it) is anchored on the surface
+// straight under it, with the radial normal and the body's own weights there.
+TEST(BodyAnchorFit, AnalyticCapsule) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
+  EXPECT_EQ(fit.anchored, ch.garment.vertexCount());
+  EXPECT_EQ(fit.insideAtRest, 0u);
+  EXPECT_EQ(fit.withinMargin, 0u);
+  EXPECT_NEAR(fit.medianMm, 1000.0 * spec.gap, 1.0);
+  for (size_t v = 0; v < ch.garment.vertexCount(); ++v) {
+    const BodyAnchor& a = fit.anchors.anchors[v];
+    ASSERT_TRUE(a.present()) << v;
+    // The tessellated surface lies within r (1 - cos(pi / 32)) = 0.6 mm inside the analytic one.
+    EXPECT_NEAR(test::capsuleSignedDistance(spec, a.position), 0.f, 0.001f) << v;
+    const Vec3f radial = Vec3f(a.position.x(), 0.f, a.position.z()).normalized();
+    EXPECT_GT(a.normal.dot(radial), 0.995f) << v;
+    EXPECT_NEAR(a.radius, spec.radius, 0.003f) << v << ": the ball inscribed in a capsule is its radius";
+    EXPECT_NEAR(weightSum(a), 1.f, 1e-5f) << v;
+    uint16_t joints[4];
+    float weights[4];
+    test::capsuleWeights(a.position.y(), joints, weights);
+    float dominant = 0.f;  // the body's weight of the anchor's first joint, by the analytic rule
+    for (int i = 0; i < 4; ++i)
+      if (joints[i] == a.joints[0]) dominant += weights[i];
+    EXPECT_NEAR(a.weights[0], dominant, 0.08f) << v << " at y " << a.position.y();
+  }
+  const bake::BodyAnchorFit again = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
+  for (size_t v = 0; v < ch.garment.vertexCount(); ++v) {
+    EXPECT_EQ(again.anchors.anchors[v].position, fit.anchors.anchors[v].position);
+    EXPECT_EQ(again.anchors.anchors[v].weights, fit.anchors.anchors[v].weights);
+  }
+
+  // The garment pushed 3 cm into the body comes back out, its margin off the (tessellated) surface,
+  // and the garment at rest is left alone.
+  bake::BodyCollider collider(ch.body, 0.05f);
+  collider.pose(identities(ch.skeleton.size()));
+  Points3f inside = ch.garment.positions;
+  for (Eigen::Index v = 0; v < inside.rows(); ++v) {
+    const Vec3f p = inside.row(v).transpose();
+    inside.row(v) = (p - Vec3f(p.x(), 0, p.z()).normalized() * (spec.gap + 0.03f)).transpose();
+  }
+  EXPECT_EQ(bake::measurePenetration(collider, inside).inside, inside.rows());
+  Points3f pushed = inside;
+  EXPECT_EQ(runtime::referencePushOut(pushed, fit.anchors, identities(ch.skeleton.size())), size_t(inside.rows()));
+  const bake::PenetrationStats after = bake::measurePenetration(collider, pushed);
+  EXPECT_EQ(after.inside, 0u);
+  Points3f rest = ch.garment.positions;
+  EXPECT_EQ(runtime::referencePushOut(rest, fit.anchors, identities(ch.skeleton.size())), 0u);
+  EXPECT_EQ(rest, ch.garment.positions);
+}
+
+// The embedded default character: every jersey vertex anchored (the jersey sits within the bound), on
+// the body's surface, normals out of the body, none inside at rest.
+TEST(BodyAnchorFit, DefaultCharacter) {
+  const Character ch = bake::makeDefaultCharacter();
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
+  EXPECT_EQ(fit.anchored, ch.garment.vertexCount());
+  EXPECT_EQ(fit.insideAtRest, 0u);
+  EXPECT_LT(fit.maxMm, 40.f);
+  bake::BodyCollider collider(ch.body, 0.05f);
+  collider.pose(identities(ch.skeleton.size()));
+  for (size_t v = 0; v < ch.garment.vertexCount(); v += 7) {
+    const BodyAnchor& a = fit.anchors.anchors[v];
+    const bake::BodyCollider::Hit on = collider.closest(a.position, 0.01f);
+    ASSERT_TRUE(on.found) << v;
+    EXPECT_NEAR(on.signedDistance, 0.f, 1e-4f) << v;
+    const bake::BodyCollider::Hit out = collider.closest(a.position + 0.003f * a.normal, 0.01f);
+    EXPECT_TRUE(!out.found || out.signedDistance > 0.f) << v << ": the normal points into the body";
+    EXPECT_GE(a.radius, kMinAnchorRadius) << v;
+    EXPECT_LE(a.radius, 0.3f) << v;
+    // The ball lies inside the body: its centre is at least (nearly) its radius deep.
+    const bake::BodyCollider::Hit centre = collider.closest(a.centre(), a.radius + 0.01f);
+    ASSERT_TRUE(centre.found) << v;
+    EXPECT_LE(centre.signedDistance, -a.radius + 0.0011f) << v;
+  }
+  Points3f rest = ch.garment.positions;
+  EXPECT_EQ(runtime::referencePushOut(rest, fit.anchors, identities(ch.skeleton.size())), 0u);
+}
+
+// Calibration: each anchor keeps the highest clearance at which pushing the network's garment does not
+// take that vertex further from the truth over the poses; an anchor whose ball the network and the
+// truth both go nearly through to the centre is dropped.
+TEST(BodyAnchorFit, CalibrationKeepsTheErrorAndPushesWhereItHelps) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  bake::BodyAnchorFit fit = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
+  fit.anchors.anchors[2].radius = 0.01f;
+  const auto& an = fit.anchors.anchors;
+  // Distances off the ball (mm, along the normal through the anchor: as the plane's) of the network's vertex and of the
+  // truth, per vertex and pose.
+  struct Pair {
+    float predicted, truth;
+  };
+  const Pair table[4][2] = {
+      {{-10.f, 5.f}, {-10.f, 5.f}},          // the network deep, the truth outside: pushing helps, margin kept
+      {{-10.5f, -10.5f}, {-10.5f, -10.5f}},  // the network on the truth: the first clearance below, -11 mm
+      {{-9.7f, -9.7f}, {-9.7f, -9.7f}},      // near the centre of a 1 cm ball: no clearance above -1 cm qualifies
+      {{-20.f, 1.f}, {-15.f, -15.f}},        // helps 21 mm in one pose, hurts 17 in the other: margin kept
+  };
+  std::vector<Points3f> truth(2, ch.garment.positions), predicted(2, ch.garment.positions);
+  std::vector<bake::BodyAnchorCalibrationPose> poses(2);
+  for (size_t p = 0; p < 2; ++p) {
+    for (int v = 0; v < 4; ++v) {
+      const BodyAnchor& a = an[size_t(v)];
+      predicted[p].row(v) = (a.position + 0.001f * table[v][p].predicted * a.normal).transpose();
+      truth[p].row(v) = (a.position + 0.001f * table[v][p].truth * a.normal).transpose();
+    }
+    poses[p] = {identities(ch.skeleton.size()), &truth[p], &predicted[p]};
+  }
+  BodyAnchors anchors = fit.anchors;
+  const bake::BodyAnchorCalibration c = bake::calibrateBodyAnchors(anchors, poses);
+  EXPECT_EQ(c.poses, 2u);
+  EXPECT_EQ(anchors.anchors[0].clearance, fit.anchors.margin);
+  EXPECT_NEAR(anchors.anchors[1].clearance, -0.011f, 1e-6f);
+  EXPECT_FALSE(anchors.anchors[2].present());
+  EXPECT_EQ(anchors.anchors[3].clearance, fit.anchors.margin);
+  for (size_t v = 4; v < anchors.anchors.size(); ++v) EXPECT_EQ(anchors.anchors[v].clearance, fit.anchors.margin);
+  EXPECT_EQ(c.lowered, 1u);
+  EXPECT_EQ(c.dropped, 1u);
+  EXPECT_LT(c.meanMmWith, c.meanMmWithout);
+  // The calibrated push-out on those poses: each vertex's summed distance to the truth no larger.
+  std::vector<double> before(4, 0.0), after(4, 0.0);
+  for (size_t p = 0; p < 2; ++p) {
+    Points3f x = predicted[p];
+    runtime::referencePushOut(x, anchors, poses[p].skinMatrices);
+    for (int v = 0; v < 4; ++v) {
+      before[size_t(v)] += (predicted[p].row(v) - truth[p].row(v)).norm();
+      after[size_t(v)] += (x.row(v) - truth[p].row(v)).norm();
+    }
+  }
+  for (int v = 0; v < 4; ++v) EXPECT_LE(after[size_t(v)], before[size_t(v)] + 1e-6) << v;
+  EXPECT_LT(after[0], before[0] - 0.02);
+
+  EXPECT_THROW(bake::calibrateBodyAnchors(anchors, {{identities(4), &truth[0], nullptr}}), Error);
+  const Points3f tooShort = ch.garment.positions.topRows(3);
+  EXPECT_THROW(bake::calibrateBodyAnchors(anchors, {{identities(4), &tooShort, &tooShort}}), Error);
+}
+
+// The reference on hand-made anchors: a ball of 5 cm touching z = 0 from below at (0, 1, 0). A vertex
+// inside lands on the sphere of radius + clearance along the radius, one outside stays, the ball rides
+// its joints, and the push is continuous and never pulls a vertex in.
+TEST(PushOutReference, KnownAnswersAndContinuity) {
+  BodyAnchors anchors;
+  BodyAnchor a;
+  a.position = Vec3f(0, 1, 0);
+  a.normal = Vec3f(0, 0, 1);
+  a.radius = 0.05f;
+  a.clearance = 0.002f;
+  a.joints = {0, 1, 0, 0};
+  a.weights = {0.5f, 0.5f, 0.f, 0.f};
+  EXPECT_LT((a.centre() - Vec3f(0, 1, -0.05f)).norm(), 1e-7f);
+  anchors.anchors = {a, a, BodyAnchor{}};
+  anchors.anchors[1].clearance = -0.01f;  // calibrated: kept 1 cm inside the ball only
+  Points3f p(3, 3);
+  p.row(0) << 0.f, 1.f, -0.03f;   // 2 cm above the centre: to z = -0.05 + 0.052
+  p.row(1) << 0.f, 1.f, -0.005f;  // 4.5 cm from the centre, but its reach is 4 cm: stays
+  p.row(2) << 0.f, 1.f, -0.05f;   // no anchor: stays
+  std::vector<Mat4f> mats = identities(2);
+  Points3f q = p;
+  EXPECT_EQ(runtime::referencePushOut(q, anchors, mats), 1u);
+  EXPECT_NEAR(q(0, 2), 0.002f, 1e-7f);
+  EXPECT_EQ(q(0, 0), p(0, 0));
+  EXPECT_EQ(q(0, 1), p(0, 1));
+  EXPECT_EQ(q.row(1), p.row(1));
+  EXPECT_EQ(q.row(2), p.row(2));
+
+  // Joint 1 moved 4 cm along +x: the blended centre (half of it) 2 cm; the vertex lands on the moved
+  // sphere, on the ray from the centre through it.
+  mats[1](0, 3) = 0.04f;
+  const Vec3f c = runtime::skinAnchorCentre(a, mats);
+  EXPECT_LT((c - Vec3f(0.02f, 1, -0.05f)).norm(), 1e-6f);
+  q = p;
+  runtime::referencePushOut(q, anchors, mats);
+  const Vec3f moved = q.row(0).transpose(), before = p.row(0).transpose();
+  EXPECT_NEAR((moved - c).norm(), a.reach(), 1e-6f);
+  EXPECT_LT((moved - c).normalized().cross((before - c).normalized()).norm(), 1e-5f);
+  // Joint 1 turned 90 degrees about x: the centre is the blend of (0, 1, -0.05) and its turn (0, 0.05, 1).
+  mats[1] = Mat4f::Identity();
+  mats[1].topLeftCorner<3, 3>() = Eigen::AngleAxisf(float(M_PI / 2), Vec3f::UnitX()).toRotationMatrix();
+  EXPECT_LT((runtime::skinAnchorCentre(a, mats) - Vec3f(0, 0.525f, 0.475f)).norm(), 1e-6f);
+
+  // Continuity along the radius: the output never moves backwards and never jumps.
+  mats = identities(2);
+  Points3f prev(1, 3);
+  for (int s = 0; s <= 400; ++s) {
+    Points3f x(1, 3);
+    x << 0.f, 1.f, -0.04f + 0.00015f * float(s);
+    Points3f y = x;
+    runtime::referencePushOut(y, BodyAnchors{0.002f, {a}}, mats);
+    EXPECT_GE(y(0, 2), x(0, 2) - 1e-7f);
+    EXPECT_GE(y(0, 2), 0.002f - 1e-6f);
+    if (s > 0) {
+      EXPECT_LE(std::abs(y(0, 2) - prev(0, 2)), 0.00015f + 1e-6f) << s;
+    }
+    prev = y;
+  }
+  // On the centre there is no direction: the vertex stays.
+  Points3f centre(1, 3);
+  centre << 0.f, 1.f, -0.05f;
+  EXPECT_EQ(runtime::referencePushOut(centre, BodyAnchors{0.002f, {a}}, mats), 0u);
+
+  // Errors: anchors for another vertex count, a weighted joint without a matrix.
+  Points3f two = p.topRows(2);
+  EXPECT_THROW(runtime::referencePushOut(two, anchors, mats), Error);
+  EXPECT_THROW(runtime::referencePushOut(q, anchors, identities(1)), Error);
+  // A NaN matrix gives the anchor no centre: the vertex stays.
+  std::vector<Mat4f> nan = identities(2);
+  nan[1].setConstant(std::numeric_limits<float>::quiet_NaN());
+  q = p;
+  EXPECT_EQ(runtime::referencePushOut(q, anchors, nan), 0u);
+  EXPECT_EQ(q, p);
+  EXPECT_EQ(runtime::referencePushOut(q, BodyAnchors{}, mats), 0u);
+}
+
+}  // namespace
+}  // namespace swish
