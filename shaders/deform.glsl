@@ -25,11 +25,12 @@
 // instance count, so the texel form pays most where characters are few (docs/performance.md).
 //
 // The push-out (runtime/reference_push_out.hpp, the specification): after skinning, each instance's
-// vertex is kept outside its body anchor's ball. The anchor (rest centre, reach, four influences) is
-// loaded once per thread with the rest of the vertex, and its centre skinned per instance with the
-// instance's matrix rows like the vertex itself: 12 more texel fetches and a 3x4 blend per vertex and
-// instance, no per-frame input. `pushOut` is a push constant, so a frame without the push-out
-// skips it in one uniform branch.
+// vertex is kept outside its body anchors' balls, one after the other (the first anchor, then the
+// second where the model has them). Each anchor (rest centre, reach, four influences) is loaded once
+// per thread with the rest of the vertex, and its centre skinned per instance with the instance's
+// matrix rows like the vertex itself: 12 more texel fetches and a 3x4 blend per anchor, vertex and
+// instance, no per-frame input. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
+// uniform, so a frame without the push-out skips it in uniform branches.
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
@@ -77,10 +78,11 @@ vec3 mean;
 float basis[3 * K];
 uint joints[INFLUENCES];
 float skinW[INFLUENCES];
-vec3 anchorC;   // the body anchor's ball centre (rest), when p.pushOut
-float anchorR;  // its reach (radius + clearance; 0: no anchor)
-uint anchorJ[4];
-float anchorW[4];
+// Its body anchors (p.pushOut of them, at most SWISH_MAX_ANCHOR_SLOTS: the first, then the second).
+vec3 anchorC[SWISH_MAX_ANCHOR_SLOTS];   // each ball's centre (rest)
+float anchorR[SWISH_MAX_ANCHOR_SLOTS];  // its reach (radius + clearance; 0: no anchor)
+uint anchorJ[SWISH_MAX_ANCHOR_SLOTS][4];
+float anchorW[SWISH_MAX_ANCHOR_SLOTS][4];
 
 // The blend of `count` skinning matrices of `instance` (weights w, joints j; a zero weight is skipped by
 // a select, as in the reference), as the columns b0..b3 of its top three rows.
@@ -120,13 +122,18 @@ void deformInstance(const uint instance, const uint groups) {
     SWISH_BLEND_MATRICES(INFLUENCES, joints, skinW, b0, b1, b2, b3)
     y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
   }
-  if (APPLY_SKINNING && p.pushOut != 0u) {  // (character space: after skinning only)
-    precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
-    SWISH_BLEND_MATRICES(4u, anchorJ, anchorW, a0, a1, a2, a3)
-    precise const vec3 c = ((a0 * anchorC.x + a1 * anchorC.y) + a2 * anchorC.z) + a3;
-    precise const vec3 e = y - c;
-    precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
-    if (s > 1e-12 && s < anchorR * anchorR) y = c + e * (anchorR / sqrt(s));  // kMinAnchorDistanceSq
+  if (APPLY_SKINNING) {  // (character space: after skinning only)
+    [[unroll]] for (uint a = 0u; a < SWISH_MAX_ANCHOR_SLOTS; ++a) {
+      if (a < p.pushOut) {  // uniform: every thread the same
+        precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
+        SWISH_BLEND_MATRICES(4u, anchorJ[a], anchorW[a], a0, a1, a2, a3)
+        precise const vec3 c = ((a0 * anchorC[a].x + a1 * anchorC[a].y) + a2 * anchorC[a].z) + a3;
+        precise const vec3 e = y - c;
+        precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
+        const float r = anchorR[a];
+        if (s > 1e-12 && s < r * r) y = c + e * (r / sqrt(s));  // kMinAnchorDistanceSq
+      }
+    }
   }
   FloatsOut outBuf = FloatsOut(p.positionsOut);
   const uint o = (instance * p.vertexCount + v) * 3u;
@@ -171,22 +178,24 @@ void main() {
     joints[i] = jointBuf.v[v * INFLUENCES + i];
     skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
   }
-  if (p.pushOut != 0u) {
-    FloatsIn anchorF = FloatsIn(p.anchors);
-    UintsIn anchorU = UintsIn(p.anchors);
-    const uint o = v * SWISH_ANCHOR_WORDS;
-    anchorC = vec3(anchorF.v[o], anchorF.v[o + 1u], anchorF.v[o + 2u]);
-    anchorR = anchorF.v[o + 3u];
-    [[unroll]] for (uint i = 0u; i < 4u; ++i) {
-      anchorW[i] = anchorF.v[o + 4u + i];
-      anchorJ[i] = anchorU.v[o + 8u + i];
-    }
-  } else {
-    anchorC = vec3(0.0);
-    anchorR = 0.0;
-    [[unroll]] for (uint i = 0u; i < 4u; ++i) {
-      anchorW[i] = 0.0;
-      anchorJ[i] = 0u;
+  FloatsIn anchorF = FloatsIn(p.anchors);
+  UintsIn anchorU = UintsIn(p.anchors);
+  [[unroll]] for (uint a = 0u; a < SWISH_MAX_ANCHOR_SLOTS; ++a) {
+    if (a < p.pushOut) {
+      const uint o = (a * p.vertexCount + v) * SWISH_ANCHOR_WORDS;
+      anchorC[a] = vec3(anchorF.v[o], anchorF.v[o + 1u], anchorF.v[o + 2u]);
+      anchorR[a] = anchorF.v[o + 3u];
+      [[unroll]] for (uint i = 0u; i < 4u; ++i) {
+        anchorW[a][i] = anchorF.v[o + 4u + i];
+        anchorJ[a][i] = anchorU.v[o + 8u + i];
+      }
+    } else {
+      anchorC[a] = vec3(0.0);
+      anchorR[a] = 0.0;
+      [[unroll]] for (uint i = 0u; i < 4u; ++i) {
+        anchorW[a][i] = 0.0;
+        anchorJ[a][i] = 0u;
+      }
     }
   }
 

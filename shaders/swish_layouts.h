@@ -12,7 +12,7 @@
 //   instance order    : uint[instance], the instances band by band (deform quality levels, deform.glsl)
 //   skin matrix rows  : vec4[instance][joint][3], rows 0..2 of each affine skinning matrix (texels)
 //   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
-//   body anchors      : word[vertex][SWISH_ANCHOR_WORDS]: float ball centre xyz (rest), float reach
+//   body anchors      : word[set][vertex][SWISH_ANCHOR_WORDS]: float ball centre xyz (rest), float reach
 //                       (radius + clearance), float weights[4], uint joints[4] (BodyAnchor; all 0: none)
 //   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
 //   VQ codebook       : int8[entry][16 texels][2] read as uint words (2 texels per word)
@@ -39,8 +39,9 @@ struct alignas(8) Address {
 // hundred they would spill).
 #define SWISH_MAX_MESH_COMPONENTS 256
 
-// 32-bit words per vertex of the body-anchor buffer (layout above).
+// 32-bit words per vertex of the body-anchor buffer (layout above), and the most anchor sets in it.
 #define SWISH_ANCHOR_WORDS 12
+#define SWISH_MAX_ANCHOR_SLOTS 2
 
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
 // push-out of the body anchors' balls (runtime/reference_push_out.hpp). The mesh weights
@@ -54,12 +55,12 @@ struct DeformParams {
   SWISH_ADDRESS skinJoints;      // uint[N][influences]
   SWISH_ADDRESS skinWeights;     // float[N][influences]
   SWISH_ADDRESS positionsOut;    // float[instanceCount][N][3]
-  SWISH_ADDRESS anchors;         // word[N][SWISH_ANCHOR_WORDS]: body anchors (unused when pushOut is 0)
+  SWISH_ADDRESS anchors;         // word[pushOut][N][SWISH_ANCHOR_WORDS]: body anchors (unused when pushOut is 0)
   SWISH_ADDRESS instanceOrder;   // uint[instanceCount]: instances by band (unused with one band)
   uint vertexCount;
   uint instanceCount;
   uint jointCount;
-  uint pushOut;                  // 0: no push-out; else every instance is pushed to its anchors' planes
+  uint pushOut;                  // anchor sets to push out of (0: no push-out; at most SWISH_MAX_ANCHOR_SLOTS)
   uint maxGroups;                // basis groups each vertex loads: the widest band in use (K4 / 4 at most)
   uint bandEnd[4];               // end of bands 0..3 in instanceOrder (bands beyond the pipeline's: unused)
   uint pad0;

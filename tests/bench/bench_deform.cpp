@@ -76,13 +76,14 @@ struct DeformSetup {
 };
 
 DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint32_t components = 30,
-                      bool anchors = false) {
+                      uint32_t anchorSets = 0) {
   DeformSetup s;
   Rng rng(42);
   test::RandomModelSpec spec;
   spec.vertices = 3000;
   spec.meshComponents = components;
-  spec.bodyAnchors = anchors;
+  spec.bodyAnchors = anchorSets > 0;
+  spec.secondAnchors = anchorSets > 1;
   spec.influences = 4;
   spec.joints = 24;
   spec.normalMaps = 0;
@@ -156,7 +157,8 @@ BENCHMARK(BM_Deform)
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(0.5);
 
-// The deform pass with and without its push-out step: args instances, K. Each iteration times both
+// The deform pass with and without its push-out step: args instances, K, anchor sets (1: BodyAnchors::
+// anchors, 2: and BodyAnchors::second). Each iteration times both
 // dispatches (alternating, so that drift of a shared machine hits both alike); the reported time is the
 // pass with the push-out, `pushout_share` its extra time over the plain deform.
 void BM_DeformPushOut(benchmark::State& state) {
@@ -164,11 +166,12 @@ void BM_DeformPushOut(benchmark::State& state) {
   if (!ctx) return state.SkipWithError("no Vulkan device");
   if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
   const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1));
-  DeformSetup s = makeSetup(*ctx, instances, true, k, true);
+  DeformSetup s = makeSetup(*ctx, instances, true, k, uint32_t(state.range(2)));
   gpu::TimestampQueries ts(*ctx, 2);
   gpu::DeformPass::Args a = s.gpuModel->deformArgs(s.instanceInputs.get(), s.positions, instances);
   gpu::DeformPass::Args pushed = a;
   pushed.anchors = s.gpuModel->anchors.address();
+  pushed.anchorSlots = s.gpuModel->anchorSlots();
   gpuSeconds(*ctx, ts, [&](VkCommandBuffer cmd) { s.pass->record(cmd, pushed); });  // warm-up
   double with = 0, without = 0;
   for (auto _ : state) {
@@ -180,11 +183,12 @@ void BM_DeformPushOut(benchmark::State& state) {
   state.counters["plain_us"] = 1e6 * without / double(state.iterations());
   state.counters["pushout_share"] = (with - without) / without;
 }
-// Args: instances, K. K = 128 is the default model's.
+// Args: instances, K, anchor sets. K = 128 is the default model's.
 BENCHMARK(BM_DeformPushOut)
-    ->Args({22, 30})
-    ->Args({22, 128})
-    ->Args({1, 128})
+    ->Args({22, 30, 1})
+    ->Args({22, 128, 1})
+    ->Args({22, 128, 2})
+    ->Args({1, 128, 2})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(0.5);

@@ -1,5 +1,5 @@
 // Conformance of the push-out step of the deform kernel (shaders/deform.glsl: each vertex kept outside
-// its body anchor's ball, Model::bodyAnchors) to its CPU reference
+// its body anchors' balls, Model::bodyAnchors, one set or two) to its CPU reference
 // runtime::referencePushOut, on seeded random models with random anchors (seed printed;
 // SWISH_TEST_SEED overrides): the kernel deforms, skins and then pushes, and must match
 // referencePcaReconstruct -> referenceSkin -> referencePushOut. Outputs are followed by guard words;
@@ -27,9 +27,11 @@ using test::GuardedOutput;
 
 struct PushCase {
   uint32_t vertices, influences, instances;
+  bool second = false;  // second anchors too (BodyAnchors::second)
 };
 void PrintTo(const PushCase& c, std::ostream* os) {
-  *os << c.vertices << " vertices, " << c.influences << " influences, " << c.instances << " instances";
+  *os << c.vertices << " vertices, " << c.influences << " influences, " << c.instances << " instances"
+      << (c.second ? ", two anchor sets" : "");
 }
 
 struct PushInputs {
@@ -47,6 +49,7 @@ PushInputs randomInputs(uint64_t seed, const PushCase& c) {
   spec.meshComponents = 5;
   spec.normalMaps = 0;
   spec.bodyAnchors = true;
+  spec.secondAnchors = c.second;
   PushInputs in;
   in.model = test::makeRandomModel(rng, spec);
   in.instances = c.instances;
@@ -75,7 +78,8 @@ struct Reference {
 // compute to a few ulps) errs by about 1e-5 relative, times r. So
 //   |dx| <= |dc| + (r / |e|) (|dy| + |dc|) + 1e-5 r.
 // A vertex near the sphere (|e| ~ r) may be pushed on one side and not on the other; the push there is
-// r - |e|, within the same bound: the step is continuous.
+// r - |e|, within the same bound: the step is continuous. With two anchor sets the second push starts
+// from the first's output, so its |dy| is the first's bound.
 Reference reference(const PushInputs& in, bool pushOut) {
   const Model& m = in.model;
   const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
@@ -88,15 +92,16 @@ Reference reference(const PushInputs& in, bool pushOut) {
     const Points3f skinned = p;
     if (pushOut) r.moved += runtime::referencePushOut(p, m.bodyAnchors, mats);
     for (Eigen::Index v = 0; v < p.rows(); ++v) {
-      const Vec3f y = skinned.row(v).transpose();
-      const double tolY = 2e-6 + 1e-5 * double(y.cwiseAbs().maxCoeff());
-      double tol = tolY;
-      const BodyAnchor& an = m.bodyAnchors.anchors[size_t(v)];
-      if (pushOut && an.present()) {
+      Vec3f y = skinned.row(v).transpose();
+      double tol = 2e-6 + 1e-5 * double(y.cwiseAbs().maxCoeff());
+      for (uint32_t s = 0; pushOut && s < m.bodyAnchors.slots(); ++s) {
+        const BodyAnchor& an = m.bodyAnchors.slot(s)[size_t(v)];
+        if (!an.present()) continue;
         const Vec3f c = runtime::skinAnchorCentre(an, mats);
         const double tolC = 2e-6 + 1e-5 * double(c.cwiseAbs().maxCoeff()), r = double(an.reach());
         const double e = double((y - c).norm());
-        if (e < r) tol = tolC + (e > 0 ? r / e : 1.0) * (tolY + tolC) + 1e-5 * r;
+        if (e < r) tol = tolC + (e > 0 ? r / e : 1.0) * (tol + tolC) + 1e-5 * r;
+        y = runtime::pushedOutOfBall(y, c, an.reach());
       }
       for (int e = 0; e < 3; ++e) r.tolerance.push_back(tol);
     }
@@ -142,6 +147,7 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut) {
   a.instanceCount = in.instances;
   a.jointCount = uint32_t(m.skeleton.size());
   if (pushOut) a.anchors = anchors.address();
+  a.anchorSlots = m.bodyAnchors.slots();
   ctx.submitAndWait([&](VkCommandBuffer cmd) { pass.record(cmd, a); });
 
   GpuResult r;
@@ -154,7 +160,8 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut) {
 
 std::string caseName(const ::testing::TestParamInfo<PushCase>& info) {
   const auto& c = info.param;
-  return "V" + std::to_string(c.vertices) + "_I" + std::to_string(c.influences) + "_N" + std::to_string(c.instances);
+  return "V" + std::to_string(c.vertices) + "_I" + std::to_string(c.influences) + "_N" + std::to_string(c.instances) +
+         (c.second ? "_Two" : "");
 }
 
 class PushOutConformance : public test::GpuTest, public ::testing::WithParamInterface<PushCase> {};
@@ -196,10 +203,11 @@ TEST_P(PushOutConformance, OffIsThePlainDeform) {
 }
 
 // 1 vertex; a prime vertex count with the 22 instances of the default scene; 1 and 8 skin influences
-// (the anchors have 4 whatever the garment has).
+// (the anchors have 4 whatever the garment has); one anchor set and two.
 INSTANTIATE_TEST_SUITE_P(Sizes, PushOutConformance,
                          ::testing::Values(PushCase{1, 4, 1}, PushCase{97, 1, 3}, PushCase{997, 4, 22},
-                                           PushCase{401, 8, 4}),
+                                           PushCase{401, 8, 4}, PushCase{1, 4, 1, true}, PushCase{97, 1, 3, true},
+                                           PushCase{997, 4, 22, true}),
                          caseName);
 
 class PushOutSpecialCases : public test::GpuTest {};
@@ -248,6 +256,28 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
   const auto gpu = runDeform(ctx(), in, true);
   for (const auto& p : gpu.problems) ADD_FAILURE() << p;
   EXPECT_TRUE(test::matchesReference("kernel on known answers", gpu.positions, expected, [](size_t) { return 1e-6; }));
+
+  // A second anchor set, applied after the first: vertex 0's second ball (radius 4 cm, centre at z = 0.04,
+  // reach 4.2 cm) holds where the first ball puts it (z = 0.002, 3.8 cm off its centre) but not where it
+  // started (5 cm off), so the answer shows the order: pushed down to z = 0.04 - 0.042 = -0.002 (the
+  // other order would leave it at 0.002). Vertex 1's second ball, on joint 1, moves it to 0.03 + 0.052.
+  BodyAnchor second = anchor(0.f, 0);
+  second.position = Vec3f(0.f, 1.f, 0.08f);
+  second.radius = 0.04f;
+  BodyAnchor riding = anchor(0.1f, 1);  // centre (0.1, 1, -0.07) at rest, 0.03 after the joint's move
+  riding.position.z() = -0.02f;
+  m.bodyAnchors.second = {second, riding, BodyAnchor{}, BodyAnchor{}, BodyAnchor{}};
+  std::vector<float> expected2 = expected;
+  expected2[2] = -0.002f;
+  expected2[5] = 0.082f;
+  const Reference ref2 = reference(in, true);
+  EXPECT_TRUE(
+      test::matchesReference("reference, two anchor sets", ref2.positions, expected2, [](size_t) { return 1e-6; }));
+  EXPECT_EQ(ref2.moved, 3u);
+  const auto gpu2 = runDeform(ctx(), in, true);
+  for (const auto& p : gpu2.problems) ADD_FAILURE() << p;
+  EXPECT_TRUE(
+      test::matchesReference("kernel, two anchor sets", gpu2.positions, expected2, [](size_t) { return 1e-6; }));
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "swish/model/model_file.hpp"
 #include "swish/replay/replay_job.hpp"
 #include "swish/replay/replay_plan.hpp"
+#include "swish/replay/replay_render.hpp"
 #include "swish/replay/report_writer.hpp"
 #include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
@@ -49,8 +50,9 @@ class ReplayE2E : public test::GpuTest {
     spec.vertices = 120;
     spec.normalMaps = 4;
     spec.mapSize = 16;
-    spec.bodyAnchors = true;  // the push-out runs, and the GPU-vs-CPU checks cover it
-    spec.noveltyCentres = 5;  // the novelty guard runs, and the checks cover its weights too
+    spec.bodyAnchors = true;    // the push-out runs, and the GPU-vs-CPU checks cover it
+    spec.secondAnchors = true;  // both anchor sets (BodyAnchors::second)
+    spec.noveltyCentres = 5;    // the novelty guard runs, and the checks cover its weights too
     model_ = test::makeRandomModel(rng, spec);
     // What the bake records of its evaluation on held-out poses (part2_training.cpp).
     model_.metadata =
@@ -107,6 +109,45 @@ class ReplayE2E : public test::GpuTest {
   fs::path dir_;
   Model model_;
 };
+
+// `swish replay --render`: PNG frames and a contact sheet, and the report's section says what they show
+// (the push-out, the body drawn whole or without its covered triangles; here no body at all: the
+// random model's skeleton is not the mannequin's, and the note says so).
+TEST_F(ReplayE2E, RenderDrawsFramesAContactSheetAndSaysWhatTheyShow) {
+  auto has = [](const std::string& text, const char* part) { return text.find(part) != std::string::npos; };
+  const runtime::Scene s = scene(sceneJson({"walk.json"}));
+  replay::ModelLibrary models(s);
+  replay::ReplayRenderOptions ro;
+  ro.maxFrames = 2;
+  ro.width = 64;
+  ro.height = 80;
+  ro.validation = true;  // any message fails the render
+  ro.pushOut = true;
+  ro.hideCoveredBody = true;
+  const fs::path dir = dir_ / "out/render";
+  const replay::ReplayRenderResult r = replay::renderReplayFrames(s, models, dir, ro);
+  ASSERT_EQ(r.frames.size(), 2u);
+  for (const fs::path& f : r.frames) EXPECT_TRUE(fs::exists(f)) << f;
+  EXPECT_EQ(r.contactSheet, dir / "contact_sheet.png");
+  EXPECT_TRUE(fs::exists(r.contactSheet));
+  EXPECT_TRUE(r.heatSheet.empty());
+  EXPECT_TRUE(has(r.note, "no mannequin drawn")) << r.note;
+  const std::string md = replay::renderReportSection(r, ro, dir_ / "out");
+  EXPECT_TRUE(has(md, "## Pictures")) << md;
+  EXPECT_TRUE(has(md, "push-out was ON")) << md;
+  EXPECT_TRUE(has(md, "without the triangles the garment covers")) << md;
+  EXPECT_TRUE(has(md, "![contact sheet](render/contact_sheet.png)")) << md;
+  ro.pushOut = false;
+  ro.hideCoveredBody = false;
+  const std::string whole = replay::renderReportSection(r, ro, dir_ / "out");
+  EXPECT_TRUE(has(whole, "push-out was OFF")) << whole;
+  EXPECT_TRUE(has(whole, "drawn whole")) << whole;
+  // A character the scene does not have is an error naming it, and leaves no render folder behind.
+  ro.character = 5;
+  const std::string bad = test::errorOf([&] { replay::renderReplayFrames(s, models, dir_ / "bad", ro); });
+  EXPECT_TRUE(has(bad, "--render character 5 but the scene has 1 characters")) << bad;
+  EXPECT_FALSE(fs::exists(dir_ / "bad"));
+}
 
 TEST_F(ReplayE2E, WritesAReportThatParsesWithErrorBesideTime) {
   const runtime::Scene s = scene(sceneJson({"walk.json", "walk.json", "walk.json"}));

@@ -81,6 +81,8 @@ int main(int argc, char** argv) {
     s = small();
     s.bodyAnchors = true;
     shapes.push_back({"body_anchors", s});
+    s.secondAnchors = true;
+    shapes.push_back({"second_anchors", s});
     s = small();
     s.noveltyCentres = 3;
     shapes.push_back({"novelty_guard", s});

@@ -32,6 +32,24 @@ Pose makeRandomPose(Rng& rng, const Skeleton& sk, float maxAngle) {
   return p;
 }
 
+// A body anchor for vertex v near its rest position (first joint: the vertex's own first influence).
+static BodyAnchor randomAnchor(Rng& rng, const Model& m, uint32_t v, uint32_t joints) {
+  const SkinWeights& skin = m.gameMesh.skin;
+  BodyAnchor a;
+  a.normal = Vec3f(rng.uniformf(-.5f, .5f), rng.uniformf(-.5f, .5f), -1.f).normalized();
+  a.position = m.gameMesh.positions.row(v).transpose() + a.normal * rng.uniformf(-.03f, .02f);
+  a.radius = rng.uniformf(.015f, .08f);
+  a.clearance = v % 3 == 0 ? m.bodyAnchors.margin : rng.uniformf(-.01f, m.bodyAnchors.margin);
+  float sum = 0.f;
+  for (int i = 0; i < kAnchorInfluences; ++i) {
+    a.joints[size_t(i)] = i == 0 ? skin.joints[size_t(v) * size_t(skin.influences)] : uint16_t(rng.below(joints));
+    a.weights[size_t(i)] = i == 3 && v % 2 ? 0.f : rng.uniformf(0.05f, 1.f);
+    sum += a.weights[size_t(i)];
+  }
+  for (float& w : a.weights) w /= sum;
+  return a;
+}
+
 Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
   Model m;
   // Skeleton: joint i's parent is a random earlier joint, offsets ~10 cm.
@@ -125,22 +143,8 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
   if (s.bodyAnchors) {
     m.bodyAnchors.margin = 0.002f;
     m.bodyAnchors.anchors.resize(n);
-    for (uint32_t v = 0; v < n; ++v) {
-      if (v % 7 == 3) continue;
-      BodyAnchor& a = m.bodyAnchors.anchors[v];
-      a.normal = Vec3f(rng.uniformf(-.5f, .5f), rng.uniformf(-.5f, .5f), -1.f).normalized();
-      a.position = m.gameMesh.positions.row(v).transpose() + a.normal * rng.uniformf(-.03f, .02f);
-      a.radius = rng.uniformf(.015f, .08f);
-      a.clearance = v % 3 == 0 ? m.bodyAnchors.margin : rng.uniformf(-.01f, m.bodyAnchors.margin);
-      float sum = 0.f;
-      for (int i = 0; i < kAnchorInfluences; ++i) {
-        a.joints[size_t(i)] =
-            i == 0 ? g.skin.joints[size_t(v) * size_t(g.skin.influences)] : uint16_t(rng.below(s.joints));
-        a.weights[size_t(i)] = i == 3 && v % 2 ? 0.f : rng.uniformf(0.05f, 1.f);
-        sum += a.weights[size_t(i)];
-      }
-      for (float& w : a.weights) w /= sum;
-    }
+    for (uint32_t v = 0; v < n; ++v)
+      if (v % 7 != 3) m.bodyAnchors.anchors[v] = randomAnchor(rng, m, v, s.joints);
   }
   // Novelty guard: centres near the origin of the normalised input space, weight ranges around 0.
   if (s.noveltyCentres > 0) {
@@ -157,6 +161,11 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
     g.blendStart = 1.5f;
     g.blendEnd = 3.f;
     g.flagAbove = 1.5f;
+  }
+  if (s.bodyAnchors && s.secondAnchors) {
+    m.bodyAnchors.second.resize(n);
+    for (uint32_t v = 0; v < n; ++v)
+      if (v % 5 != 1) m.bodyAnchors.second[v] = randomAnchor(rng, m, v, s.joints);
   }
   m.validate("random model");
   return m;

@@ -22,6 +22,7 @@ struct RandomModelSpec {
   uint32_t codebookSize = 32;
   bool bodyAnchors = false;     // one body anchor per vertex (every 7th without), drawn after the MLP
   uint32_t noveltyCentres = 0;  // novelty guard centres (drawn after the anchors), with clamp and blend
+  bool secondAnchors = false;   // with bodyAnchors: second anchors too (every 5th without), drawn last
 };
 
 Model makeRandomModel(Rng& rng, const RandomModelSpec& spec = {});

@@ -43,7 +43,7 @@ struct BodyProxyOptions {
   std::string model, out;
   float maxDistanceMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.maxDistance;
   float marginMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.margin;
-  bool remove = false;
+  bool remove = false, oneAnchor = false;
   std::vector<std::string> clips;
   size_t poses = 48;
 };
@@ -142,6 +142,7 @@ int runBodyProxy(const BodyProxyOptions& o) {
   bake::BodyAnchorFitSettings s;
   s.maxDistance = o.maxDistanceMm / 1000.f;
   s.margin = o.marginMm / 1000.f;
+  s.secondAnchors = !o.oneAnchor;
   const bake::BodyAnchorFit fit = bake::fitBodyAnchors(character->body, entry.model.skeleton, entry.model.gameMesh, s);
   if (fit.anchored == 0)
     throw Error(o.model + ": no garment vertex lies within " + std::to_string(o.maxDistanceMm) +
@@ -150,10 +151,10 @@ int runBodyProxy(const BodyProxyOptions& o) {
       "Body of '%s' (%s): %zu of %zu garment vertices anchored (%zu farther than %.0f mm get none).\n"
       "  distance to the anchor at rest: median %.1f mm, p95 %.1f mm, max %.1f mm; ball radius: 10th percentile "
       "%.1f mm, median %.1f mm; %zu inside the body at rest, %zu within the %.1f mm margin of their ball (the "
-      "push-out moves them at rest); %zu normals turned outward.\n",
+      "push-out moves them at rest); %zu normals turned outward; %zu also anchored on a second body part%s.\n",
       character->name.c_str(), loaded.how.c_str(), fit.anchored, entry.model.gameMesh.vertexCount(), fit.tooFar,
       fit.maxDistanceMm, fit.medianMm, fit.p95Mm, fit.maxMm, fit.radiusP10Mm, fit.radiusMedianMm, fit.insideAtRest,
-      fit.withinMargin, o.marginMm, fit.flippedNormals);
+      fit.withinMargin, o.marginMm, fit.flippedNormals, fit.secondAnchored, o.oneAnchor ? " (--one-anchor)" : "");
   BodyAnchors anchors = fit.anchors;
   nlohmann::json j = bake::toJson(fit);
   j["made_by"] = "swish body-proxy (after the bake)";
@@ -161,10 +162,10 @@ int runBodyProxy(const BodyProxyOptions& o) {
     const bake::BodyAnchorCalibration cal = calibrate(entry, anchors, o);
     std::printf(
         "Calibrated on %zu simulated poses: %zu clearances lowered below the margin (median %.1f mm), %zu anchors "
-        "dropped; on those poses the push-out moves %.1f %% of the vertices and takes the vertex error against the "
-        "simulation from %.3f to %.3f mm.\n",
-        cal.poses, cal.lowered, cal.medianLoweredMm, cal.dropped, 100.0 * cal.pushedShare, cal.meanMmWithout,
-        cal.meanMmWith);
+        "dropped (%zu of them second anchors); on those poses the push-out moves %.1f %% of the vertices and takes "
+        "the vertex error against the simulation from %.3f to %.3f mm.\n",
+        cal.poses, cal.lowered, cal.medianLoweredMm, cal.dropped, cal.secondDropped, 100.0 * cal.pushedShare,
+        cal.meanMmWithout, cal.meanMmWith);
     j["calibration"] = bake::toJson(cal);
     nlohmann::json clips = nlohmann::json::array();
     for (const fs::path& c : clipFiles(o.clips)) clips.push_back(c.filename().string());
@@ -199,12 +200,17 @@ swish::cli::CommandRegistration reg{
                      "on the model's skeleton; ideally motion like the model's training clips)");
       app.add_option("--poses", o->poses, "frames simulated for the calibration, spread over the clips (default 48)")
           ->check(CLI::Range(size_t(1), size_t(100000)));
+      app.add_flag("--one-anchor", o->oneAnchor,
+                   "one anchor per vertex (its nearest body part) instead of also a second one on the nearest other "
+                   "part, where two parts meet (format 1.3's push-out)");
       app.add_flag("--remove", o->remove,
                    "write the model without body anchors instead (turns the push-out off for good)");
       app.footer(
           "The push-out: each garment vertex is kept outside the ball of its anchor (the largest ball inside the "
           "rest body touching it at the vertex's closest point, its centre skinned with the body's own weights "
-          "there), `margin` off it; it never pulls a vertex in, and a vertex answers to its own anchor only. The "
+          "there), `margin` off it; it never pulls a vertex in, and a vertex answers to its own anchors only: the one "
+          "on its nearest body part, then (format 1.4) one on the nearest other part within reach, where parts meet. "
+          "The "
           "bake calibrates "
           "each anchor's clearance on its training poses: the highest at which pushing the network's garment does "
           "not take it further from the simulated one; here --clips does the same with the source simulation of "

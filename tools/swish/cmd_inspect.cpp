@@ -89,6 +89,7 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
   j["temporalFilter"] = {{"timeConstantSeconds", m.temporalFilter.timeConstantSeconds}};
   j["qualityLevels"] = swish::runtime::toJson(swish::runtime::ladderOf(m));
   j["bodyAnchors"] = {{"anchored", m.bodyAnchors.anchored()},
+                      {"secondAnchored", m.bodyAnchors.anchored(1)},
                       {"vertices", m.bodyAnchors.anchors.size()},
                       {"marginM", m.bodyAnchors.margin}};
   // Metadata is meant to be JSON; show it as such when it is, as text when it is not.
@@ -141,11 +142,12 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
   if (m.bodyAnchors.empty()) {
     o << "  body anchors  none (no push-out at run time; swish body-proxy fits them)\n";
   } else {
-    char line[160];
-    std::snprintf(
-        line, sizeof line,
-        "  body anchors  %zu of %zu vertices, margin %.1f mm (the run-time push-out keeps them off the body)\n",
-        m.bodyAnchors.anchored(), m.bodyAnchors.anchors.size(), 1000.0 * double(m.bodyAnchors.margin));
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "  body anchors  %zu of %zu vertices (%zu with a second one), margin %.1f mm (the run-time push-out "
+                  "keeps them off the body)\n",
+                  m.bodyAnchors.anchored(), m.bodyAnchors.anchors.size(), m.bodyAnchors.anchored(1),
+                  1000.0 * double(m.bodyAnchors.margin));
     o << line;
   }
   o << "  sections\n";

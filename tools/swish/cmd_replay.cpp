@@ -18,12 +18,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "swish/command.hpp"
 #include "swish/core/error.hpp"
+#include "swish/files/atomic_write.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/replay/replay_job.hpp"
 #include "swish/replay/replay_plan.hpp"
@@ -40,7 +43,7 @@ struct ReplayCliOptions {
   std::string scene, out, device;
   bool plan = false, quiet = false, validation = false, render = false;
   uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16, penetrationEvery = 30;
-  bool pushOut = false, noGuard = false, hideCoveredBody = false;
+  bool pushOut = false, noPushOut = false, noGuard = false, hideCoveredBody = false, showCoveredBody = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
   std::optional<double> frameBudgetMs, tolerancePixels;
@@ -123,6 +126,8 @@ int runReplay(const ReplayCliOptions& o) {
   else if (isDefault)
     scene.outputs.directory = fs::current_path() / "replay-out";  // not into the source tree
   if (o.frames > 0) scene.frameCount = o.frames;
+  if (o.pushOut || o.noPushOut) scene.body.pushOut = o.pushOut;  // the command line over the scene
+  if (o.hideCoveredBody || o.showCoveredBody) scene.body.hideCovered = o.hideCoveredBody;
   replay::ModelLibrary models(scene);  // loaded once: plan, replay and render share it
 
   if (o.plan) {
@@ -144,7 +149,7 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.truth.simulationVertices = o.truthVertices;
   jo.engine.truth.substeps = o.truthSubsteps;
   jo.engine.penetrationEvery = o.penetrationEvery;
-  jo.engine.pushOut = o.pushOut;
+  jo.engine.pushOut = scene.body.pushOut;
   jo.engine.noveltyGuard = !o.noGuard;
   jo.engine.frameBudgetMs = o.frameBudgetMs;
   jo.engine.tolerancePixels = o.tolerancePixels;
@@ -219,9 +224,15 @@ int runReplay(const ReplayCliOptions& o) {
     ro.device = o.device;
     ro.validation = o.validation;
     ro.truth = jo.engine.truth;
-    ro.pushOut = o.pushOut;
-    ro.hideCoveredBody = o.hideCoveredBody;
+    ro.pushOut = scene.body.pushOut;
+    ro.hideCoveredBody = scene.body.hideCovered;
     const replay::ReplayRenderResult rr = replay::renderReplayFrames(scene, models, dir, ro);
+    const fs::path report = dir.parent_path() / "report.md";
+    if (std::ifstream in(report); in) {  // the pictures' section at the end of the report: what they show
+      std::ostringstream text;
+      text << in.rdbuf();
+      writeTextFileAtomic(report, text.str() + replay::renderReportSection(rr, ro, dir.parent_path()));
+    }
     if (!o.quiet) {
       std::printf("Rendered %zu frames of character %u: %s\n", rr.frames.size(), o.renderCharacter,
                   rr.contactSheet.string().c_str());
@@ -260,13 +271,19 @@ swish::cli::CommandRegistration reg{
           "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "
           "on every Nth frame; 0: not at all (default 30: the measure poses a body collider per character, costly on "
           "the CPU)");
-      app.add_flag("--push-out", o->pushOut,
-                   "keep the garment off the body on the GPU: each vertex outside its body anchor's ball "
-                   "(models that carry anchors, format 1.3: `swish body-proxy` adds them; off by default)");
-      app.add_flag(
+      auto* push = app.add_flag("--push-out", o->pushOut,
+                                "keep the garment off the body on the GPU: each vertex outside its body anchors' "
+                                "balls (models that carry anchors, format 1.3 and later: `swish body-proxy` adds "
+                                "them; default: the scene's body.pushOut, else off)");
+      app.add_flag("--no-push-out", o->noPushOut, "no push-out, whatever the scene says")->excludes(push);
+      auto* hide = app.add_flag(
           "--hide-covered-body", o->hideCoveredBody,
           "with --render: leave out the body triangles the garment covers in (nearly) every training pose (the "
-          "model's list, as games do under tight clothing); off by default so that a fault shows");
+          "model's list, as games do under tight clothing); default: the scene's body.hideCovered, else off so that "
+          "a fault shows");
+      app.add_flag("--show-covered-body", o->showCoveredBody,
+                   "with --render: draw the whole body, whatever the scene says")
+          ->excludes(hide);
       app.add_flag("--no-guard", o->noGuard,
                    "measure each character's novelty (how far its pose is from the model's training poses) but do "
                    "not apply the model's novelty guard (clamp of the mesh weights, blend towards the mean shape): "

@@ -73,13 +73,16 @@ void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
 }
 
 static_assert(SWISH_ANCHOR_WORDS == 4 + 2 * kAnchorInfluences, "shaders/swish_layouts.h: body anchor layout");
+static_assert(SWISH_MAX_ANCHOR_SLOTS == kMaxAnchorSlots, "shaders/swish_layouts.h: body anchor sets");
 
 std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32_t jointCount) {
-  std::vector<uint32_t> out(anchors.anchors.size() * SWISH_ANCHOR_WORDS);
+  const size_t n = anchors.anchors.size();
+  std::vector<uint32_t> out(anchors.slots() * n * SWISH_ANCHOR_WORDS);
   auto put = [&](size_t at, float f) { std::memcpy(&out[at], &f, 4); };
-  for (size_t v = 0; v < anchors.anchors.size(); ++v) {
-    const BodyAnchor& a = anchors.anchors[v];
-    const size_t o = v * SWISH_ANCHOR_WORDS;
+  for (size_t e = 0; e < anchors.slots() * n; ++e) {
+    const size_t v = e % n;
+    const BodyAnchor& a = anchors.slot(uint32_t(e / n))[v];
+    const size_t o = e * SWISH_ANCHOR_WORDS;
     const Vec3f centre = a.present() ? a.centre() : Vec3f::Zero();
     for (int k = 0; k < 3; ++k) put(o + size_t(k), centre[k]);
     put(o + 3, a.present() ? a.reach() : 0.f);
@@ -136,7 +139,9 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.skinWeights = layout::Address::of(a.skinWeights);
   p.positionsOut = layout::Address::of(a.positionsOut);
   p.anchors = layout::Address::of(a.anchors);
-  p.pushOut = a.anchors ? 1u : 0u;
+  if (a.anchors && (a.anchorSlots < 1 || a.anchorSlots > kMaxAnchorSlots))
+    throw Error("deform pass: " + std::to_string(a.anchorSlots) + " body anchor sets (1 or 2)");
+  p.pushOut = a.anchors ? a.anchorSlots : 0u;
   p.vertexCount = a.vertexCount;
   p.instanceCount = a.instanceCount;
   p.jointCount = a.jointCount;

@@ -38,9 +38,11 @@ class DeformPass {
     VkDeviceAddress skinJoints = 0;    // uint[N][influences]
     VkDeviceAddress skinWeights = 0;   // float[N][influences]
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
-    // The push-out: word[N][SWISH_ANCHOR_WORDS], packAnchors' layout (the model's, GpuModel::anchors);
-    // 0: no push-out. Only with skinning applied (the anchors are skinned like the vertices).
+    // The push-out: word[anchorSlots][N][SWISH_ANCHOR_WORDS], packAnchors' layout (the model's,
+    // GpuModel::anchors); 0: no push-out. Only with skinning applied (the anchors are skinned like the
+    // vertices). anchorSlots: the anchor sets in it (1 or 2: BodyAnchors::slots()).
     VkDeviceAddress anchors = 0;
+    uint32_t anchorSlots = 1;
     VkDescriptorSet instanceInputs = VK_NULL_HANDLE;  // from bindInstanceInputs
     uint32_t vertexCount = 0;
     uint32_t instanceCount = 0;
@@ -92,7 +94,8 @@ class DeformPass {
   }
   // Writes `count` matrices (instance-major, as FrameKernelInputs holds them) in that layout.
   static void packSkinMatrices(const Mat4f* matrices, size_t count, float* out);
-  // The body anchors (one per vertex) in the push-out's layout: word[N][SWISH_ANCHOR_WORDS], float ball
+  // The body anchors (each set's one per vertex, set after set) in the push-out's layout:
+  // word[BodyAnchors::slots()][N][SWISH_ANCHOR_WORDS], float ball
   // centre xyz (BodyAnchor::centre()), reach (BodyAnchor::reach()), weights[4], then uint joints[4]. Throws Error
   // naming the vertex for a joint
   // >= jointCount (the kernel fetches every influence's matrix, even at weight 0).

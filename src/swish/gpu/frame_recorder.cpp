@@ -129,6 +129,7 @@ uint32_t FrameRecorder::record(VkCommandBuffer cmd, uint64_t frameIndex, const r
   DeformPass::Args d = m.deformArgs(f.deformInputs.get(), f.positions, in.instanceCount);
   if (pushOut) {
     d.anchors = m.anchors.address();
+    d.anchorSlots = m.anchorSlots();
   }
   if (levels) {
     d.instanceOrder = f.instanceOrder.address();

@@ -132,14 +132,17 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   }
 
   if (!m.bodyAnchors.empty()) {
-    if (m.bodyAnchors.anchors.size() != n)
-      fail(std::to_string(m.bodyAnchors.anchors.size()) + " body anchors for " + std::to_string(n) + " vertices");
-    for (size_t v = 0; v < n; ++v)
-      for (const uint16_t j : m.bodyAnchors.anchors[v].joints)
-        if (j >= jointCount_)  // the kernel fetches every influence's matrix, even at weight 0
-          fail("body anchor joint " + std::to_string(j) + " of vertex " + std::to_string(v) +
-               " is not in the skeleton of " + std::to_string(jointCount_) + " joints");
-    hasAnchors_ = true;
+    for (uint32_t s = 0; s < m.bodyAnchors.slots(); ++s) {
+      const std::vector<BodyAnchor>& set = m.bodyAnchors.slot(s);
+      const std::string what = s ? "second body anchor" : "body anchor";
+      if (set.size() != n) fail(std::to_string(set.size()) + " " + what + "s for " + std::to_string(n) + " vertices");
+      for (size_t v = 0; v < n; ++v)
+        for (const uint16_t j : set[v].joints)
+          if (j >= jointCount_)  // the kernel fetches every influence's matrix, even at weight 0
+            fail(what + " joint " + std::to_string(j) + " of vertex " + std::to_string(v) +
+                 " is not in the skeleton of " + std::to_string(jointCount_) + " joints");
+    }
+    anchorSlots_ = m.bodyAnchors.slots();
   }
 
   const ModelUploads uploads(m, true);

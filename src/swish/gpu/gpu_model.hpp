@@ -36,7 +36,8 @@ class GpuModel {
   uint32_t mapHeight() const { return mapHeight_; }
   uint32_t codebookSize() const { return codebookSize_; }
   // The push-out's body anchors (`anchors`, DeformPass::packAnchors' layout).
-  bool hasBodyAnchors() const { return hasAnchors_; }
+  bool hasBodyAnchors() const { return anchorSlots_ > 0; }
+  uint32_t anchorSlots() const { return anchorSlots_; }  // BodyAnchors::slots()
 
   // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
   // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
@@ -46,11 +47,11 @@ class GpuModel {
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;
   Buffer frameTriangles;  // TangentFramesPass::frameTriangles: the two-pass gather's one walk of both adjacencies
   Buffer codebook, indices;
-  Buffer anchors;  // word[N][SWISH_ANCHOR_WORDS]; empty without body anchors
+  Buffer anchors;  // word[anchorSlots()][N][SWISH_ANCHOR_WORDS]; empty without body anchors
 
  private:
   std::string name_;
-  bool hasAnchors_ = false;
+  uint32_t anchorSlots_ = 0;
   uint32_t vertexCount_ = 0, triangleCount_ = 0, jointCount_ = 0, meshComponents_ = 0, kernelComponents_ = 1;
   uint32_t influences_ = 1;
   bool hasUvs_ = false;

@@ -85,16 +85,21 @@ void Model::validate(const std::string& what) const {
   } else if (db.codeDims() != 0) {
     fail("normal maps", "keys have dimensions but no maps");
   }
+  if (bodyAnchors.empty() && !bodyAnchors.second.empty()) fail("body anchors", "second anchors without first ones");
   if (!bodyAnchors.empty()) {
     const BodyAnchors& ba = bodyAnchors;
     if (ba.anchors.size() != n)
       fail("body anchors",
            n2s(ba.anchors.size()) + " anchors for " + n2s(n) + " game-mesh vertices (one each, or none)");
+    if (!ba.second.empty() && ba.second.size() != n)
+      fail("body anchors",
+           n2s(ba.second.size()) + " second anchors for " + n2s(n) + " game-mesh vertices (one each, or none)");
     if (!(ba.margin >= 0.f && ba.margin <= kMaxAnchorMargin))
       fail("body anchors", "margin " + std::to_string(ba.margin) + " m is not in [0, 0.05] metres");
-    for (size_t v = 0; v < n; ++v) {
-      const BodyAnchor& a = ba.anchors[v];
-      const std::string which = "anchor of vertex " + n2s(v);
+    for (size_t e = 0; e < ba.slots() * n; ++e) {
+      const size_t v = e % n;
+      const BodyAnchor& a = ba.slot(uint32_t(e / n))[v];
+      const std::string which = std::string(e < n ? "anchor" : "second anchor") + " of vertex " + n2s(v);
       if (!a.present()) {
         if (a.position != Vec3f::Zero() || a.normal != Vec3f::Zero() || a.radius != 0.f || a.clearance != 0.f)
           fail("body anchors", which + " has no weights (no anchor) but a position, normal, radius or clearance");
@@ -149,9 +154,10 @@ void Model::validate(const std::string& what) const {
     fail("temporal filter", "time constant must be finite and >= 0");
 }
 
-size_t BodyAnchors::anchored() const {
+size_t BodyAnchors::anchored(uint32_t s) const {
   size_t k = 0;
-  for (const BodyAnchor& a : anchors) k += a.present() ? 1 : 0;
+  if (s >= slots()) return 0;
+  for (const BodyAnchor& a : slot(s)) k += a.present() ? 1 : 0;
   return k;
 }
 

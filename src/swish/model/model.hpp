@@ -106,10 +106,20 @@ struct BodyAnchors {
   // The clearance an anchor starts with (metres): the cloth's own half thickness, so that a pushed
   // vertex does not sit exactly on the body surface and z-fight with it; no anchor's is above it.
   float margin = 0.002f;
-  std::vector<BodyAnchor> anchors;  // empty (no push-out) or one per game-mesh vertex
+  std::vector<BodyAnchor> anchors;  // empty (no push-out) or one per game-mesh vertex: its nearest body part
+  // Format 1.4: empty, or one per game-mesh vertex (only with `anchors`): the nearest point of ANOTHER
+  // body part within the fit's reach, applied after `anchors`. Where two parts meet (a shoulder, whose
+  // jersey lies on the trunk while the upper arm's end turns up through it when the arm hangs), the
+  // vertex's own part cannot see the other one; its second anchor does.
+  std::vector<BodyAnchor> second;
   bool empty() const { return anchors.empty(); }
-  size_t anchored() const;  // vertices with an anchor
+  // Anchor sets the push-out applies, in order: 0 (none), 1 (`anchors`) or 2 (then `second`).
+  uint32_t slots() const { return anchors.empty() ? 0u : second.empty() ? 1u : 2u; }
+  const std::vector<BodyAnchor>& slot(uint32_t s) const { return s == 0 ? anchors : second; }
+  std::vector<BodyAnchor>& slot(uint32_t s) { return s == 0 ? anchors : second; }
+  size_t anchored(uint32_t slot = 0) const;  // vertices with an anchor in that set
 };
+inline constexpr uint32_t kMaxAnchorSlots = 2;
 
 // Largest margin a model may ask for (metres): beyond a few centimetres the push-out would hold
 // the garment visibly off the body, which is not what it is for.

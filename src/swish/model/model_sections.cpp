@@ -270,30 +270,52 @@ void readLegacyBodyProxy(ByteReader& r, Model&) {
 }
 
 // ---- BANC (format 1.3) ------------------------------------------------------------------------
+// ---- BAN2 (format 1.4): the second anchors, in BANC's layout after the count (no margin) -------
+constexpr uint64_t kAnchorBytes = 12 + 12 + 4 + 4 + 2 * kAnchorInfluences + 4 * kAnchorInfluences;
+
+void writeAnchorList(const std::vector<BodyAnchor>& list, ByteWriter& w) {
+  for (const BodyAnchor& a : list) w.f32s({a.position.data(), 3});
+  for (const BodyAnchor& a : list) w.f32s({a.normal.data(), 3});
+  for (const BodyAnchor& a : list) w.f32(a.radius);
+  for (const BodyAnchor& a : list) w.f32(a.clearance);
+  for (const BodyAnchor& a : list) w.u16s(a.joints);
+  for (const BodyAnchor& a : list) w.f32s(a.weights);
+}
+
+void readAnchorList(ByteReader& r, std::vector<BodyAnchor>& list, uint32_t count, bool second) {
+  // (the reader's names are C strings: one set for each list)
+  auto name = [second](const char* first, const char* other) { return second ? other : first; };
+  list.resize(r.checkCount(count, kAnchorBytes, name("body anchor", "second body anchor")));
+  for (BodyAnchor& a : list) r.f32s(a.position.data(), 3, name("body anchor position", "second body anchor position"));
+  for (BodyAnchor& a : list) r.f32s(a.normal.data(), 3, name("body anchor normal", "second body anchor normal"));
+  for (BodyAnchor& a : list) a.radius = r.f32(name("body anchor radius", "second body anchor radius"));
+  for (BodyAnchor& a : list) a.clearance = r.f32(name("body anchor clearance", "second body anchor clearance"));
+  for (BodyAnchor& a : list)
+    r.u16s(a.joints.data(), a.joints.size(), name("body anchor joint", "second body anchor joint"));
+  for (BodyAnchor& a : list)
+    r.f32s(a.weights.data(), a.weights.size(), name("body anchor weight", "second body anchor weight"));
+}
+
 void writeBodyAnchors(const Model& m, ByteWriter& w) {
   const BodyAnchors& b = m.bodyAnchors;
   w.u32(count32(b.anchors.size(), "body anchor"));
   w.f32(b.margin);
-  for (const BodyAnchor& a : b.anchors) w.f32s({a.position.data(), 3});
-  for (const BodyAnchor& a : b.anchors) w.f32s({a.normal.data(), 3});
-  for (const BodyAnchor& a : b.anchors) w.f32(a.radius);
-  for (const BodyAnchor& a : b.anchors) w.f32(a.clearance);
-  for (const BodyAnchor& a : b.anchors) w.u16s(a.joints);
-  for (const BodyAnchor& a : b.anchors) w.f32s(a.weights);
+  writeAnchorList(b.anchors, w);
 }
 
 void readBodyAnchors(ByteReader& r, Model& m) {
-  BodyAnchors& b = m.bodyAnchors;
-  constexpr uint64_t kAnchorBytes = 12 + 12 + 4 + 4 + 2 * kAnchorInfluences + 4 * kAnchorInfluences;
   const uint32_t count = r.u32("body anchor count");
-  b.margin = r.f32("body anchor margin");
-  b.anchors.resize(r.checkCount(count, kAnchorBytes, "body anchor"));
-  for (BodyAnchor& a : b.anchors) r.f32s(a.position.data(), 3, "body anchor position");
-  for (BodyAnchor& a : b.anchors) r.f32s(a.normal.data(), 3, "body anchor normal");
-  for (BodyAnchor& a : b.anchors) a.radius = r.f32("body anchor radius");
-  for (BodyAnchor& a : b.anchors) a.clearance = r.f32("body anchor clearance");
-  for (BodyAnchor& a : b.anchors) r.u16s(a.joints.data(), a.joints.size(), "body anchor joint");
-  for (BodyAnchor& a : b.anchors) r.f32s(a.weights.data(), a.weights.size(), "body anchor weight");
+  m.bodyAnchors.margin = r.f32("body anchor margin");
+  readAnchorList(r, m.bodyAnchors.anchors, count, false);
+}
+
+void writeSecondAnchors(const Model& m, ByteWriter& w) {
+  w.u32(count32(m.bodyAnchors.second.size(), "second body anchor"));
+  writeAnchorList(m.bodyAnchors.second, w);
+}
+
+void readSecondAnchors(ByteReader& r, Model& m) {
+  readAnchorList(r, m.bodyAnchors.second, r.u32("second body anchor count"), true);
 }
 
 // ---- NOVG (format 1.2) ------------------------------------------------------------------------
@@ -372,6 +394,7 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {"NOVG", writeNoveltyGuard, readNoveltyGuard, 2},
       {"BCOV", writeBodyCoverage, readBodyCoverage, 2},
       {"BANC", writeBodyAnchors, readBodyAnchors, 3},
+      {"BAN2", writeSecondAnchors, readSecondAnchors, 4},
       {"META", writeMetadata, readMetadata},
   };
   return codecs;

@@ -179,6 +179,23 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
 
 }  // namespace
 
+std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderOptions& o, const fs::path& reportDir) {
+  auto rel = [&](const fs::path& p) { return p.lexically_relative(reportDir).generic_string(); };
+  std::string s = "\n## Pictures\n\nCharacter " + std::to_string(o.character) + ", " + std::to_string(r.frames.size()) +
+                  " frames drawn in place by the preview renderer: the run time's push-out was " +
+                  (o.pushOut ? "ON" : "OFF") + "; the body was " +
+                  (o.hideCoveredBody ? "drawn without the triangles the garment covers in (nearly) every training pose "
+                                       "(as games leave out the skin under tight clothing)"
+                                     : "drawn whole (a body showing through the garment is visible)") +
+                  ".";
+  if (!r.note.empty()) s += " " + r.note + ".";
+  s += "\n\n![contact sheet](" + rel(r.contactSheet) + ")\n";
+  if (!r.heatSheet.empty())
+    s += "\nModel | truth | per-vertex error (mm, one scale for all frames):\n\n![error heat maps](" +
+         rel(r.heatSheet) + ")\n";
+  return s;
+}
+
 ReplayRenderResult renderReplayFrames(const runtime::Scene& scene, ModelLibrary& models, const fs::path& dir,
                                       const ReplayRenderOptions& o) {
   std::error_code ec;

@@ -45,4 +45,9 @@ struct ReplayRenderResult {
 ReplayRenderResult renderReplayFrames(const runtime::Scene& scene, ModelLibrary& models,
                                       const std::filesystem::path& directory, const ReplayRenderOptions& options);
 
+// The report's section on the pictures (Markdown, links relative to `reportDirectory`): which character,
+// what the body shows (whole, or the covered triangles left out), whether the push-out ran, the sheets.
+std::string renderReportSection(const ReplayRenderResult& result, const ReplayRenderOptions& options,
+                                const std::filesystem::path& reportDirectory);
+
 }  // namespace swish::replay

@@ -33,17 +33,22 @@ Vec3f pushedOutOfBall(const Vec3f& x, const Vec3f& c, float reach) {
 
 size_t referencePushOut(Points3f& positions, const BodyAnchors& anchors, std::span<const Mat4f> mats) {
   if (anchors.empty()) return 0;
-  if (anchors.anchors.size() != size_t(positions.rows()))
-    throw Error("push-out: " + std::to_string(anchors.anchors.size()) + " body anchors for " +
-                std::to_string(positions.rows()) + " vertices");
+  const size_t n = size_t(positions.rows());
+  for (uint32_t s = 0; s < anchors.slots(); ++s)
+    if (anchors.slot(s).size() != n)
+      throw Error("push-out: " + std::to_string(anchors.slot(s).size()) + (s ? " second" : "") + " body anchors for " +
+                  std::to_string(n) + " vertices");
   size_t moved = 0;
-  for (Eigen::Index v = 0; v < positions.rows(); ++v) {
-    const BodyAnchor& an = anchors.anchors[size_t(v)];
-    if (!an.present()) continue;  // (its reach is 0: the kernel computes and keeps it in place)
-    const Vec3f x = positions.row(v).transpose();
-    const Vec3f y = pushedOutOfBall(x, skinAnchorCentre(an, mats), an.reach());
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3f x = positions.row(Eigen::Index(v)).transpose();
+    Vec3f y = x;
+    for (uint32_t s = 0; s < anchors.slots(); ++s) {
+      const BodyAnchor& an = anchors.slot(s)[v];
+      if (an.present())  // (without one its reach is 0: the kernel computes and keeps the vertex in place)
+        y = pushedOutOfBall(y, skinAnchorCentre(an, mats), an.reach());
+    }
     if (y == x) continue;
-    positions.row(v) = y.transpose();
+    positions.row(Eigen::Index(v)) = y.transpose();
     ++moved;
   }
   return moved;

@@ -15,6 +15,8 @@
 // vertex in, and it is continuous in x (the move is 0 on the sphere), so a device whose rounding
 // differs near the sphere differs by rounding only. A vertex without an anchor has r = 0 and stays, as
 // does one whose anchor matrices are not finite (s is NaN) or that sits on the centre (no direction).
+// A model with second anchors (BodyAnchors::second, format 1.4) then does the same for the vertex's
+// second anchor, starting from where the first left it: two pushes in that order, each as above.
 //
 // Why per-vertex anchors and not a proxy of the whole body (capsules, formats 1.1 and 1.2): a vertex
 // pushed out of the nearest of several overlapping shapes can land inside another, or inside the real
@@ -39,9 +41,9 @@ Vec3f skinAnchorCentre(const BodyAnchor& anchor, std::span<const Mat4f> skinMatr
 Vec3f pushedOutOfBall(const Vec3f& x, const Vec3f& c, float reach);
 
 // Pushes `positions` (one instance, skinned, character space; one row per game-mesh vertex) out of
-// their anchors' balls, in place. `skinMatrices`: that instance's, one per joint. Returns how many
-// vertices moved. Throws Error when the anchors do not match the positions or name a joint without a
-// matrix; empty anchors do nothing.
+// their anchors' balls (each anchor set in order), in place. `skinMatrices`: that instance's, one per joint. Returns
+// how many vertices moved. Throws Error when the anchors do not match the positions or name a joint without a matrix;
+// empty anchors do nothing.
 size_t referencePushOut(Points3f& positions, const BodyAnchors& anchors, std::span<const Mat4f> skinMatrices);
 
 }  // namespace swish::runtime

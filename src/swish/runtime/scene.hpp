@@ -77,6 +77,13 @@ struct SceneOutputs {
   uint32_t gpuCheckEvery = 1;  // compare GPU outputs with the CPU reference on every Nth frame (>= 1)
 };
 
+// What the scene does with the body under the garment (both off unless the scene asks: a body showing
+// through is a fault to see; a game scene, like the default football play, turns both on, as games do).
+struct SceneBody {
+  bool pushOut = false;      // keep the garment off the body: the push-out to each model's body anchors
+  bool hideCovered = false;  // the preview render leaves out the body triangles the garment covers
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path source;  // the scene file, for messages ("<built-in>" for code-made scenes)
@@ -89,6 +96,7 @@ struct Scene {
   double imageHeightPixels = 1080.0;                 // of the image the characters are drawn into
   SceneLevels levels;
   std::optional<double> cullDistance;  // metres from the camera; beyond it a character is off screen
+  SceneBody body;
   SceneOutputs outputs;
   std::vector<SceneCharacter> characters;
 

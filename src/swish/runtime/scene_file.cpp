@@ -95,7 +95,7 @@ SceneCharacter parseCharacter(const JsonReader& r, const std::filesystem::path& 
 
 Scene parseScene(const json& j, const std::filesystem::path& source, bool checkFiles) {
   const JsonReader root(j, source.string(), "");
-  root.requireObject({"name", "frames", "camera", "cullDistance", "levels", "outputs", "characters"});
+  root.requireObject({"name", "frames", "camera", "cullDistance", "levels", "body", "outputs", "characters"});
   const std::filesystem::path base = source.has_parent_path() ? source.parent_path() : std::filesystem::path(".");
   Scene s;
   s.source = source;
@@ -129,6 +129,13 @@ Scene parseScene(const json& j, const std::filesystem::path& source, bool checkF
     const double d = root.child("cullDistance").number();
     if (!(d > 0.0)) root.child("cullDistance").fail("must be a positive number of metres");
     s.cullDistance = d;
+  }
+
+  if (root.has("body")) {
+    const JsonReader b = root.child("body");
+    b.requireObject({"pushOut", "hideCovered"});
+    if (b.has("pushOut")) s.body.pushOut = b.child("pushOut").boolean();
+    if (b.has("hideCovered")) s.body.hideCovered = b.child("hideCovered").boolean();
   }
 
   if (root.has("outputs")) {
@@ -178,6 +185,7 @@ json sceneToJson(const Scene& s) {
   if (s.levels.frameBudgetMs) j["levels"]["frameBudgetMs"] = *s.levels.frameBudgetMs;
   if (s.levels.tolerancePixels) j["levels"]["tolerancePixels"] = *s.levels.tolerancePixels;
   if (s.cullDistance) j["cullDistance"] = *s.cullDistance;
+  j["body"] = {{"pushOut", s.body.pushOut}, {"hideCovered", s.body.hideCovered}};
   j["outputs"] = {{"directory", s.outputs.directory.string()},
                   {"report", s.outputs.report},
                   {"render", s.outputs.render},

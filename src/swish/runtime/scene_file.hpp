@@ -14,6 +14,13 @@
 //   "camera": { "position": [0, 1.8, -40] },  optional; used by cullDistance
 //   "cullDistance": 80,                       number > 0, optional: characters placed further than this
 //                                             from the camera are off screen (no mesh/normal work)
+//   "body": {                                 optional (defaults shown): the body under the garment
+//     "pushOut": false,                       run the push-out to the models' body anchors (as
+//                                             api::BatchOptions::pushOut; replay --push-out / --no-push-out)
+//     "hideCovered": false                    the preview render leaves out the body triangles the
+//                                             garment covers (as games do; replay --hide-covered-body /
+//                                             --show-covered-body)
+//   },
 //   "outputs": {                              optional (defaults shown)
 //     "directory": "replay-out",              string: relative to the scene file's folder
 //     "report": true,                         JSON + Markdown report with SVG plots

@@ -281,6 +281,12 @@ std::vector<uint8_t> assemble(const std::vector<RawSection>& sections, uint16_t 
   return w.take();
 }
 
+// The sections but those tagged `tags` (a file as an older format version wrote it).
+std::vector<RawSection> withoutSections(std::vector<RawSection> sections, std::initializer_list<const char*> tags) {
+  for (const char* tag : tags) std::erase_if(sections, [&](const RawSection& s) { return s.tag == tag; });
+  return sections;
+}
+
 RawSection& sectionOf(std::vector<RawSection>& sections, const std::string& tag) {
   for (auto& s : sections)
     if (s.tag == tag) return s;
@@ -378,14 +384,14 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   auto u16 = [&](size_t at) { return uint32_t(bytes[at] | bytes[at + 1] << 8); };
   auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
   EXPECT_EQ(u16(8), 1u);
-  EXPECT_EQ(u16(10), 3u);
-  EXPECT_EQ(u32(12), 15u);
+  EXPECT_EQ(u16(10), 4u);
+  EXPECT_EQ(u32(12), 16u);
   EXPECT_EQ(uint64_t(u32(16)) | uint64_t(u32(20)) << 32, bytes.size());
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
   const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN",
-                                "NMDB", "TFLT", "BPRX", "NOVG", "BCOV", "BANC", "META"};
+                                "NMDB", "TFLT", "BPRX", "NOVG", "BCOV", "BANC", "BAN2", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());
@@ -408,6 +414,10 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
     }
     if (std::string(tag) == "BANC") {
       EXPECT_EQ(size, 8u) << "no anchors: the count and the margin";
+      EXPECT_EQ(u32(at + 16), 0u);
+    }
+    if (std::string(tag) == "BAN2") {
+      EXPECT_EQ(size, 4u) << "no second anchors: the count";
       EXPECT_EQ(u32(at + 16), 0u);
     }
     if (std::string(tag) == "META") {
@@ -503,7 +513,7 @@ TEST(ModelFile, WrongMagicAndVersionsAreClearErrors) {
   const auto info = swish::readModelFileInfo(assemble(extended, 1, 7), "newer.swish");
   EXPECT_FALSE(info.sections[3].known);
   // The same unknown section in a file claiming the current version is corruption.
-  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.3 file");
+  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.4 file");
 }
 
 // Format 1.1 added the capsule proxy (BPRX), legacy since 1.3: a 1.0 file (no BPRX) still loads; a 1.1
@@ -516,9 +526,8 @@ TEST(ModelFile, LegacyCapsuleSectionOfVersion11) {
   spec.vertices = 9;
   const Model m = swish::test::makeRandomModel(rng, spec);
   auto sections = splitSections(swish::serializeModel(m));
-  // A 1.2 file as 1.2 wrote it: no BANC, two capsules in BPRX.
-  auto v12 = sections;
-  v12.erase(std::find_if(v12.begin(), v12.end(), [](const RawSection& s) { return s.tag == "BANC"; }));
+  // A 1.2 file as 1.2 wrote it: no BANC (nor BAN2), two capsules in BPRX.
+  auto v12 = withoutSections(sections, {"BANC", "BAN2"});
   swish::ByteWriter capsules;
   capsules.u32(2);
   for (int c = 0; c < 2; ++c) {
@@ -559,8 +568,7 @@ TEST(ModelFile, BodyAnchorSectionOfVersion13) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
   EXPECT_EQ(sectionOf(sections, "BANC").payload.size(), 8u + 9u * (12 + 12 + 4 + 4 + 8 + 16));
 
-  auto without = sections;
-  without.erase(std::find_if(without.begin(), without.end(), [](const RawSection& s) { return s.tag == "BANC"; }));
+  const auto without = withoutSections(sections, {"BANC", "BAN2"});
   Model old = m;
   old.bodyAnchors = {};
   expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 2), "old.swish"), old);
@@ -612,6 +620,62 @@ TEST(ModelFile, BodyAnchorSectionOfVersion13) {
   }
 }
 
+// Format 1.4 added the second body anchors (BAN2): round trip; a 1.3 file (no BAN2) loads without
+// them; a 1.4 file without the section, or a 1.3 file with it, is refused; second anchors that do not
+// fit the model, or that come without first ones, are refused naming them.
+TEST(ModelFile, SecondAnchorSectionOfVersion14) {
+  swish::Rng rng(14);
+  RandomModelSpec spec;
+  spec.vertices = 9;
+  spec.bodyAnchors = true;
+  spec.secondAnchors = true;
+  const Model m = swish::test::makeRandomModel(rng, spec);
+  ASSERT_EQ(m.bodyAnchors.second.size(), 9u);
+  ASSERT_EQ(m.bodyAnchors.slots(), 2u);
+  ASSERT_FALSE(m.bodyAnchors.second[1].present());  // (every 5th from 1 has none)
+  ASSERT_TRUE(m.bodyAnchors.second[3].present());   // (where the first set has none)
+  auto sections = splitSections(swish::serializeModel(m));
+  expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
+  EXPECT_EQ(sectionOf(sections, "BAN2").payload.size(), 4u + 9u * (12 + 12 + 4 + 4 + 8 + 16));
+
+  const auto v13 = withoutSections(sections, {"BAN2"});
+  Model old = m;
+  old.bodyAnchors.second.clear();
+  expectBitwiseEqual(swish::deserializeModel(assemble(v13, 1, 3), "v13.swish"), old);
+  EXPECT_EQ(old.bodyAnchors.slots(), 1u);
+  EXPECT_CONTAINS(loadError(assemble(v13)), "section 'BAN2' is missing");
+  EXPECT_CONTAINS(loadError(assemble(sections, 1, 3)), "a section of format 1.4 in a version 1.3 file");
+
+  // A model without second anchors writes an empty BAN2.
+  auto oneSet = splitSections(swish::serializeModel(old));
+  EXPECT_EQ(sectionOf(oneSet, "BAN2").payload.size(), 4u);
+
+  const size_t normals = 4 + 12 * 9;
+  auto edited = sections;
+  std::memcpy(&sectionOf(edited, "BAN2").payload[normals + 12 * 2], "\0\0\0\x40", 4);  // x = 2
+  EXPECT_CONTAINS(loadError(assemble(edited), "two.swish"),
+                  "two.swish: body anchors: second anchor of vertex 2 has a normal that is not of unit length");
+  edited = sections;
+  putU32(sectionOf(edited, "BAN2").payload, 0, 0x10000000u);
+  EXPECT_CONTAINS(loadError(assemble(edited)), "second body anchor count 268435456 needs");
+  Model bad = m;
+  bad.bodyAnchors.second.pop_back();
+  try {
+    bad.validate("m");
+    ADD_FAILURE() << "second anchors for another vertex count were accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "m: body anchors: 8 second anchors for 9 game-mesh vertices");
+  }
+  bad = m;
+  bad.bodyAnchors.anchors.clear();
+  try {
+    bad.validate("m");
+    ADD_FAILURE() << "second anchors without first ones were accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "m: body anchors: second anchors without first ones");
+  }
+}
+
 // Format 1.2 added the novelty guard: older files load without one; a 1.2 file without it, or a 1.1
 // file with it, is refused; a guard that does not fit the model is refused naming the part.
 TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
@@ -625,7 +689,7 @@ TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
 
   auto without = sections;
-  for (const char* tag : {"NOVG", "BCOV", "BANC"})
+  for (const char* tag : {"NOVG", "BCOV", "BANC", "BAN2"})
     without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
   Model old = m;
   old.noveltyGuard = {};

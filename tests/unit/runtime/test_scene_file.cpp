@@ -63,10 +63,25 @@ TEST_F(SceneFileTest, ValidSceneParsesWithDefaultsAndResolvedPaths) {
   EXPECT_EQ(s.outputs.directory, dir_ / "out");
   EXPECT_TRUE(s.outputs.render);
   EXPECT_FALSE(s.outputs.normalMaps);
+  EXPECT_FALSE(s.body.pushOut) << "the body is drawn as it is unless the scene asks";
+  EXPECT_FALSE(s.body.hideCovered);
   // Round trip through sceneToJson keeps what matters.
   const auto again = parseScene(swish::runtime::sceneToJson(s), source());
   EXPECT_EQ(again.characters[1].placement.yawDegrees, 90.0);
   EXPECT_EQ(again.characters[0].model, s.characters[0].model);
+
+  // The body under the garment: push-out and hidden covered triangles when the scene asks.
+  json j = valid();
+  j["body"] = {{"pushOut", true}, {"hideCovered", true}};
+  const auto b = parseScene(j, source());
+  EXPECT_TRUE(b.body.pushOut);
+  EXPECT_TRUE(b.body.hideCovered);
+  const auto b2 = parseScene(swish::runtime::sceneToJson(b), source());
+  EXPECT_TRUE(b2.body.pushOut && b2.body.hideCovered);
+  j["body"]["hide"] = true;
+  EXPECT_NE(errorOf(j).find("body.hide: unknown key"), std::string::npos);
+  j["body"] = {{"pushOut", 1}};
+  EXPECT_NE(errorOf(j).find("body.pushOut: must be true or false"), std::string::npos);
 }
 
 TEST_F(SceneFileTest, UnknownKeyNamesFileAndPath) {
@@ -189,6 +204,9 @@ TEST(DefaultScene, FootballPlayParses) {
     clip01 += s.characters[i].clip->file.filename() == "01_01.bvh";
   }
   EXPECT_EQ(clip01, 11u);  // both clips are used
+  // A game scene: the garment kept off the body, the skin under it not drawn (issue 19).
+  EXPECT_TRUE(s.body.pushOut);
+  EXPECT_TRUE(s.body.hideCovered);
   // Offsets differ, so no two characters play the same frames.
   for (size_t i = 1; i < s.characters.size(); ++i)
     EXPECT_NE(s.characters[i].clip->timeOffsetSeconds, s.characters[i - 1].clip->timeOffsetSeconds);

@@ -85,19 +85,9 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
   }
 
   const int inf = body.skin.influences;
-  const size_t n = garment.vertexCount();
-  BodyAnchorFit fit;
-  fit.anchors.margin = s.margin;
-  fit.maxDistanceMm = 1000.f * s.maxDistance;
-  fit.anchors.anchors.assign(n, BodyAnchor{});
-  std::vector<float> distances, radii;
-  for (size_t v = 0; v < n; ++v) {
-    const Vec3f x = garment.positions.row(Eigen::Index(v)).transpose();
-    const BodyCollider::Hit hit = collider.closest(x, s.maxDistance);
-    if (!hit.found || hit.triangle < 0) {
-      ++fit.tooFar;
-      continue;
-    }
+  // The anchor at a closest-point answer: normal, skin and inscribed ball there (see the header).
+  auto anchorAt = [&](const BodyCollider::Hit& hit, bool& flipped) {
+    BodyAnchor a;
     const int t = hit.triangle;
     const uint32_t corner[3] = {tris(t, 0), tris(t, 1), tris(t, 2)};
     const Vec3f bc = barycentric(hit.point, pos.row(corner[0]).transpose(), pos.row(corner[1]).transpose(),
@@ -110,10 +100,8 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     }
     if (!(normal.norm() > 1e-6f)) normal = hit.normal;  // corners' normals cancel (a degenerate sliver)
     normal.normalize();
-    if (normal.dot(hit.normal) < 0.f) {
-      normal = -normal;
-      ++fit.flippedNormals;
-    }
+    flipped = normal.dot(hit.normal) < 0.f;
+    if (flipped) normal = -normal;
 
     // The body's skin at the point: (joint -> weight) summed over the corners, largest first.
     std::map<uint16_t, float> skin;
@@ -127,11 +115,7 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     if (ranked.size() > size_t(kAnchorInfluences)) ranked.resize(size_t(kAnchorInfluences));
     float sum = 0.f;
     for (const auto& r : ranked) sum += r.second;
-    if (!(sum > 0.f)) {  // a corner without weights (Mesh::validate refuses those): no anchor
-      ++fit.tooFar;
-      continue;
-    }
-    BodyAnchor& a = fit.anchors.anchors[v];
+    if (!(sum > 0.f)) return a;  // a corner without weights (Mesh::validate refuses those): no anchor
     a.position = hit.point;
     a.normal = normal;
     a.radius = inscribedRadius(collider, hit.point, normal, hit.part, s.maxRadius);
@@ -140,12 +124,42 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
       a.joints[i] = ranked[i].first;
       a.weights[i] = ranked[i].second / sum;
     }
+    return a;
+  };
+
+  const size_t n = garment.vertexCount();
+  BodyAnchorFit fit;
+  fit.anchors.margin = s.margin;
+  fit.maxDistanceMm = 1000.f * s.maxDistance;
+  fit.anchors.anchors.assign(n, BodyAnchor{});
+  if (s.secondAnchors) fit.anchors.second.assign(n, BodyAnchor{});
+  std::vector<float> distances, radii;
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3f x = garment.positions.row(Eigen::Index(v)).transpose();
+    const BodyCollider::Hit hit = collider.closest(x, s.maxDistance);
+    bool flipped = false;
+    BodyAnchor a = hit.found && hit.triangle >= 0 ? anchorAt(hit, flipped) : BodyAnchor{};
+    if (!a.present()) {
+      ++fit.tooFar;
+      continue;
+    }
+    fit.flippedNormals += flipped ? 1 : 0;
+    fit.anchors.anchors[v] = a;
     ++fit.anchored;
     if (hit.signedDistance < 0.f) ++fit.insideAtRest;
     if ((x - a.centre()).norm() - a.radius < s.margin) ++fit.withinMargin;
     distances.push_back(1000.f * (x - a.position).norm());
     radii.push_back(1000.f * a.radius);
+    if (!s.secondAnchors) continue;
+    // The nearest point of any other part within the bound (none on a one-part body).
+    const BodyCollider::Hit other = collider.closest(x, s.maxDistance, -1, hit.part);
+    if (!other.found || other.triangle < 0 || other.part == hit.part) continue;
+    const BodyAnchor b = anchorAt(other, flipped);
+    if (!b.present()) continue;
+    fit.anchors.second[v] = b;
+    ++fit.secondAnchored;
   }
+  if (fit.secondAnchored == 0) fit.anchors.second.clear();  // a model without them, not N empty ones
   fit.medianMm = percentile(distances, 0.5);
   fit.p95Mm = percentile(distances, 0.95);
   fit.maxMm = distances.empty() ? 0.f : *std::max_element(distances.begin(), distances.end());
@@ -158,6 +172,9 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
                                            const BodyAnchorCalibrationSettings& s) {
   if (!(s.step > 0.f) || !std::isfinite(s.step)) throw Error("body anchor calibration: the step must be > 0 metres");
   const size_t n = anchors.anchors.size();
+  if (!anchors.second.empty() && anchors.second.size() != n)
+    throw Error("body anchor calibration: " + std::to_string(anchors.second.size()) + " second anchors for " +
+                std::to_string(n) + " anchors");
   for (size_t p = 0; p < poses.size(); ++p) {
     const BodyAnchorCalibrationPose& cp = poses[p];
     for (const Points3f* g : {cp.truth, cp.predicted})
@@ -169,64 +186,73 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
   c.poses = poses.size();
   if (poses.empty() || n == 0) return c;
   struct Sample {
-    float d;  // the network's vertex's distance off the ball's surface (negative inside)
-    Vec3f x, c, t;
-    double error;  // |x - t|
+    float d;   // the vertex's distance off the ball's surface (negative inside)
+    Vec3f c;   // the ball's skinned centre
+    size_t k;  // index into the vertex's (x, t) pairs
   };
+  // Per calibration pose with finite values: the vertex so far, the truth, the pose.
+  std::vector<Vec3f> xs, ts;
+  std::vector<size_t> at;
   std::vector<Sample> samples;
   std::vector<float> lowered;
   double without = 0, with = 0;
   size_t pairs = 0, pushed = 0;
   for (size_t v = 0; v < n; ++v) {
-    BodyAnchor& an = anchors.anchors[v];
-    samples.clear();
-    for (const BodyAnchorCalibrationPose& cp : poses) {
-      const Vec3f x = cp.predicted->row(Eigen::Index(v)).transpose(), t = cp.truth->row(Eigen::Index(v)).transpose();
+    xs.clear(), ts.clear(), at.clear();
+    for (size_t p = 0; p < poses.size(); ++p) {
+      const Vec3f x = poses[p].predicted->row(Eigen::Index(v)).transpose();
+      const Vec3f t = poses[p].truth->row(Eigen::Index(v)).transpose();
       if (!x.allFinite() || !t.allFinite()) continue;
-      const double e = double((x - t).norm());
-      without += e, ++pairs;
-      const Vec3f c = an.present() ? runtime::skinAnchorCentre(an, cp.skinMatrices) : Vec3f::Zero();
-      if (an.present() && c.allFinite())
-        samples.push_back({(x - c).norm() - an.radius, x, c, t, e});
-      else
-        with += e;
+      xs.push_back(x), ts.push_back(t), at.push_back(p);
+      without += double((x - t).norm()), ++pairs;
     }
-    if (!an.present()) continue;
-    std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.d < b.d; });
-    // The change of the summed error when every sample is pushed to clearance cl (only those with d < cl move).
-    auto change = [&](float cl) {
-      double sum = 0;
-      for (const Sample& q : samples) {
-        if (!(q.d < cl)) break;
-        sum += double((runtime::pushedOutOfBall(q.x, q.c, an.radius + cl) - q.t).norm()) - q.error;
+    const std::vector<Vec3f> start = xs;
+    // Each anchor set in the run time's order, each calibrated on where the sets before it leave the vertex.
+    for (uint32_t slot = 0; slot < anchors.slots(); ++slot) {
+      BodyAnchor& an = anchors.slot(slot)[v];
+      if (!an.present()) continue;
+      samples.clear();
+      for (size_t k = 0; k < xs.size(); ++k) {
+        const Vec3f centre = runtime::skinAnchorCentre(an, poses[at[k]].skinMatrices);
+        if (centre.allFinite()) samples.push_back({(xs[k] - centre).norm() - an.radius, centre, k});
       }
-      return sum;
-    };
-    bool found = false;
-    float chosen = 0.f;
-    for (int k = 0;; ++k) {
-      const float cl = anchors.margin - float(k) * s.step;
-      if (cl < -kMaxAnchorDepth || !(an.radius + cl > 0.f)) break;
-      if (change(cl) <= 0.0) {
-        chosen = cl, found = true;
-        break;
+      std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.d < b.d; });
+      // The change of the summed error when every sample is pushed to clearance cl (only those with d < cl move).
+      auto change = [&](float cl) {
+        double sum = 0;
+        for (const Sample& q : samples) {
+          if (!(q.d < cl)) break;
+          sum += double((runtime::pushedOutOfBall(xs[q.k], q.c, an.radius + cl) - ts[q.k]).norm()) -
+                 double((xs[q.k] - ts[q.k]).norm());
+        }
+        return sum;
+      };
+      bool found = false;
+      float chosen = 0.f;
+      for (int step = 0;; ++step) {
+        const float cl = anchors.margin - float(step) * s.step;
+        if (cl < -kMaxAnchorDepth || !(an.radius + cl > 0.f)) break;
+        if (change(cl) <= 0.0) {
+          chosen = cl, found = true;
+          break;
+        }
       }
+      if (!found) {
+        an = BodyAnchor{};
+        ++c.dropped;
+        c.secondDropped += slot ? 1 : 0;
+        continue;
+      }
+      if (chosen < an.clearance) {
+        an.clearance = chosen;
+        ++c.lowered;
+        lowered.push_back(1000.f * chosen);
+      }
+      for (const Sample& q : samples) xs[q.k] = runtime::pushedOutOfBall(xs[q.k], q.c, an.reach());
     }
-    if (!found) {
-      an = BodyAnchor{};
-      ++c.dropped;
-      for (const Sample& q : samples) with += q.error;
-      continue;
-    }
-    if (chosen < an.clearance) {
-      an.clearance = chosen;
-      ++c.lowered;
-      lowered.push_back(1000.f * chosen);
-    }
-    for (const Sample& q : samples) {
-      const Vec3f y = runtime::pushedOutOfBall(q.x, q.c, an.reach());
-      pushed += y != q.x ? 1 : 0;
-      with += double((y - q.t).norm());
+    for (size_t k = 0; k < xs.size(); ++k) {
+      pushed += xs[k] != start[k] ? 1 : 0;
+      with += double((xs[k] - ts[k]).norm());
     }
   }
   c.medianLoweredMm = percentile(lowered, 0.5);
@@ -242,6 +268,7 @@ nlohmann::json toJson(const BodyAnchorCalibration& c) {
   return {{"poses", c.poses},
           {"lowered", c.lowered},
           {"dropped", c.dropped},
+          {"second_dropped", c.secondDropped},
           {"median_lowered_mm", c.medianLoweredMm},
           {"vertex_mean_mm_without", c.meanMmWithout},
           {"vertex_mean_mm_with", c.meanMmWith},
@@ -250,6 +277,7 @@ nlohmann::json toJson(const BodyAnchorCalibration& c) {
 
 nlohmann::json toJson(const BodyAnchorFit& f) {
   return {{"anchored", f.anchored},
+          {"second_anchored", f.secondAnchored},
           {"too_far", f.tooFar},
           {"margin_mm", 1000.0 * double(f.anchors.margin)},
           {"max_distance_mm", f.maxDistanceMm},

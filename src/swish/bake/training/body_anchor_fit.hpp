@@ -32,11 +32,16 @@ struct BodyAnchorFitSettings {
   float maxDistance = 0.04f;  // metres from the rest body; farther vertices get no anchor (see above)
   float margin = 0.002f;      // BodyAnchors::margin written into the result
   float maxRadius = 0.3f;     // metres: the largest ball tried (a trunk is not thicker)
+  // Also the second anchors (BodyAnchors::second): for each anchored vertex, the closest point of
+  // another body part within maxDistance, fitted the same way (a shoulder's jersey on the trunk gets
+  // the upper arm, whose end rises through it when the arm hangs).
+  bool secondAnchors = true;
 };
 
 struct BodyAnchorFit {
   BodyAnchors anchors;
   size_t anchored = 0;        // vertices with an anchor
+  size_t secondAnchored = 0;  // vertices with a second anchor (on another part; see the settings)
   size_t tooFar = 0;          // vertices beyond maxDistance (no anchor)
   size_t insideAtRest = 0;    // anchored vertices inside the body at rest (the push-out moves them at rest)
   size_t withinMargin = 0;    // anchored vertices nearer their ball than the margin at rest (pushed at rest)
@@ -65,7 +70,9 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
 // its distances to the truth over those poses. A clearance below every calibration pose's distance
 // pushes nothing there and qualifies, so one is found unless the network put the vertex deeper than
 // its ball's radius or kMaxAnchorDepth; such an anchor is dropped. The push-out then removes what it can
-// without making any vertex worse on the calibration poses.
+// without making any vertex worse on the calibration poses. Second anchors (BodyAnchors::second) are
+// calibrated the same way after the first, on where the first anchor's push leaves each vertex, as the
+// run time applies them.
 struct BodyAnchorCalibrationSettings {
   float step = 0.001f;  // metres between the clearances tried
 };
@@ -79,7 +86,8 @@ struct BodyAnchorCalibrationPose {
 struct BodyAnchorCalibration {
   size_t poses = 0;
   size_t lowered = 0;         // anchors whose clearance went below the margin
-  size_t dropped = 0;         // anchors dropped (see above)
+  size_t dropped = 0;         // anchors dropped (see above), second anchors included
+  size_t secondDropped = 0;   // of them, second anchors
   float medianLoweredMm = 0;  // median clearance of the lowered anchors (mm, negative: inside the ball)
   // Over the calibration poses and every vertex: mean distance to the truth (mm) without and with the
   // calibrated push-out, and the share of (pose, vertex) pairs it moves.

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 
+#include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/transfer/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"
 #include "swish/runtime/reference_skinning.hpp"
@@ -19,6 +21,11 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
   if (body.triangleCount() == 0 || poses.empty()) return r;
   const size_t nt = body.triangleCount();
   std::vector<uint32_t> hits(nt, 0);
+  std::vector<uint8_t> everCovered(nt, 0);
+  // Parts of the body buried in each other (an arm tube in the trunk) hide their own triangles: the
+  // collider's closest point of the OTHER parts tells whether a triangle is inside one of them.
+  std::optional<BodyCollider> collider;
+  if (o.buriedCounts) collider.emplace(body, 0.05f, "body coverage: body");
   const size_t step = std::max<size_t>(1, (poses.size() + o.maxPoses - 1) / std::max<size_t>(1, o.maxPoses));
   for (size_t k = 0; k < poses.size(); k += step) {
     const DatasetPose& p = *poses[k];
@@ -29,7 +36,8 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
     const Points3f posed =
         runtime::referenceSkin(body.positions, body.skin, character.skeleton.skinningMatrices(p.pose));
     const TriangleRayScene garment(p.gameMeshWorld, character.garment.triangles, "body coverage: garment");
-    std::vector<uint8_t> hit(nt, 0);
+    if (collider) collider->pose(character.skeleton.skinningMatrices(p.pose));
+    std::vector<uint8_t> hit(nt, 0), buried(nt, 0);
     tbb::parallel_for(size_t(0), nt, [&](size_t t) {
       const Vec3f a = posed.row(body.triangles(Eigen::Index(t), 0)), b = posed.row(body.triangles(Eigen::Index(t), 1)),
                   c = posed.row(body.triangles(Eigen::Index(t), 2));
@@ -39,12 +47,20 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
       const Vec3f centroid = (a + b + c) / 3.f;
       const Vec3f dir = n / len;
       hit[t] = garment.intersect(centroid - o.maxInside * dir, dir, 0.f, o.maxInside + o.maxGap).found;
+      if (!hit[t] && collider) {
+        const int part = int(collider->triangleRegions()[t]);
+        const BodyCollider::Hit q = collider->closest(centroid, kBuriedSearch, -1, part);
+        buried[t] = q.found && q.signedDistance < -kBuriedDepth;
+      }
     });
-    size_t own = 0;
+    size_t own = 0, inside = 0;
     for (size_t t = 0; t < nt; ++t) {
       own += hit[t];
-      hits[t] += hit[t];
+      inside += buried[t];
+      hits[t] += hit[t] | buried[t];
+      everCovered[t] |= hit[t];
     }
+    r.buriedPerPose.push_back(uint32_t(inside));
     if (r.poses == 0) r.coveredAtRest = own;
     r.perPose.push_back(uint32_t(own));
     ++r.poses;
@@ -56,7 +72,7 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
   // Covered in at least minShare of the poses tested (rounded up; 1: every one).
   const uint32_t need = uint32_t(std::max<double>(1.0, std::ceil(o.minShare * double(r.poses) - 1e-9)));
   for (size_t t = 0; t < nt; ++t)
-    if (hits[t] >= need) r.covered.push_back(uint32_t(t));
+    if (hits[t] >= need && everCovered[t]) r.covered.push_back(uint32_t(t));
   return r;
 }
 

@@ -151,6 +151,88 @@ TEST(BodyAnchorFit, BoxBodyPointsNormalsAndWeights) {
   EXPECT_THROW(bake::fitBodyAnchors(box.body, box.skeleton, garment, {0.04f, 0.5f}), Error);
 }
 
+// Two boxes side by side, 5 cm apart (x in [-0.1, 0.1] and [0.15, 0.35]), the second skinned to the
+// first's joints shifted by 4: two parts. A vertex between them gets its nearest box as its anchor and
+// the other as its second; a vertex with the other box beyond the bound gets none; with the second
+// anchors off there are none. At run time the second anchor pushes out of the second box a vertex its
+// first anchor leaves inside it.
+TEST(BodyAnchorFit, SecondAnchorOnTheOtherPart) {
+  BoxBody two = boxBody();
+  const Mesh one = two.body;
+  Mesh& m = two.body;
+  m.positions.conservativeResize(16, 3);
+  m.positions.bottomRows(8) = one.positions;
+  m.positions.bottomRows(8).col(0).array() += 0.25f;
+  m.triangles.conservativeResize(24, 3);
+  m.triangles.bottomRows(12) = one.triangles.array() + 8;
+  for (size_t c = 0; c < 8; ++c) {
+    m.skin.joints.insert(m.skin.joints.end(), {uint16_t((c + 4) % 8), uint16_t((c + 5) % 8)});
+    m.skin.weights.insert(m.skin.weights.end(), {0.6f, 0.4f});
+  }
+  const Mesh garment = pointsMesh({
+      Vec3f(0.12f, 0.f, 0.f),   // 2 cm off the first box, 3 cm off the second
+      Vec3f(0.135f, 0.f, 0.f),  // 1.5 cm off the second, 3.5 cm off the first
+      Vec3f(-0.12f, 0.f, 0.f),  // the second box 27 cm away
+  });
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(m, two.skeleton, garment);
+  EXPECT_EQ(fit.anchored, 3u);
+  EXPECT_EQ(fit.secondAnchored, 2u);
+  ASSERT_EQ(fit.anchors.second.size(), 3u);
+  EXPECT_EQ(fit.anchors.slots(), 2u);
+  const auto& a = fit.anchors.anchors;
+  const auto& b = fit.anchors.second;
+  EXPECT_LT((a[0].position - Vec3f(0.1f, 0.f, 0.f)).norm(), 1e-6f);
+  EXPECT_GT(a[0].normal.x(), 0.98f);  // (the corner-averaged normals lean a little on so coarse a mesh)
+  EXPECT_LT((b[0].position - Vec3f(0.15f, 0.f, 0.f)).norm(), 1e-6f);
+  EXPECT_LT(b[0].normal.x(), -0.98f) << "the second box's face looks back at the first";
+  EXPECT_GT(b[0].radius, 0.05f) << "the middle of a face holds a large ball";
+  EXPECT_LE(b[0].radius, 0.101f);
+  EXPECT_EQ(b[0].clearance, fit.anchors.margin);
+  EXPECT_NEAR(weightSum(b[0]), 1.f, 1e-5f);
+  EXPECT_LT((a[1].position - Vec3f(0.15f, 0.f, 0.f)).norm(), 1e-6f);  // the nearer box first
+  EXPECT_LT((b[1].position - Vec3f(0.1f, 0.f, 0.f)).norm(), 1e-6f);
+  EXPECT_TRUE(a[2].present());
+  EXPECT_FALSE(b[2].present());
+
+  // The vertex between the boxes moved 12.5 mm into the second box: its own anchor (the first box) leaves
+  // it there; the second pushes it out to 2 mm off the second box's ball, i.e. off its face.
+  Points3f x(3, 3);
+  x << 0.1625f, 0.f, 0.f, 0.135f, 0.f, 0.f, -0.12f, 0.f, 0.f;
+  Points3f pushed = x;
+  EXPECT_EQ(runtime::referencePushOut(pushed, fit.anchors, identities(two.skeleton.size())), 1u);
+  EXPECT_NEAR(pushed(0, 0), 0.15f - fit.anchors.margin, 2e-3f);
+  EXPECT_EQ(pushed.bottomRows(2), x.bottomRows(2));
+  BodyAnchors firstOnly = fit.anchors;
+  firstOnly.second.clear();
+  pushed = x;
+  EXPECT_EQ(runtime::referencePushOut(pushed, firstOnly, identities(two.skeleton.size())), 0u);
+
+  bake::BodyAnchorFitSettings off;
+  off.secondAnchors = false;
+  const bake::BodyAnchorFit single = bake::fitBodyAnchors(m, two.skeleton, garment, off);
+  EXPECT_TRUE(single.anchors.second.empty());
+  EXPECT_EQ(single.secondAnchored, 0u);
+  EXPECT_EQ(single.anchors.slots(), 1u);
+
+  // Calibration, second anchors after the first: vertex 0's truth lies 12.5 mm inside the second box in
+  // both poses, as does the network's vertex, so pushing it out would only add error: its second
+  // anchor's clearance goes down to where it pushes nothing; vertex 1's truth is outside its second
+  // ball (the first box), so that one keeps its margin.
+  Points3f truth = x;
+  truth(1, 0) = 0.14f;
+  const std::vector<bake::BodyAnchorCalibrationPose> poses = {{identities(two.skeleton.size()), &truth, &x},
+                                                              {identities(two.skeleton.size()), &truth, &x}};
+  BodyAnchors calibrated = fit.anchors;
+  const bake::BodyAnchorCalibration c = bake::calibrateBodyAnchors(calibrated, poses);
+  EXPECT_LT(calibrated.second[0].clearance, -0.012f);
+  EXPECT_EQ(calibrated.second[1].clearance, fit.anchors.margin);
+  EXPECT_EQ(c.secondDropped, 0u);
+  EXPECT_LE(c.meanMmWith, c.meanMmWithout + 1e-9);
+  pushed = x;
+  runtime::referencePushOut(pushed, calibrated, identities(two.skeleton.size()));
+  EXPECT_EQ(pushed.row(0), x.row(0)) << "calibrated not to push against the truth";
+}
+
 // On the analytic capsule body every garment vertex (a tube 12 mm off it) is anchored on the surface
 // straight under it, with the radial normal and the body's own weights there.
 TEST(BodyAnchorFit, AnalyticCapsule) {

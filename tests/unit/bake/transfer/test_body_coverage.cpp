@@ -4,6 +4,8 @@
 // within it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "support/cloth_fixture.hpp"
 #include "swish/bake/transfer/body_coverage.hpp"
 
@@ -71,4 +73,61 @@ TEST(BodyCoverage, CoveredInEveryPoseIsWhatTheGarmentHidesInAll) {
   Character bare = ch;
   bare.body = Mesh{};
   EXPECT_TRUE(coveredBodyTriangles(bare, {&rest}).covered.empty());
+}
+
+// A part buried in another hides its own triangles (BodyCoverageOptions::buriedCounts): a 3 cm cube set
+// into the capsule up to its surface (z from 0.09 to 0.12 at y 0.3; the capsule's radius is 0.12, the
+// tube's 0.132). At rest the tube covers its outer (+z), inner (-z) and x faces (their normals meet the
+// tube; the y faces' run along it and never do); with the tube ridden up 30 cm nothing covers the cube,
+// but all faces but the outer one lie inside the capsule. Over both poses the inner and x faces are
+// listed; without buriedCounts none of the cube is.
+TEST(BodyCoverage, ABuriedPartCountsAsHidden) {
+  const test::CapsuleSpec spec;
+  Character ch = test::capsuleCharacter(spec);
+  Mesh& body = ch.body;
+  const Eigen::Index v0 = body.positions.rows(), t0 = body.triangles.rows();
+  body.positions.conservativeResize(v0 + 8, 3);
+  for (int c = 0; c < 8; ++c)
+    body.positions.row(v0 + c) << (c & 1 ? 0.015f : -0.015f), 0.3f + (c & 2 ? 0.015f : -0.015f),
+        0.105f + (c & 4 ? 0.015f : -0.015f);
+  // Faces as quads, counter-clockwise seen from outside: -z, +z, -y, +y, -x, +x.
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  body.triangles.conservativeResize(t0 + 12, 3);
+  for (int f = 0; f < 6; ++f) {
+    const uint32_t q[4] = {uint32_t(v0 + quads[f][0]), uint32_t(v0 + quads[f][1]), uint32_t(v0 + quads[f][2]),
+                           uint32_t(v0 + quads[f][3])};
+    body.triangles.row(t0 + 2 * f) << q[0], q[1], q[2];
+    body.triangles.row(t0 + 2 * f + 1) << q[0], q[2], q[3];
+  }
+  const size_t inf = size_t(body.skin.influences);
+  for (int c = 0; c < 8; ++c)
+    for (size_t i = 0; i < inf; ++i) {
+      body.skin.joints.push_back(0);
+      body.skin.weights.push_back(i == 0 ? 1.f : 0.f);
+    }
+  DatasetPose rest, away;
+  rest.id = 0;
+  rest.pose = ch.skeleton.restPose();
+  rest.gameMeshWorld = ch.garment.positions;
+  away = rest;
+  away.id = 1;
+  away.gameMeshWorld.col(1).array() += 0.3f;
+
+  BodyCoverageOptions every;
+  every.minShare = 1.0;
+  const BodyCoverageResult r = coveredBodyTriangles(ch, {&rest, &away}, every);
+  ASSERT_EQ(r.buriedPerPose.size(), 2u);
+  EXPECT_GE(r.buriedPerPose[1], 10u) << "the cube's sides and inner face, and the capsule inside the cube";
+  auto listed = [](const BodyCoverageResult& res, Eigen::Index t) {
+    return std::binary_search(res.covered.begin(), res.covered.end(), uint32_t(t));
+  };
+  for (int f = 0; f < 6; ++f)
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Index t = t0 + 2 * f + k;
+      EXPECT_EQ(listed(r, t), f == 0 || f >= 4) << "cube face " << f;  // -z, -x, +x
+    }
+  every.buriedCounts = false;
+  const BodyCoverageResult plain = coveredBodyTriangles(ch, {&rest, &away}, every);
+  for (Eigen::Index t = t0; t < t0 + 12; ++t) EXPECT_FALSE(listed(plain, t)) << t;
+  EXPECT_LT(plain.covered.size(), r.covered.size());
 }
