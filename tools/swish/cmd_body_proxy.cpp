@@ -43,9 +43,10 @@ struct BodyProxyOptions {
   std::string model, out;
   float maxDistanceMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.maxDistance;
   float marginMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.margin;
-  bool remove = false, oneAnchor = false;
+  bool remove = false, oneAnchor = false, secondAtMargin = false;
   std::vector<std::string> clips;
   size_t poses = 48;
+  float toleranceMm = 1000.f * swish::bake::BodyAnchorCalibrationSettings{}.tolerance;
 };
 
 // Every file the --clips arguments name: files as given, folders' .bvh/.fbx/.gltf/.glb files sorted.
@@ -109,7 +110,10 @@ swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& en
     cal.push_back({entry.model.skeleton.skinningMatrices(poses[i]), &shapes[i].gameMeshWorld, &predicted[i]});
   }
   if (failed) std::printf("  %zu simulations failed and are left out (as the bake leaves them out)\n", failed);
-  return bake::calibrateBodyAnchors(anchors, cal);
+  bake::BodyAnchorCalibrationSettings cs;
+  cs.tolerance = o.toleranceMm / 1000.f;
+  cs.second = !o.secondAtMargin;
+  return bake::calibrateBodyAnchors(anchors, cal, cs);
 }
 
 // The metadata with `key` set to `value` (null: removed), and the capsule proxy's old entry dropped.
@@ -200,6 +204,12 @@ swish::cli::CommandRegistration reg{
                      "on the model's skeleton; ideally motion like the model's training clips)");
       app.add_option("--poses", o->poses, "frames simulated for the calibration, spread over the clips (default 48)")
           ->check(CLI::Range(size_t(1), size_t(100000)));
+      app.add_option("--tolerance-mm", o->toleranceMm,
+                     "with --clips: mean distance to the simulation per pose that pushing a vertex may add (default "
+                     "0: none)")
+          ->check(CLI::Range(0.f, 100.f));
+      app.add_flag("--second-at-margin", o->secondAtMargin,
+                   "with --clips: calibrate the first anchors only; the second ones keep the margin");
       app.add_flag("--one-anchor", o->oneAnchor,
                    "one anchor per vertex (its nearest body part) instead of also a second one on the nearest other "
                    "part, where two parts meet (format 1.3's push-out)");

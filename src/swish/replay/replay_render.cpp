@@ -62,10 +62,10 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   if (popts.body && o.hideCoveredBody) {
     try {
       const size_t hidden = model.info().coveredBodyTriangles.empty() ? 0 : popts.body->hideCovered(model.info());
-      result.note = hidden
-                        ? "left out " + std::to_string(hidden) +
-                              " body triangles the garment covers in (nearly) every training pose (--hide-covered-body)"
-                        : "body drawn whole: the model lists no covered triangles (baked before format 1.2)";
+      result.note = hidden ? "left out " + std::to_string(hidden) +
+                                 " body triangles the garment covers in (nearly) every training pose (the scene's "
+                                 "body.hideCovered or --hide-covered-body)"
+                           : "body drawn whole: the model lists no covered triangles (baked before format 1.2)";
     } catch (const api::Error& e) {
       result.note = std::string("body drawn whole: ") + e.what();
     }

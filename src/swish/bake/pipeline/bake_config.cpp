@@ -294,7 +294,8 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "temporal_time_constant",
                                                   "seed",
                                                   "bc5_baseline",
-                                                  "input_joints"});
+                                                  "input_joints",
+                                                  "anchor_calibration"});
   BakeTrainSettings& t = cfg.train;
   t.meshComponents = int(train.wholeNumber("mesh_components", 1, 4096, t.meshComponents));
   t.meshVariance = train.number("mesh_variance", 0, 1, t.meshVariance);
@@ -333,6 +334,12 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   t.seed = uint64_t(train.wholeNumber("seed", 0, 9.007199254740992e15, double(t.seed)));
   t.inputJoints = train.strings("input_joints", t.inputJoints);
   t.bc5Baseline = train.boolean("bc5_baseline", t.bc5Baseline);
+  if (train.has("anchor_calibration")) {
+    const JsonReader c = train.child("anchor_calibration");
+    const std::string v = c.string();
+    if (v != "strict" && v != "none") c.fail("must be \"strict\" or \"none\"");
+    t.calibrateAnchors = v == "strict";
+  }
   return cfg;
 }
 

@@ -55,7 +55,9 @@
 //       "max_epochs", "patience", "validation_fraction", "normal_code_weight" (the normal code's share of the MLP loss,
 //       1: the mesh's), "mesh_weight_floor" (0..1, default 0: the mesh weights' loss follows the vertex error; a floor
 //       shares that much of it evenly over the components), "max_training_seconds", "test_fraction",
-//       "temporal_time_constant", "seed", "bc5_baseline", "input_joints" (the network's Theta joints; absent:
+//       "temporal_time_constant", "seed", "bc5_baseline", "anchor_calibration" ("strict", the default: the push-out's
+//       anchors calibrated on the training poses; "none": every anchor keeps the margin; part2_training.hpp),
+//       "input_joints" (the network's Theta joints; absent:
 //       part1.input_joints, the thinning joints;
 //                       checked against the character before part 1 simulates anything)
 //     }

@@ -42,6 +42,7 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (!inputJoints.empty()) j["input_joints"] = inputJoints;       // absent: the dataset's (older fingerprints stay)
   if (mlp.weightDecay > 0.0) j["weight_decay"] = mlp.weightDecay;  // absent when off (older fingerprints stay)
   if (mlp.inputNoise > 0.0) j["input_noise"] = mlp.inputNoise;     // likewise
+  if (!calibrateAnchors) j["anchor_calibration"] = "none";         // likewise
   return j;
 }
 
@@ -218,18 +219,22 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   if (ds.character.body.triangleCount() > 0) {
     report("body anchors", 0.92);
     BodyAnchorFit fit = fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh);
-    std::vector<Points3f> predicted(out.trainingPoses.size());
-    std::vector<BodyAnchorCalibrationPose> cal(out.trainingPoses.size());
-    for (size_t i = 0; i < out.trainingPoses.size(); ++i) {
-      const DatasetPose& p = ds.poses[out.trainingPoses[i]];
-      predicted[i] = predictPositions(out.model, p.pose, false);
-      cal[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld, &predicted[i]};
-    }
-    const BodyAnchorCalibration calibration = calibrateBodyAnchors(fit.anchors, cal);
-    out.model.bodyAnchors = fit.anchors;
     out.metadata["body_anchors"] = toJson(fit);
-    out.metadata["body_anchors"]["calibration"] = toJson(calibration);
-    out.metadata["body_anchors"]["calibration"]["poses_from"] = "the training poses";
+    if (st.calibrateAnchors) {
+      std::vector<Points3f> predicted(out.trainingPoses.size());
+      std::vector<BodyAnchorCalibrationPose> cal(out.trainingPoses.size());
+      for (size_t i = 0; i < out.trainingPoses.size(); ++i) {
+        const DatasetPose& p = ds.poses[out.trainingPoses[i]];
+        predicted[i] = predictPositions(out.model, p.pose, false);
+        cal[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld, &predicted[i]};
+      }
+      const BodyAnchorCalibration calibration = calibrateBodyAnchors(fit.anchors, cal);
+      out.metadata["body_anchors"]["calibration"] = toJson(calibration);
+      out.metadata["body_anchors"]["calibration"]["poses_from"] = "the training poses";
+    } else {
+      out.metadata["body_anchors"]["calibration"] = "none (train.anchor_calibration): every anchor keeps the margin";
+    }
+    out.model.bodyAnchors = fit.anchors;
     stage("body anchors");
   }
 

@@ -44,6 +44,13 @@ struct BakeTrainSettings {
   // default character, adding the forearms and thighs to its 7 thinning joints took the held-out
   // regression error from 4.09 to 3.40 mm (docs/baking.md).
   std::vector<std::string> inputJoints;
+  // The push-out's body anchors: calibrated on the training poses so that pushing never takes a
+  // vertex further from the simulation there (true, body_anchor_fit.hpp), or every anchor at the margin
+  // (false). Where the simulation itself leaves the garment inside the body (the limb clearance's
+  // re-skinning puts the arm tubes back through the jersey, docs/baking.md), calibration keeps the
+  // push-out from covering the body there, and the body shows through; without it the push-out covers
+  // it and moves those vertices away from that truth.
+  bool calibrateAnchors = true;
 
   nlohmann::json toJson() const;
 };

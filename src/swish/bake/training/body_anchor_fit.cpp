@@ -51,7 +51,7 @@ float inscribedRadius(const BodyCollider& collider, const Vec3f& point, const Ve
 
 float percentile(std::vector<float> v, double q) {
   if (v.empty()) return 0.f;
-  const size_t i = std::min(v.size() - 1, size_t(q * double(v.size() - 1) + 0.5));
+  const size_t i = std::min(v.size() - 1, size_t(std::lround(q * double(v.size() - 1))));
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(i), v.end());
   return v[i];
 }
@@ -171,6 +171,8 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
 BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vector<BodyAnchorCalibrationPose>& poses,
                                            const BodyAnchorCalibrationSettings& s) {
   if (!(s.step > 0.f) || !std::isfinite(s.step)) throw Error("body anchor calibration: the step must be > 0 metres");
+  if (!(s.tolerance >= 0.f) || !std::isfinite(s.tolerance))
+    throw Error("body anchor calibration: the tolerance must be >= 0 metres");
   const size_t n = anchors.anchors.size();
   if (!anchors.second.empty() && anchors.second.size() != n)
     throw Error("body anchor calibration: " + std::to_string(anchors.second.size()) + " second anchors for " +
@@ -211,6 +213,7 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
     for (uint32_t slot = 0; slot < anchors.slots(); ++slot) {
       BodyAnchor& an = anchors.slot(slot)[v];
       if (!an.present()) continue;
+      const bool calibrated = slot == 0 || s.second;
       samples.clear();
       for (size_t k = 0; k < xs.size(); ++k) {
         const Vec3f centre = runtime::skinAnchorCentre(an, poses[at[k]].skinMatrices);
@@ -227,12 +230,12 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
         }
         return sum;
       };
-      bool found = false;
-      float chosen = 0.f;
-      for (int step = 0;; ++step) {
+      bool found = !calibrated;
+      float chosen = an.clearance;
+      for (int step = 0; calibrated; ++step) {
         const float cl = anchors.margin - float(step) * s.step;
         if (cl < -kMaxAnchorDepth || !(an.radius + cl > 0.f)) break;
-        if (change(cl) <= 0.0) {
+        if (change(cl) <= double(s.tolerance) * double(samples.size())) {
           chosen = cl, found = true;
           break;
         }

@@ -75,6 +75,9 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
 // run time applies them.
 struct BodyAnchorCalibrationSettings {
   float step = 0.001f;  // metres between the clearances tried
+  // Metres of mean distance to the truth per calibration pose that pushing a vertex may add (0: none).
+  float tolerance = 0.f;
+  bool second = true;  // calibrate the second anchors too (false: they keep the margin)
 };
 
 struct BodyAnchorCalibrationPose {

@@ -49,6 +49,17 @@ TEST(BakeConfig, DefaultsAndPaths) {
                                        "recipe.json", "/base");
   EXPECT_EQ(j.train.inputJoints, (std::vector<std::string>{"Spine", "LeftForeArm"}));
   EXPECT_EQ(j.train.toJson()["input_joints"], nlohmann::json({"Spine", "LeftForeArm"}));
+  // The push-out's anchors: calibrated unless the recipe says "none" (then recorded; absent by default,
+  // so that the fingerprints of earlier bakes stay).
+  EXPECT_TRUE(w.train.calibrateAnchors);
+  EXPECT_FALSE(w.train.toJson().contains("anchor_calibration"));
+  const BakeConfig a =
+      parseBakeConfig({{"output", "out"}, {"train", {{"anchor_calibration", "none"}}}}, "recipe.json", "/base");
+  EXPECT_FALSE(a.train.calibrateAnchors);
+  EXPECT_EQ(a.train.toJson()["anchor_calibration"], "none");
+  EXPECT_TRUE(
+      parseBakeConfig({{"output", "out"}, {"train", {{"anchor_calibration", "strict"}}}}, "recipe.json", "/base")
+          .train.calibrateAnchors);
 }
 
 TEST(BakeConfig, ErrorsNameTheKey) {
@@ -70,6 +81,9 @@ TEST(BakeConfig, ErrorsNameTheKey) {
       std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"mesh_weight_floor", 1.5}}}})
                 .find("train.mesh_weight_floor: 1.5 is outside"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"anchor_calibration", "some"}}}})
+                .find("train.anchor_calibration: must be \"strict\" or \"none\""),
             std::string::npos);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"input_joints", "Spine"}}}})
                 .find("train.input_joints: must be a non-empty array"),

@@ -231,6 +231,14 @@ TEST(BodyAnchorFit, SecondAnchorOnTheOtherPart) {
   pushed = x;
   runtime::referencePushOut(pushed, calibrated, identities(two.skeleton.size()));
   EXPECT_EQ(pushed.row(0), x.row(0)) << "calibrated not to push against the truth";
+  // The first anchors only: the second keep the margin, and push.
+  BodyAnchors firstCalibrated = fit.anchors;
+  bake::BodyAnchorCalibrationSettings firstOnlySettings;
+  firstOnlySettings.second = false;
+  const bake::BodyAnchorCalibration c1 = bake::calibrateBodyAnchors(firstCalibrated, poses, firstOnlySettings);
+  EXPECT_EQ(firstCalibrated.second[0].clearance, fit.anchors.margin);
+  EXPECT_GT(c1.meanMmWith, c1.meanMmWithout) << "pushed against the truth";
+  EXPECT_GT(c1.pushedShare, 0.0);
 }
 
 // On the analytic capsule body every garment vertex (a tube 12 mm off it) is anchored on the surface
@@ -367,6 +375,17 @@ TEST(BodyAnchorFit, CalibrationKeepsTheErrorAndPushesWhereItHelps) {
   for (int v = 0; v < 4; ++v) EXPECT_LE(after[size_t(v)], before[size_t(v)] + 1e-6) << v;
   EXPECT_LT(after[0], before[0] - 0.02);
 
+  // With a tolerance, an anchor keeps a clearance whose push adds at most that much mean distance per
+  // pose: vertex 1's push to clearance c adds c + 10.5 mm in each pose, so 13 mm keeps the 2 mm margin
+  // and 5 mm stops at -6 mm (4.5 mm added; -5 would add 5.5).
+  for (const auto& [tolMm, expected] : {std::pair{13.f, fit.anchors.margin}, std::pair{5.f, -0.006f}}) {
+    BodyAnchors tolerant = fit.anchors;
+    bake::BodyAnchorCalibrationSettings ts;
+    ts.tolerance = tolMm / 1000.f;
+    bake::calibrateBodyAnchors(tolerant, poses, ts);
+    EXPECT_NEAR(tolerant.anchors[1].clearance, expected, 1e-6f) << tolMm;
+  }
+  EXPECT_THROW(bake::calibrateBodyAnchors(anchors, poses, {0.001f, -1.f}), Error);
   EXPECT_THROW(bake::calibrateBodyAnchors(anchors, {{identities(4), &truth[0], nullptr}}), Error);
   const Points3f tooShort = ch.garment.positions.topRows(3);
   EXPECT_THROW(bake::calibrateBodyAnchors(anchors, {{identities(4), &tooShort, &tooShort}}), Error);
