@@ -1,5 +1,6 @@
 #include "swish/replay/replay_render.hpp"
 
+#include <cctype>
 #include <cstdio>
 
 #include <tbb/parallel_for.h>
@@ -188,7 +189,11 @@ std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderO
                                        "(as games leave out the skin under tight clothing)"
                                      : "drawn whole (a body showing through the garment is visible)") +
                   ".";
-  if (!r.note.empty()) s += " " + r.note + ".";
+  if (!r.note.empty()) {
+    std::string note = r.note;
+    note[0] = char(std::toupper(static_cast<unsigned char>(note[0])));
+    s += " " + note + ".";
+  }
   s += "\n\n![contact sheet](" + rel(r.contactSheet) + ")\n";
   if (!r.heatSheet.empty())
     s += "\nModel | truth | per-vertex error (mm, one scale for all frames):\n\n![error heat maps](" +
