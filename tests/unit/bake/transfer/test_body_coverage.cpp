@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <utility>
 
 #include "support/cloth_fixture.hpp"
 #include "swish/bake/transfer/body_coverage.hpp"
@@ -20,18 +21,24 @@ float centroidY(const Mesh& m, uint32_t t) {
   return y / 3.f;
 }
 
+// Two poses of the character at rest: its garment as it is, and the garment moved up by `rise` metres.
+std::pair<DatasetPose, DatasetPose> restAndRaised(const Character& ch, float rise) {
+  DatasetPose rest;
+  rest.id = 0;
+  rest.pose = ch.skeleton.restPose();
+  rest.gameMeshWorld = ch.garment.positions;
+  DatasetPose raised = rest;
+  raised.id = 1;
+  raised.gameMeshWorld.col(1).array() += rise;
+  return {rest, raised};
+}
+
 }  // namespace
 
 TEST(BodyCoverage, CoveredInEveryPoseIsWhatTheGarmentHidesInAll) {
   const test::CapsuleSpec spec;  // tube from y 0.05 to 0.62, 12 mm off a 0.12 m capsule
   const Character ch = test::capsuleCharacter(spec);
-  DatasetPose rest, raised;
-  rest.id = 0;
-  rest.pose = ch.skeleton.restPose();
-  rest.gameMeshWorld = ch.garment.positions;
-  raised = rest;
-  raised.id = 1;
-  raised.gameMeshWorld.col(1).array() += 0.1f;  // the shirt ridden up by 10 cm
+  const auto [rest, raised] = restAndRaised(ch, 0.1f);  // the shirt ridden up by 10 cm
 
   const BodyCoverageResult one = coveredBodyTriangles(ch, {&rest});
   EXPECT_EQ(one.bodyTriangles, ch.body.triangleCount());
@@ -105,13 +112,7 @@ TEST(BodyCoverage, ABuriedPartCountsAsHidden) {
       body.skin.joints.push_back(0);
       body.skin.weights.push_back(i == 0 ? 1.f : 0.f);
     }
-  DatasetPose rest, away;
-  rest.id = 0;
-  rest.pose = ch.skeleton.restPose();
-  rest.gameMeshWorld = ch.garment.positions;
-  away = rest;
-  away.id = 1;
-  away.gameMeshWorld.col(1).array() += 0.3f;
+  const auto [rest, away] = restAndRaised(ch, 0.3f);
 
   BodyCoverageOptions every;
   every.minShare = 1.0;
