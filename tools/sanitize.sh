@@ -2,7 +2,8 @@
 # The unit, stability, conformance and integration suites built with AddressSanitizer and
 # UndefinedBehaviorSanitizer (-O1 -g, no recovery: the first finding fails its test), run on lavapipe
 # with validation on. Suppressions cover only the Vulkan driver stack (tools/sanitize/*.supp, each with
-# its reason); our code has none.
+# its reason); our code has none. Every test runs through tools/sanitize/launch.sh, which keeps the driver
+# and the validation layer loaded until exit so that the suppressions can name them; timeouts are 4x.
 #
 #   bash tools/sanitize.sh                      build into build-asan/, run the suites
 #   bash tools/sanitize.sh --fuzz-runs 1000000  also: the model-loader fuzzer for that many executions
@@ -29,17 +30,18 @@ flags="-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$flags" -DCMAKE_C_FLAGS_RELWITHDEBINFO="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+  -DCMAKE_CROSSCOMPILING_EMULATOR="$root/tools/sanitize/launch.sh" -DSWISH_TEST_TIMEOUT_SCALE=4 \
   -DSWISH_BUILD_BENCHMARKS=OFF -DSWISH_BUILD_FUZZERS=$([ "$fuzz_runs" -gt 0 ] && echo ON || echo OFF) >/dev/null
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 
-export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=1:strict_init_order=1:check_initialization_order=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=1:strict_init_order=1:check_initialization_order=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tools/sanitize/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tools/sanitize/ubsan.supp"
 export SWISH_VALIDATION=1
 if [ "${CI:-}" = "true" ]; then export SWISH_REQUIRE_GPU=1; fi
 status=0
 ctest --test-dir "$BUILD_DIR" -L 'unit|stability|conformance|integration' -LE fuzz --output-on-failure \
-  -j"$(nproc)" --timeout 1800 --output-junit sanitize-junit.xml "${ctest_args[@]}" || status=$?
+  -j"$(nproc)" --output-junit sanitize-junit.xml "${ctest_args[@]}" || status=$?
 
 if [ "$fuzz_runs" -gt 0 ]; then
   fuzz=$BUILD_DIR/tests/fuzz/clang/fuzz_model_loader
