@@ -177,6 +177,17 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     std::ifstream mdIn(smd);
     const std::string text((std::istreambuf_iterator<char>(mdIn)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("held-out subjects mean mm"), std::string::npos) << text;
+    // Their frames against the body too, beside the random frames: penetration of truth and model, and
+    // the error with the push-out (the model has anchors).
+    ASSERT_TRUE(subjects.overall.penetrationMeasured);
+    EXPECT_TRUE(subjects.overall.pushOut);
+    EXPECT_EQ(subjects.overall.modelPenetration.frames, subjects.overall.poses);
+    EXPECT_EQ(subjects.overall.pushedPenetration.frames, subjects.overall.poses);
+    EXPECT_GT(subjects.overall.totalPushedMm.mean, 0.0);
+    EXPECT_DOUBLE_EQ(sreport["held_out_subjects"]["penetration"]["vertex_total_pushed"]["mean_mm"].get<double>(),
+                     subjects.overall.totalPushedMm.mean);
+    EXPECT_NE(text.find("| held-out subjects | model after the run-time push-out |"), std::string::npos) << text;
+    EXPECT_NE(text.find("Vertex error with the push-out, held-out subjects: mean "), std::string::npos) << text;
   }
 
   saveModel(out.model, dir / "synthetic.swish");

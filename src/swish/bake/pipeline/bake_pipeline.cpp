@@ -178,6 +178,15 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
                   subjects->overall.restSkinnedMm.mean, subjects->overall.restSkinnedMm.p95,
                   out.evaluation.totalMm.mean, out.evaluation.totalMm.p95);
     log(line);
+    const BakeEvaluation& o = subjects->overall;
+    if (o.penetrationMeasured && o.pushOut) {
+      std::snprintf(line, sizeof line,
+                    "part 2: held-out subjects with the push-out: vertex error mean %.2f mm, p95 %.2f mm; garment "
+                    "vertices inside the body %.1f %% (model %.1f %%, truth %.1f %%)",
+                    o.totalPushedMm.mean, o.totalPushedMm.p95, 100.0 * o.pushedPenetration.share(),
+                    100.0 * o.modelPenetration.share(), 100.0 * o.truthPenetration.share());
+      log(line);
+    }
   }
   Model model = out.model;
   nlohmann::json meta = nlohmann::json::parse(model.metadata);

@@ -185,30 +185,39 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
             "study above chooses is not in these figures.\n\n";
   }
   if (ev.penetrationMeasured) {
+    const BakeEvaluation* subjectEv = subjects && subjects->overall.penetrationMeasured ? &subjects->overall : nullptr;
     md << "## Garment inside the body\n\nHeld-out poses against the character's posed body, truth and model side by "
-          "side "
-          "(whether the model or the truth puts the cloth inside): vertices inside the body, those deeper than "
-       << f2(kVisiblePenetrationMm) << " mm (visible), the deepest.\n\n"
-       << "| positions | poses with any inside | poses with visible | vertices inside | share | deepest mm | p95 of "
-          "per-pose deepest mm |\n"
-          "|---|---|---|---|---|---|---|\n";
-    auto prow = [&](const char* name, const PenetrationPool& p) {
-      md << "| " << name << " | " << p.framesInside << " / " << p.frames << " | " << p.framesVisible << " | "
-         << p.inside << " | " << f3(100.0 * p.share()) << " % | " << f2(p.deepestMm) << " | "
+          "side (whether the model or the truth puts the cloth inside)"
+       << (subjectEv ? ", on the random held-out frames of the training clips and on the held-out subjects" : "")
+       << ": vertices inside the body, those deeper than " << f2(kVisiblePenetrationMm)
+       << " mm (visible), the deepest.\n\n"
+       << "| poses | positions | poses with any inside | poses with visible | vertices inside | share | deepest mm | "
+          "p95 of per-pose deepest mm |\n"
+          "|---|---|---|---|---|---|---|---|\n";
+    auto prow = [&](const char* set, const char* name, const PenetrationPool& p) {
+      md << "| " << set << " | " << name << " | " << p.framesInside << " / " << p.frames << " | " << p.framesVisible
+         << " | " << p.inside << " | " << f3(100.0 * p.share()) << " % | " << f2(p.deepestMm) << " | "
          << f2(p.deepestPercentileMm(0.95)) << " |\n";
     };
-    prow("truth (simulation, transferred + smoothed)", ev.truthPenetration);
-    prow("model (before the push-out)", ev.modelPenetration);
-    if (ev.pushOut) {
-      prow("model after the run-time push-out", ev.pushedPenetration);
-      md << "\nVertex error with the push-out: mean " << f2(ev.totalPushedMm.mean) << " mm, p95 "
-         << f2(ev.totalPushedMm.p95) << " mm, max " << f2(ev.totalPushedMm.max)
-         << " mm (without: " << f2(ev.totalMm.mean) << " / " << f2(ev.totalMm.p95) << " / " << f2(ev.totalMm.max)
-         << " mm).\n";
-    } else {
-      md << "\nThe model has no body anchors: no push-out at run time.\n";
-    }
+    auto rows = [&](const char* set, const BakeEvaluation& e) {
+      prow(set, "truth (simulation, transferred + smoothed)", e.truthPenetration);
+      prow(set, "model (before the push-out)", e.modelPenetration);
+      if (e.pushOut) prow(set, "model after the run-time push-out", e.pushedPenetration);
+    };
+    rows("random held-out frames", ev);
+    if (subjectEv) rows("held-out subjects", *subjectEv);
     md << "\n";
+    auto pushedError = [&](const char* set, const BakeEvaluation& e) {
+      md << "Vertex error with the push-out, " << set << ": mean " << f2(e.totalPushedMm.mean) << " mm, p95 "
+         << f2(e.totalPushedMm.p95) << " mm, max " << f2(e.totalPushedMm.max) << " mm (without: " << f2(e.totalMm.mean)
+         << " / " << f2(e.totalMm.p95) << " / " << f2(e.totalMm.max) << " mm).\n\n";
+    };
+    if (ev.pushOut) {
+      pushedError("random held-out frames", ev);
+      if (subjectEv && subjectEv->pushOut) pushedError("held-out subjects", *subjectEv);
+    } else {
+      md << "The model has no body anchors: no push-out at run time.\n\n";
+    }
   }
   md << "## MLP\n\n"
      << activationName(out.regressor.activation) << ", best validation epoch " << out.regressor.bestEpoch << " of "

@@ -45,6 +45,7 @@ nlohmann::json SubjectEvaluation::toJson() const {
                       {"poses_planned", posesPlanned},
                       {"overall", evaluationSummary(overall)},
                       {"per_clip", clips}};
+  if (overall.penetrationMeasured) j["penetration"] = penetrationJson(overall);
   if (!guard.rows.empty()) j["novelty_guard_study"] = guard.toJson();
   if (levels.measured()) j["quality_levels"] = runtime::toJson(levels);
   return j;
@@ -241,7 +242,9 @@ SubjectEvaluation evaluateHeldOutSubjects(const BakeTrainOutput& out, const Data
     slot.first = subject;
     slot.second.push_back(&p);
   }
-  r.overall = evaluateModel(out.model, all, out.databaseMaps, normalPca);
+  // The body too, as for the random held-out frames: penetration, and the error with the push-out.
+  const Mesh* body = holdout.character.body.triangleCount() > 0 ? &holdout.character.body : nullptr;
+  r.overall = evaluateModel(out.model, all, out.databaseMaps, normalPca, body);
   for (const auto& [clip, entry] : byClip)
     r.perClip.push_back({clip, entry.first, evaluateModel(out.model, entry.second, out.databaseMaps, normalPca)});
   std::vector<const DatasetPose*> trained, random;

@@ -4,7 +4,9 @@
 // into their own dataset (BakeConfig::holdoutDatasetDir, evenly spaced over their clips); here each is
 // evaluated through the same run-time path as the bake's own held-out poses (bake_evaluation.hpp):
 // vertex error mean / p95 / max and normal-map angular error, with both baselines (the rest shape
-// skinned, the PCA mean shape skinned) on the same poses, overall and per held-out clip.
+// skinned, the PCA mean shape skinned) on the same poses, overall and per held-out clip; overall also
+// the garment inside the character's body (truth, model, model after the run-time push-out) and the
+// error with the push-out, where the dataset has the body.
 #include <string>
 #include <vector>
 
@@ -61,7 +63,8 @@ struct SubjectEvaluation {
 
   // {"subjects", "poses", "overall": {...}, "per_clip": [{"clip", "subject", ...}]}, each evaluation as
   // {"poses", "vertex": {mean_mm, p95_mm, max_mm}, "baseline_rest_skinned", "baseline_mean_skinned",
-  //  "normal_total": {mean_deg, ...}}, and "quality_levels" (the levels on the subjects, without times):
+  //  "normal_total": {mean_deg, ...}}, "penetration" (penetrationJson of `overall`, when measured), and
+  //  "quality_levels" (the levels on the subjects, without times):
   // what the report and the model metadata carry.
   nlohmann::json toJson() const;
   // The report's section: the held-out subjects against `randomFrames` (the bake's random held-out
