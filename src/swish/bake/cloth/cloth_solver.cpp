@@ -9,6 +9,7 @@
 #include <ctime>
 #include <map>
 
+#include "swish/bake/cloth/static_solve.hpp"
 #include "swish/bake/transfer/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/hash.hpp"
@@ -117,6 +118,8 @@ void ClothSimSettings::validate() const {
         "equilibriumSeconds must be in [0, 60]");
   check(equilibriumIterations >= 0 && equilibriumIterations <= 1000, "equilibriumIterations must be in [0, 1000]");
   check(retries >= 0 && retries <= 4, "retries must be in [0, 4]");
+  check(std::isfinite(staticTolerance) && staticTolerance > 0.f, "staticTolerance must be positive");
+  check(staticIterations >= 1 && staticIterations <= 1000, "staticIterations must be in [1, 1000]");
 }
 
 ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSettings settings)
@@ -271,6 +274,13 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   f.value(uint32_t(s.finalProjection));
   f.value(s.retries);
   f.matrix(s.gravity);
+  // (8, hashed only with the static solve on: the settings of the solve that replaces the equilibrium
+  // phase; without it the fingerprint, and so every cached pose, stays as it was.)
+  if (s.staticSolve) {
+    f.value(uint32_t(8));
+    f.value(s.staticTolerance);
+    f.value(s.staticIterations);
+  }
   fingerprint_ = f.h;
 }
 
@@ -538,10 +548,30 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown) const
     if (std::string why = runFrame(frame, t, s.substeps * slowdown, s.iterations); !why.empty()) return fail(why);
   }
   measureResidual();
+  if (s.staticSolve) {
+    // The end as an equilibrium: the static solve from the path's shape, on the body and band targets
+    // of the goal pose (the last frame of the path was at it).
+    StaticProblem problem;
+    problem.constraints = &cc;
+    problem.attached = &attached_;
+    problem.attachCompliance = &attachCompliance_;
+    problem.attachTarget = &attachTarget;
+    problem.tethers = &tethers_;
+    problem.tetherSlack = s.tetherSlack;
+    problem.body = &body;
+    problem.thickness = s.thickness;
+    problem.reach = reach;
+    problem.gravity = s.gravity;
+    const StaticSolveResult st = solveStatic(problem, x, s.staticTolerance, s.staticIterations);
+    if (!st.failure.empty()) return fail(st.failure);
+    r.equilibriumResidual = st.residual;
+    r.equilibriumResidualMax = st.residualMax;
+    r.staticIterations = st.iterations;
+  }
   // The end: frames at the goal pose, at the base settings (equilibriumIterations sweeps), until the
-  // residual is at most the tolerance or equilibriumSeconds are spent.
+  // residual is at most the tolerance or equilibriumSeconds are spent (none after the static solve).
   const int eqIterations = s.equilibriumIterations > 0 ? s.equilibriumIterations : s.iterations;
-  const int maxFrames = int(std::lround(s.equilibriumSeconds * s.frameRate));
+  const int maxFrames = s.staticSolve ? 0 : int(std::lround(s.equilibriumSeconds * s.frameRate));
   for (int k = 1; k <= maxFrames && r.equilibriumResidual > s.equilibriumTolerance; ++k) {
     before = x;
     if (std::string why = runFrame(totalFrames + k, 1.f, s.substeps, eqIterations); !why.empty()) return fail(why);

@@ -59,6 +59,13 @@ struct ClothSimSettings {
   float equilibriumTolerance = 0.01f;
   float equilibriumSeconds = 0.5f;
   int equilibriumIterations = 10;
+  // The static solve (static_solve.hpp), instead of the equilibrium phase: from the path's end, Newton
+  // steps on the garment's energy at the goal pose until the residual (the same unbalanced share of
+  // gravity's load, from the forces rather than the motion) is at most staticTolerance or
+  // staticIterations steps are spent. Frictionless: the shape is the pose's, not the path's speed.
+  bool staticSolve = false;
+  float staticTolerance = 0.01f;
+  int staticIterations = 40;
   // Every vertex closer to the body than the thickness at the end is moved out along the body's
   // normal (repeated where that moves it into another part).
   bool finalProjection = true;

@@ -70,7 +70,9 @@ nlohmann::json simulationRunJson(const std::vector<SimulatedPoseSummary>& poses,
                                  const std::vector<std::pair<uint32_t, std::string>>& extraFailures) {
   std::map<std::string, size_t> byReason;
   nlohmann::json retried = nlohmann::json::array();
-  std::vector<double> seconds, residual;
+  std::vector<double> seconds, residual, staticSteps;
+  // The residual's tolerance: the static solve's where it ends the pose, else the equilibrium phase's.
+  const float tolerance = settings.staticSolve ? settings.staticTolerance : settings.equilibriumTolerance;
   double projected = 0.0;
   size_t notAtEquilibrium = 0, ok = 0;
   for (const SimulatedPoseSummary& p : poses) {
@@ -83,8 +85,10 @@ nlohmann::json simulationRunJson(const std::vector<SimulatedPoseSummary>& poses,
     projected = std::max(projected, double(p.residuals.projectedDepth));
     if (p.residuals.equilibriumResidual >= 0.f) {
       residual.push_back(p.residuals.equilibriumResidual);
-      notAtEquilibrium += p.residuals.equilibriumResidual > settings.equilibriumTolerance;
+      notAtEquilibrium += p.residuals.equilibriumResidual > tolerance;
     }
+    // (Newton steps are not stored with a pose: the poses simulated in this run.)
+    if (settings.staticSolve && p.residuals.staticIterations > 0) staticSteps.push_back(p.residuals.staticIterations);
   }
   for (const auto& f : extraFailures) ++byReason[failureCategory(f.second)];
   const double n = std::max<double>(1.0, double(poses.size()));
@@ -94,20 +98,28 @@ nlohmann::json simulationRunJson(const std::vector<SimulatedPoseSummary>& poses,
     reasons[why] = {{"count", count}, {"share", double(count) / n}};
     failed += count;
   }
-  return {{"poses", poses.size()},
-          {"failed", failed},
-          {"failed_share", double(failed) / n},
-          {"failures_by_reason", reasons},
-          {"retried_poses", retried.size()},
-          {"retried", retried},
-          {"seconds_per_pose_per_core", mean(seconds)},
-          {"equilibrium_tolerance", settings.equilibriumTolerance},
-          {"equilibrium_residual_mean", mean(residual)},
-          {"equilibrium_residual_p95", percentile(residual, 0.95)},
-          {"equilibrium_residual_max", residual.empty() ? 0.0 : *std::max_element(residual.begin(), residual.end())},
-          {"poses_not_at_equilibrium", notAtEquilibrium},
-          {"final_projection_max_mm", 1000.0 * projected},
-          {"kept", ok}};
+  nlohmann::json out = {
+      {"poses", poses.size()},
+      {"failed", failed},
+      {"failed_share", double(failed) / n},
+      {"failures_by_reason", reasons},
+      {"retried_poses", retried.size()},
+      {"retried", retried},
+      {"seconds_per_pose_per_core", mean(seconds)},
+      {"equilibrium_tolerance", tolerance},
+      {"equilibrium_residual_mean", mean(residual)},
+      {"equilibrium_residual_p95", percentile(residual, 0.95)},
+      {"equilibrium_residual_max", residual.empty() ? 0.0 : *std::max_element(residual.begin(), residual.end())},
+      {"poses_not_at_equilibrium", notAtEquilibrium},
+      {"final_projection_max_mm", 1000.0 * projected},
+      {"kept", ok}};
+  if (settings.staticSolve) {
+    out["static_solve"] = true;
+    out["static_iterations_mean"] = mean(staticSteps);
+    out["static_iterations_max"] =
+        staticSteps.empty() ? 0.0 : *std::max_element(staticSteps.begin(), staticSteps.end());
+  }
+  return out;
 }
 
 std::vector<uint32_t> sampleQualityPoses(const std::vector<uint32_t>& candidates, size_t count, uint64_t seed) {
@@ -144,6 +156,7 @@ SimulationQuality measureSimulationQuality(const Character& character, const Clo
   ClothSimSettings fine = solver.settings();
   fine.substeps *= 2;
   fine.equilibriumTolerance *= 0.5f;
+  fine.staticTolerance *= 0.5f;
   const ClothSolver reference(character, solver.mesh(), fine);
 
   // Three solves per pose: the reference, and the pose turned by +a and -a.

@@ -25,6 +25,7 @@ struct SimResiduals {
   float equilibriumResidual = -1.f;
   float equilibriumResidualMax = -1.f;
   int equilibriumFrames = 0;
+  int staticIterations = 0;    // Newton steps of the static solve (0: not run)
   float projectedDepth = 0.f;  // m: the deepest vertex the final projection moved out of the body
 };
 

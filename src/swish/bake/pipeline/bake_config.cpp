@@ -94,6 +94,9 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "equilibrium_tolerance",
                                                   "equilibrium_seconds",
                                                   "equilibrium_iterations",
+                                                  "static_solve",
+                                                  "static_tolerance",
+                                                  "static_iterations",
                                                   "retries",
                                                   "final_projection",
                                                   "check_poses",
@@ -136,6 +139,11 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   cs.equilibriumTolerance = float(sim.number("equilibrium_tolerance", 1e-6, 10, cs.equilibriumTolerance));
   cs.equilibriumSeconds = float(sim.number("equilibrium_seconds", 0, 60, cs.equilibriumSeconds));
   cs.equilibriumIterations = int(sim.wholeNumber("equilibrium_iterations", 0, 1000, cs.equilibriumIterations));
+  // Or the static solve instead (static_solve.hpp): Newton steps until the force residual is at most
+  // static_tolerance, for at most static_iterations steps.
+  cs.staticSolve = sim.boolean("static_solve", cs.staticSolve);
+  cs.staticTolerance = float(sim.number("static_tolerance", 1e-6, 10, cs.staticTolerance));
+  cs.staticIterations = int(sim.wholeNumber("static_iterations", 1, 1000, cs.staticIterations));
   // Retries of a failed pose along a slower path (twice the substeps and transition each) before it is left out.
   cs.retries = int(sim.wholeNumber("retries", 0, 4, cs.retries));
   // Vertices left within the thickness of the body at the end are moved out along its normal.

@@ -31,7 +31,9 @@
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
 //                      "attach_band" (top share of the garment's height held on the body),
 //                      "equilibrium_tolerance", "equilibrium_seconds", "equilibrium_iterations" (the
-//                      end condition: cloth_solver.hpp), "retries" (of a failed pose, slower each),
+//                      end condition: cloth_solver.hpp), "static_solve" (true: a Newton static solve
+//                      instead, static_solve.hpp) with "static_tolerance", "static_iterations",
+//                      "retries" (of a failed pose, slower each),
 //                      "final_projection" (out of the body at the end), "check_poses" (sampled for the
 //                      report's convergence and noise, 0: none),
 

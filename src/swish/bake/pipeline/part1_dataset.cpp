@@ -268,6 +268,12 @@ nlohmann::json DatasetBuildSettings::toJson() const {
     out["simulation"]["friction"] = m.material.friction;
   // Only when external, so that the settings (and so the datasets) of solver bakes stay as they were.
   if (external.enabled()) out["simulation"].update(external.toJson());
+  // Only when on, likewise.
+  if (m.staticSolve) {
+    out["simulation"]["static_solve"] = true;
+    out["simulation"]["static_tolerance"] = m.staticTolerance;
+    out["simulation"]["static_iterations"] = m.staticIterations;
+  }
   return out;
 }
 

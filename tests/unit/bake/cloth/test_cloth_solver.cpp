@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <set>
@@ -706,4 +707,69 @@ TEST(ClothSolver, AFailedPoseIsRetriedAndTheRetryIsRecorded) {
   wrong.local.pop_back();
   s.retries = 2;
   EXPECT_EQ(ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(wrong).attempts, 1);
+}
+
+// The static solve (static_solve.hpp): the end shape is the energy's minimum, not where a number of
+// substeps left the cloth. A sheet hanging from its top row has one equilibrium; reached from two paths
+// of different substeps it is the same shape, where the XPBD end phase leaves the two apart.
+TEST(ClothSolver, TheStaticSolveEndsAtTheSameShapeWhateverTheSubsteps) {
+  Character ch;
+  ch.name = "hanging sheet";
+  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
+  ch.garment = sheet(16, 0.4f, Vec3f(-0.2f, 0.5f, 0.f), Vec3f::UnitX(), Vec3f::UnitY());
+  test::CapsuleSpec far;
+  far.offset = Vec3f(0, -5.f, 0);
+  ch.body = test::capsuleBody(far);
+  auto solve = [&](int substeps, bool staticSolve) {
+    ClothSimSettings s = quickSettings();
+    s.attachTopFraction = 0.01f;
+    s.settleSeconds = 0.f;
+    s.transitionSeconds = 0.2f;
+    s.substeps = substeps;
+    s.staticSolve = staticSolve;
+    s.staticTolerance = 1e-3f;
+    const PoseSimulation r = ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(ch.skeleton.restPose());
+    EXPECT_TRUE(r.ok) << r.failure;
+    return r;
+  };
+  const PoseSimulation a = solve(6, true), b = solve(24, true);
+  ASSERT_TRUE(a.ok && b.ok);
+  EXPECT_LE(a.residuals.equilibriumResidual, 1e-3f);
+  EXPECT_LE(b.residuals.equilibriumResidual, 1e-3f);
+  EXPECT_GT(a.residuals.staticIterations, 0);
+  const float staticApart = (a.positions - b.positions).rowwise().norm().maxCoeff();
+  const PoseSimulation c = solve(6, false), d = solve(24, false);
+  ASSERT_TRUE(c.ok && d.ok);
+  EXPECT_EQ(c.residuals.staticIterations, 0);
+  const float pathApart = (c.positions - d.positions).rowwise().norm().maxCoeff();
+  std::printf("hanging sheet, 6 vs 24 substeps, farthest vertex apart: static solve %.4f mm, XPBD end %.4f mm\n",
+              1000.f * staticApart, 1000.f * pathApart);
+  EXPECT_LT(staticApart, 1e-4f);  // 0.1 mm
+  EXPECT_LT(staticApart, 0.1f * pathApart);
+  // It hangs: below its rest height, stretched a little (a knit under its own weight), in its plane.
+  EXPECT_LT(a.positions.col(1).minCoeff(), 0.5f);
+  EXPECT_GT(a.residuals.maxConstraintViolation, 0.f);
+  EXPECT_LT(a.residuals.maxConstraintViolation, 0.05f);
+  EXPECT_LT(a.positions.col(2).cwiseAbs().maxCoeff(), 1e-3f);
+}
+
+// On a body: the tube on the bent capsule ends outside the body, near its equilibrium: the static
+// solve's residual (from the forces; recorded in place of the end phase's) ends at 0.06 of gravity's
+// load after its 40 steps (measured), which the bound below guards.
+TEST(ClothSolver, TheStaticSolveKeepsTheTubeOffTheBentCapsule) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  ClothSimSettings s = quickSettings();
+  s.staticSolve = true;
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), s);
+  const PoseSimulation bent = solver.simulate(bentPose(ch.skeleton, 0.8f));
+  ASSERT_TRUE(bent.ok) << bent.failure;
+  EXPECT_GT(bent.residuals.staticIterations, 0);
+  EXPECT_GE(bent.residuals.equilibriumResidual, 0.f);
+  EXPECT_EQ(bent.residuals.equilibriumFrames, 0);  // no XPBD end phase after it
+  EXPECT_LT(bent.residuals.maxPenetration, 2e-3f);
+  EXPECT_LT(bent.residuals.equilibriumResidual, 0.5f);
+  std::printf("tube on the bent capsule: %d Newton steps, residual %.4g (worst vertex %.4g)\n",
+              bent.residuals.staticIterations, bent.residuals.equilibriumResidual,
+              bent.residuals.equilibriumResidualMax);
 }

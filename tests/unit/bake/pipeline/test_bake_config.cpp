@@ -136,7 +136,10 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"threads", 2},
                           {"substeps", 4},
                           {"gravity", 0},
-                          {"attach_band", 0.03}}},
+                          {"attach_band", 0.03},
+                          {"static_solve", true},
+                          {"static_tolerance", 0.002},
+                          {"static_iterations", 25}}},
                         {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
                         {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
       "recipe.json", "/base");
@@ -156,6 +159,17 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(s.threads, 2);
   EXPECT_EQ(s.simulation.substeps, 4);
   EXPECT_FLOAT_EQ(s.simulation.attachTopFraction, 0.03f);
+  EXPECT_TRUE(s.simulation.staticSolve);
+  EXPECT_FLOAT_EQ(s.simulation.staticTolerance, 0.002f);
+  EXPECT_EQ(s.simulation.staticIterations, 25);
+  EXPECT_FALSE(d.part1->simulation.staticSolve);  // off unless asked for
+  // Recorded in the dataset settings only when on, so that other bakes' datasets stay as they were.
+  EXPECT_EQ(s.toJson()["simulation"]["static_iterations"], 25);
+  EXPECT_FALSE(d.part1->toJson()["simulation"].contains("static_solve"));
+  // ...and read back from them (the replay's truth simulates as the bake did).
+  const PoseShapeSettings back = poseShapeSettingsFromJson(s.toJson(), "dataset settings");
+  EXPECT_TRUE(back.simulation.staticSolve);
+  EXPECT_EQ(back.simulation.staticIterations, 25);
   EXPECT_FLOAT_EQ(d.part1->simulation.attachTopFraction, ClothSimSettings{}.attachTopFraction);
   EXPECT_EQ(s.simulation.gravity, Vec3f::Zero());
   EXPECT_FLOAT_EQ(d.part1->simulation.gravity.y(), -9.81f);
@@ -172,6 +186,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"simulation", {{"preset", "silk"}}}}), "part1.simulation.preset");
   says(part1Error({{"simulation", {{"substeps", 0}}}}), "part1.simulation.substeps: 0 is outside");
   says(part1Error({{"simulation", {{"attach_band", 0.9}}}}), "part1.simulation.attach_band: 0.9 is outside");
+  says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
   says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
   says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");
