@@ -38,8 +38,8 @@ struct StaticProblem {
 };
 
 struct StaticSolveResult {
-  int iterations = 0;       // Newton steps taken
-  float residual = -1.f;    // at the end: mass-weighted RMS of |force| / (m g) (unbalanced share of gravity)
+  int iterations = 0;        // Newton steps taken
+  float residual = -1.f;     // at the end: mass-weighted RMS of |force| / (m g) (unbalanced share of gravity)
   float residualMax = -1.f;  // the worst vertex's |force| / (m g)
   bool converged = false;    // residual <= tolerance
   std::string failure;       // non-empty: the solve could not proceed (x is left at its last good shape)
