@@ -70,6 +70,19 @@ Pose bentPose(const Skeleton& sk, float angle) {
   return p;
 }
 
+// A sheet of n x n vertices, `size` wide, in the x-y plane from height 0.5 m up, to hang from its top
+// row; the character's body (a capsule) is far out of the way.
+Character hangingSheet(int n, float size) {
+  Character ch;
+  ch.name = "hanging sheet";
+  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
+  ch.garment = sheet(n, size, Vec3f(-0.5f * size, 0.5f, 0.f), Vec3f::UnitX(), Vec3f::UnitY());
+  test::CapsuleSpec far;
+  far.offset = Vec3f(0, -5.f, 0);
+  ch.body = test::capsuleBody(far);
+  return ch;
+}
+
 }  // namespace
 
 TEST(ClothSimulationMesh, WeldsSeamsAndSubdividesTowardsTarget) {
@@ -547,13 +560,7 @@ TEST(ClothConstraints, ProjectionReducesViolation) {
 }
 
 TEST(ClothSolver, HangingClothSettles) {
-  Character ch;
-  ch.name = "hanging sheet";
-  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
-  ch.garment = sheet(25, 0.5f, Vec3f(-0.25f, 0.5f, 0.f), Vec3f::UnitX(), Vec3f::UnitY());
-  test::CapsuleSpec far;
-  far.offset = Vec3f(0, -5.f, 0);  // a body, far out of the way
-  ch.body = test::capsuleBody(far);
+  const Character ch = hangingSheet(25, 0.5f);
   ClothSimSettings s = quickSettings();
   s.attachTopFraction = 0.01f;  // the top row only
   s.settleSeconds = 1.5f;
@@ -657,13 +664,7 @@ TEST(ClothSolver, RejectsAGarmentInsideTheBody) {
 // load) is below the tolerance, and the residual is recorded. Without that phase and with a short
 // settle, the sheet is still stretching under its weight: the same measure reads above the tolerance.
 TEST(ClothSolver, EndsAtEquilibriumAndRecordsTheResidual) {
-  Character ch;
-  ch.name = "hanging sheet";
-  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
-  ch.garment = sheet(20, 0.4f, Vec3f(-0.2f, 0.5f, 0.f), Vec3f::UnitX(), Vec3f::UnitY());
-  test::CapsuleSpec far;
-  far.offset = Vec3f(0, -5.f, 0);
-  ch.body = test::capsuleBody(far);
+  const Character ch = hangingSheet(20, 0.4f);
   ClothSimSettings s = quickSettings();
   s.attachTopFraction = 0.01f;
   s.settleSeconds = 0.f;
@@ -713,13 +714,7 @@ TEST(ClothSolver, AFailedPoseIsRetriedAndTheRetryIsRecorded) {
 // substeps left the cloth. A sheet hanging from its top row has one equilibrium; reached from two paths
 // of different substeps it is the same shape, where the XPBD end phase leaves the two apart.
 TEST(ClothSolver, TheStaticSolveEndsAtTheSameShapeWhateverTheSubsteps) {
-  Character ch;
-  ch.name = "hanging sheet";
-  ch.skeleton = test::capsuleSkeleton(Vec3f::Zero());
-  ch.garment = sheet(16, 0.4f, Vec3f(-0.2f, 0.5f, 0.f), Vec3f::UnitX(), Vec3f::UnitY());
-  test::CapsuleSpec far;
-  far.offset = Vec3f(0, -5.f, 0);
-  ch.body = test::capsuleBody(far);
+  const Character ch = hangingSheet(16, 0.4f);
   auto solve = [&](int substeps, bool staticSolve) {
     ClothSimSettings s = quickSettings();
     s.attachTopFraction = 0.01f;
