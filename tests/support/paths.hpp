@@ -1,5 +1,6 @@
 #pragma once
 // Where tests find data that lives outside the project.
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -10,7 +11,12 @@ namespace swish::test {
 inline std::filesystem::path sharedAsset(const std::string& name) {
   return std::filesystem::path(SWISH_SHARED_ASSETS_DIR) / name;
 }
-inline std::filesystem::path sourceDir() { return SWISH_SOURCE_DIR; }
+// The project's source folder (assets/, docs/): where it was built, unless SWISH_SOURCE_DIR says where a
+// copy is (tools/bundle.sh runs the benchmarks away from the build).
+inline std::filesystem::path sourceDir() {
+  if (const char* e = std::getenv("SWISH_SOURCE_DIR"); e && *e) return e;
+  return SWISH_SOURCE_DIR;
+}
 // ../shared/mocap beside the project (the CMU motion corpus: cmu/, cmu-daz/, each with index.tsv).
 inline std::filesystem::path sharedMocap(const std::string& name = "") {
   return std::filesystem::path(SWISH_SHARED_ASSETS_DIR).parent_path() / "mocap" / name;
