@@ -124,7 +124,10 @@ void deformInstance(const uint instance, const uint groups) {
   }
   if (APPLY_SKINNING) {  // (character space: after skinning only)
     [[unroll]] for (uint a = 0u; a < SWISH_MAX_ANCHOR_SLOTS; ++a) {
-      if (a < p.pushOut) {  // uniform: every thread the same
+      // p.pushOut is uniform; a vertex without an anchor in this set (reach 0: four in five of the default
+      // jersey's in the second set) skips the blend, which could not move it. On a GPU whole subgroups of
+      // such vertices do; lavapipe runs it masked as before.
+      if (a < p.pushOut && anchorR[a] != 0.0) {
         precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
         SWISH_BLEND_MATRICES(4u, anchorJ[a], anchorW[a], a0, a1, a2, a3)
         precise const vec3 c = ((a0 * anchorC[a].x + a1 * anchorC[a].y) + a2 * anchorC[a].z) + a3;
