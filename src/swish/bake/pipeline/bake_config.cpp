@@ -80,6 +80,7 @@ void parseSimulationSource(const JsonReader& sim, DatasetBuildSettings& s) {
 void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   const JsonReader sim = j.section("simulation", {"preset",
                                                   "friction",
+                                                  "damping",
                                                   "vertices",
                                                   "thickness",
                                                   "transition_seconds",
@@ -119,6 +120,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   }
   // The preset's Coulomb coefficient against the body, overridden (0: the cloth slides freely).
   cs.material.friction = float(sim.number("friction", 0, 2, cs.material.friction));
+  // The preset's velocity damping (1/s), overridden (0: none; the path then keeps more of its motion).
+  cs.material.damping = float(sim.number("damping", 0, 100, cs.material.damping));
   s.simulationVertices = size_t(sim.wholeNumber("vertices", 0, 2e6, double(s.simulationVertices)));
   cs.thickness = float(sim.number("thickness", 0, 0.05, cs.thickness));
   cs.transitionSeconds = float(sim.number("transition_seconds", 0.05, 10, cs.transitionSeconds));

@@ -25,7 +25,8 @@
 //                    "speed_jitter", "seed"},
 //       "thinning": {"tolerance": 0.1} | {"target_poses": 200}, plus "include_rest_pose" (default true:
 //                   the rest pose joins the kept poses and is always trained on),
-//       "simulation": {"preset", "friction" (overrides the preset's, 0-2), "vertices", "thickness",
+//       "simulation": {"preset", "friction" (overrides the preset's, 0-2), "damping" (the preset's
+//                      velocity damping in 1/s, overridden, 0-100), "vertices", "thickness",
 //                      "transition_seconds", "settle_seconds",
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),

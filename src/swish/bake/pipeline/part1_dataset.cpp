@@ -266,6 +266,8 @@ nlohmann::json DatasetBuildSettings::toJson() const {
       std::find_if(presets.begin(), presets.end(), [&](const ClothMaterial& c) { return c.name == m.material.name; });
   if (preset == presets.end() || m.material.friction != preset->friction)
     out["simulation"]["friction"] = m.material.friction;
+  if (preset == presets.end() || m.material.damping != preset->damping)
+    out["simulation"]["damping"] = m.material.damping;
   // Only when external, so that the settings (and so the datasets) of solver bakes stay as they were.
   if (external.enabled()) out["simulation"].update(external.toJson());
   // Only when on, likewise.

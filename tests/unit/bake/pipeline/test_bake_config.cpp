@@ -137,6 +137,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"substeps", 4},
                           {"gravity", 0},
                           {"attach_band", 0.03},
+                          {"damping", 1.5},
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25}}},
@@ -159,6 +160,10 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(s.threads, 2);
   EXPECT_EQ(s.simulation.substeps, 4);
   EXPECT_FLOAT_EQ(s.simulation.attachTopFraction, 0.03f);
+  EXPECT_FLOAT_EQ(s.simulation.material.damping, 1.5f);
+  EXPECT_FLOAT_EQ(d.part1->simulation.material.damping, clothMaterialPreset("jersey").damping);
+  EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(s.toJson(), "dataset settings").simulation.material.damping, 1.5f);
+  EXPECT_FALSE(d.part1->toJson()["simulation"].contains("damping"));  // the preset's: not recorded
   EXPECT_TRUE(s.simulation.staticSolve);
   EXPECT_FLOAT_EQ(s.simulation.staticTolerance, 0.002f);
   EXPECT_EQ(s.simulation.staticIterations, 25);
