@@ -31,9 +31,6 @@ constexpr float kLimbClearance = 0.05f;
 constexpr float kBandSoftening = 0.05f;
 // An edge this many times failStrain stretched is a runaway solve on its own, however few share it.
 constexpr float kRunawayFactor = 5.f;
-// Contact planes kept per cloth vertex: one per body part (or contact region of a one-surface body),
-// the deepest first (see closestParts, closestRegions).
-constexpr size_t kContactPlanes = 2;
 using V3 = Eigen::Map<Vec3f>;
 
 // The CPU seconds this thread has run: a solve is sequential on one thread, so this is its cost on one

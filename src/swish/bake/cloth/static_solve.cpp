@@ -12,7 +12,6 @@ namespace {
 
 using Vec3d = Eigen::Vector3d;
 using Mat3d = Eigen::Matrix3d;
-constexpr size_t kPlanes = 2;  // contact planes per vertex, as the path's (cloth_solver.cpp)
 
 // The proximal term's step length h (seconds): the first, the largest, and how it grows after a full
 // step. Small at first so that the first steps stay near the path's shape (a pure Newton step from a
@@ -34,7 +33,7 @@ constexpr double kStallDecrease = 1e-7;
 Vec3d at(const Points3f& x, size_t v) { return x.row(Eigen::Index(v)).transpose().cast<double>(); }
 
 struct Planes {
-  std::vector<std::array<BodyCollider::Hit, kPlanes>> hits;
+  std::vector<std::array<BodyCollider::Hit, kContactPlanes>> hits;
   std::vector<uint8_t> count;
 };
 
@@ -68,6 +67,11 @@ class Energy {
   double value(const Points3f& x) const {
     Planes planes;
     findPlanes(x, planes);
+    return value(x, planes);
+  }
+
+  // The energy at x with the contacts found there (findPlanes at the same x).
+  double value(const Points3f& x, const Planes& planes) const {
     const ClothConstraints& cc = *p_.constraints;
     double e = 0.0;
     auto distance = [&](const DistanceConstraint& c) {
@@ -274,7 +278,7 @@ StaticSolveResult solveStatic(const StaticProblem& p, Points3f& x, float toleran
       return r;
     }
     // Backtracking line search on the energy (Armijo), its contacts found at each trial shape.
-    const double e0 = energy.value(x);
+    const double e0 = energy.value(x, planes);  // (the contacts found for this step's gradient, at x)
     double s = 1.0;
     Points3f trial;
     bool accepted = false;

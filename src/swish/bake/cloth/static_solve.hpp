@@ -24,6 +24,11 @@
 
 namespace swish::bake {
 
+// Contact planes kept per cloth vertex, by the path (cloth_solver.cpp) and the static solve alike: one
+// per body part (or contact region of a one-surface body), the deepest first (see closestParts,
+// closestRegions).
+inline constexpr size_t kContactPlanes = 2;
+
 struct StaticProblem {
   const ClothConstraints* constraints = nullptr;
   const std::vector<uint32_t>* attached = nullptr;       // the top band's vertices
