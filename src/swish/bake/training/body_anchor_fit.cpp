@@ -213,7 +213,6 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
     for (uint32_t slot = 0; slot < anchors.slots(); ++slot) {
       BodyAnchor& an = anchors.slot(slot)[v];
       if (!an.present()) continue;
-      const bool calibrated = slot == 0 || s.second;
       samples.clear();
       for (size_t k = 0; k < xs.size(); ++k) {
         const Vec3f centre = runtime::skinAnchorCentre(an, poses[at[k]].skinMatrices);
@@ -230,14 +229,19 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
         }
         return sum;
       };
-      bool found = !calibrated;
+      // The highest clearance whose push adds at most the tolerance (a second anchor left uncalibrated
+      // keeps its own).
+      bool found = true;
       float chosen = an.clearance;
-      for (int step = 0; calibrated; ++step) {
-        const float cl = anchors.margin - float(step) * s.step;
-        if (cl < -kMaxAnchorDepth || !(an.radius + cl > 0.f)) break;
-        if (change(cl) <= double(s.tolerance) * double(samples.size())) {
-          chosen = cl, found = true;
-          break;
+      if (slot == 0 || s.second) {
+        found = false;
+        for (int step = 0;; ++step) {
+          const float cl = anchors.margin - float(step) * s.step;
+          if (cl < -kMaxAnchorDepth || !(an.radius + cl > 0.f)) break;
+          if (change(cl) <= double(s.tolerance) * double(samples.size())) {
+            chosen = cl, found = true;
+            break;
+          }
         }
       }
       if (!found) {
