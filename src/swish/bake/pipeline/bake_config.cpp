@@ -227,12 +227,20 @@ DatasetBuildSettings parsePart1(const JsonReader& j, const std::filesystem::path
 
   if (!j.has("thinning")) j.child("thinning").fail("is required: {\"tolerance\": t} or {\"target_poses\": n}");
   const JsonReader thin = j.child("thinning");
-  thin.requireObject({"tolerance", "target_poses", "include_rest_pose"});
+  thin.requireObject({"tolerance", "target_poses", "grow_from", "include_rest_pose"});
   if (thin.has("tolerance") == thin.has("target_poses"))
     thin.fail("give exactly one of \"tolerance\" and \"target_poses\"");
   s.thinningTolerance = float(thin.number("tolerance", 1e-6, 100, 0));
   s.targetPoses = size_t(thin.wholeNumber("target_poses", 2, 1e6, 0));
   s.includeRestPose = thin.boolean("include_rest_pose", s.includeRestPose);
+  if (thin.has("grow_from")) {
+    if (s.targetPoses == 0) thin.child("grow_from").fail("needs \"target_poses\" (the count to grow to)");
+    s.growFrom = size_t(thin.wholeNumber("grow_from", 2, 1e6, 0));
+    if (s.growFrom >= s.targetPoses)
+      thin.child("grow_from")
+          .fail("is " + std::to_string(s.growFrom) + ", not below target_poses (" + std::to_string(s.targetPoses) +
+                "): nothing to grow");
+  }
 
   parseShapeSections(j, s);
   if (s.external.enabled()) {

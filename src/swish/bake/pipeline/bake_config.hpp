@@ -24,7 +24,9 @@
 //       "sampling": {"characters", "seconds_per_character", "sample_rate", "mirror_odd_characters",
 //                    "speed_jitter", "seed"},
 //       "thinning": {"tolerance": 0.1} | {"target_poses": 200}, plus "include_rest_pose" (default true:
-//                   the rest pose joins the kept poses and is always trained on),
+//                   the rest pose joins the kept poses and is always trained on) and "grow_from" (with
+//                   target_poses: keep the poses, ids and simulations of the bake with target_poses
+//                   grow_from, and add poses after them: part1_dataset.hpp),
 //       "simulation": {"preset", "friction" (overrides the preset's, 0-2), "damping" (the preset's
 //                      velocity damping in 1/s, overridden, 0-100), "vertices", "thickness",
 //                      "transition_seconds", "settle_seconds",

@@ -260,6 +260,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   // Set only where used, so that recipes without them keep their datasets.
   if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
   if (evenPoses > 0) out["even_poses"] = evenPoses;
+  if (growFrom > 0) out["thinning"]["grow_from"] = growFrom;
   // Only when overridden, so that the settings (and so the datasets) of other bakes stay as they were.
   const auto& presets = clothMaterialPresets();
   const auto preset =
@@ -369,38 +370,61 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   if (s.evenPoses > 0) {
     for (uint32_t k = 0; k < samples.origins.size(); ++k) thin.kept.push_back(k);
   } else {
-    thin = s.targetPoses > 0 ? thinPosesToCount(samples, s.targetPoses) : thinPoses(samples, s.thinningTolerance);
+    thin = s.targetPoses > 0 ? thinPosesToCount(samples, s.growFrom > 0 ? s.growFrom : s.targetPoses)
+                             : thinPoses(samples, s.thinningTolerance);
   }
-  res.tolerance = thin.tolerance;
   std::vector<Pose>& poses = plan.toSimulate;
   res.origins = nlohmann::json::array();
-  for (uint32_t k : thin.kept) {
-    const PoseSamples::Origin& o = samples.origins[k];
-    poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, o)));
-    res.origins.push_back({{"clip", s.clips[o.clip].file.stem().string()},
-                           {"subject", s.clips[o.clip].subject},
-                           {"frame", o.frame},
-                           {"mirrored", o.mirrored}});
-  }
+  auto addKept = [&](size_t from, size_t to) {
+    for (size_t i = from; i < to; ++i) {
+      const PoseSamples::Origin& o = samples.origins[thin.kept[i]];
+      poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, o)));
+      res.origins.push_back({{"clip", s.clips[o.clip].file.stem().string()},
+                             {"subject", s.clips[o.clip].subject},
+                             {"frame", o.frame},
+                             {"mirrored", o.mirrored}});
+    }
+  };
+  addKept(0, thin.kept.size());
   {
     char line[200];
     std::snprintf(line, sizeof line, "part 1: %zu samples thinned to %zu poses (tolerance %.4f, %d passes) in %.2f s",
                   res.samples, poses.size(), double(thin.tolerance), thin.passes, since(t));
     log(line);
   }
+  int64_t restPoseId = -1;
   if (s.includeRestPose && s.evenPoses == 0) {
     const Pose rest = canonicalPose(character.skeleton, character.skeleton.restPose());
     const float nearest = nearestKeptDistance(samples, thin.kept, runtime::computeTheta(inputJoints, rest.local));
     if (nearest > thin.tolerance) {
+      restPoseId = int64_t(poses.size());
       poses.push_back(rest);
       res.restPoseAdded = true;
       res.origins.push_back({{"clip", "rest pose"}});
     }
     char line[200];
     std::snprintf(line, sizeof line, "part 1: the rest pose is %.4f from the nearest kept pose: ", double(nearest));
-    log(line +
-        (res.restPoseAdded ? "added as pose " + std::to_string(poses.size() - 1) : std::string("already covered")));
+    log(line + (res.restPoseAdded ? "added as pose " + std::to_string(restPoseId) : std::string("already covered")));
   }
+  // Growing a smaller bake's pose list: its poses (and its rest pose) keep their ids, so their
+  // simulations are reused; a second greedy pass at a smaller tolerance adds the rest after them.
+  if (s.growFrom > 0) {
+    const auto t2 = Clock::now();
+    const size_t first = thin.kept.size();
+    const float firstTolerance = thin.tolerance;
+    ThinToCountOptions grow;
+    grow.keepFirst = thin.kept;
+    thin = thinPosesToCount(samples, s.targetPoses, grow);
+    addKept(first, thin.kept.size());
+    char line[240];
+    std::snprintf(line, sizeof line,
+                  "part 1: grown from the %zu poses of tolerance %.4f (ids 0..%zu kept) to %zu (tolerance %.4f, %d "
+                  "passes) in %.2f s",
+                  first, double(firstTolerance), first - (res.restPoseAdded ? 0 : 1), poses.size(),
+                  double(thin.tolerance), thin.passes, since(t2));
+    log(line);
+  }
+  res.tolerance = thin.tolerance;
   res.keptPoses = poses.size();
   step("sampling + thinning", t);
 
@@ -468,7 +492,7 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   settingsJson["kept_poses"] = poses.size();
   settingsJson["thinning_tolerance_used"] = thin.tolerance;
   // Part 2 keeps this pose in its training split (part2_training.cpp); -1: none was added.
-  settingsJson["rest_pose_id"] = res.restPoseAdded ? int64_t(poses.size() - 1) : int64_t(-1);
+  settingsJson["rest_pose_id"] = restPoseId;
   return plan;
 }
 

@@ -77,6 +77,12 @@ struct DatasetBuildSettings {
   // Thinning: exactly one of the two is > 0 (unless evenPoses is).
   float thinningTolerance = 0.f;
   size_t targetPoses = 0;
+  // > 0 (with targetPoses, and smaller): grow the pose list a bake with targetPoses = growFrom chose
+  // (part1.thinning.grow_from). Its poses, and its rest pose, keep their ids and so their simulations;
+  // a second greedy pass at a smaller tolerance adds poses after them up to targetPoses
+  // (pose_thinning.hpp). The result covers the samples as densely as a fresh thinning to targetPoses,
+  // with other poses.
+  size_t growFrom = 0;
   // The character's rest pose (the A-pose every simulation starts from) joins the kept poses, last,
   // unless a kept pose is within the tolerance of it. Gameplay clips rarely hold the A-pose, and a
   // network that never saw it extrapolates there (arms among the inputs: several cm off); part 2
@@ -140,7 +146,7 @@ struct DatasetBuildResult {
   size_t clipFrames = 0;       // frames over all clips
   size_t samples = 0;          // Theta samples before thinning
   size_t keptPoses = 0;        // after thinning (the rest pose included when it was added)
-  bool restPoseAdded = false;  // the rest pose was appended to the thinned poses (its id: keptPoses - 1)
+  bool restPoseAdded = false;  // the rest pose was appended to the thinned poses (after the first stage's)
   size_t posesCorrected = 0;   // poses whose limbs (or one-surface head) were turned out of the body
   float maxCorrectionDegrees = 0.f;
   float maxTowardsRest = 0.f;  // head clearance: the largest fraction of the neck turned back to rest

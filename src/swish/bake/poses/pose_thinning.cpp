@@ -65,6 +65,17 @@ std::array<std::vector<float>, kAxes> principalAxes(const PoseSamples& samples) 
   return axes;
 }
 
+void checkKeepFirst(const PoseSamples& samples, std::span<const uint32_t> keepFirst) {
+  std::vector<bool> seen(samples.size(), false);
+  for (uint32_t k : keepFirst) {
+    if (k >= samples.size())
+      throw Error("pose thinning: pose to keep " + std::to_string(k) + " is not among the " +
+                  std::to_string(samples.size()) + " samples");
+    if (seen[k]) throw Error("pose thinning: pose to keep " + std::to_string(k) + " is listed twice");
+    seen[k] = true;
+  }
+}
+
 void checkSamples(const PoseSamples& samples) {
   if (samples.dim <= 0) throw Error("pose thinning: samples have dimension " + std::to_string(samples.dim));
   if (samples.values.size() % size_t(samples.dim) != 0)
@@ -133,7 +144,7 @@ class KeptPoses {
 };
 
 ThinningResult thinPass(const PoseSamples& samples, float tolerance, size_t maxKept,
-                        const std::array<std::vector<float>, kAxes>& axes) {
+                        const std::array<std::vector<float>, kAxes>& axes, std::span<const uint32_t> keepFirst) {
   if (!(tolerance >= 0.f) || !std::isfinite(tolerance))
     throw Error("pose thinning: tolerance " + std::to_string(tolerance) + " must be finite and >= 0");
   const int dim = samples.dim;
@@ -143,6 +154,7 @@ ThinningResult thinPass(const PoseSamples& samples, float tolerance, size_t maxK
   KeptPoses kept(dim, axes);
   ThinningResult result;
   result.tolerance = tolerance;
+  for (uint32_t k : keepFirst) kept.add(samples.row(k), kept.project(samples.row(k)), k);
   long lastCover = -1;
   for (size_t i = 0; i < n; ++i) {
     const float* x = samples.row(i);
@@ -170,9 +182,13 @@ ThinningResult thinPass(const PoseSamples& samples, float tolerance, size_t maxK
 
 }  // namespace
 
-ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept) {
+ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept,
+                         std::span<const uint32_t> keepFirst) {
   checkSamples(samples);
-  return thinPass(samples, tolerance, maxKept, principalAxes(samples));
+  checkKeepFirst(samples, keepFirst);
+  ThinningResult r = thinPass(samples, tolerance, maxKept, principalAxes(samples), keepFirst);
+  r.truncated = r.truncated || keepFirst.size() > maxKept;
+  return r;
 }
 
 float nearestKeptDistance(const PoseSamples& samples, const std::vector<uint32_t>& kept, std::span<const float> x) {
@@ -191,10 +207,15 @@ float nearestKeptDistance(const PoseSamples& samples, const std::vector<uint32_t
 
 ThinningResult thinPosesToCount(const PoseSamples& samples, size_t target, const ThinToCountOptions& options) {
   checkSamples(samples);
+  const std::span<const uint32_t> first = options.keepFirst;
+  checkKeepFirst(samples, first);
   const size_t n = samples.size();
   if (target == 0) throw Error("pose thinning: target count must be at least 1");
   if (n == 0) throw Error("pose thinning: no samples to thin");
-  if (target >= n) return thinPoses(samples, 0.f);
+  if (!first.empty() && target <= first.size())
+    throw Error("pose thinning: a target of " + std::to_string(target) + " poses does not grow the " +
+                std::to_string(first.size()) + " already kept");
+  if (target >= n) return thinPoses(samples, 0.f, SIZE_MAX, first);
 
   const auto axes = principalAxes(samples);
   // Upper bound: at twice the largest distance from sample 0, one pose covers everything.
@@ -212,9 +233,9 @@ ThinningResult thinPosesToCount(const PoseSamples& samples, size_t target, const
   const double slack = std::max(options.relativeSlack * double(target), 0.0);
   // A pass at a too-small tolerance is abandoned once it keeps far more than asked.
   const size_t cap = std::max<size_t>(target * 4, target + 16);
-  double countLo = double(cap), countHi = 1.0;  // counts at lo (at least) and at hi
+  double countLo = double(cap), countHi = double(std::max<size_t>(1, first.size()));  // counts at lo (at least), hi
 
-  ThinningResult best = thinPass(samples, float(hi), cap, axes);
+  ThinningResult best = thinPass(samples, float(hi), cap, axes, first);
   int passes = 1;
   auto miss = [&](const ThinningResult& r) {
     return r.truncated ? double(n) : std::abs(double(r.kept.size()) - double(target));
@@ -229,7 +250,7 @@ ThinningResult thinPosesToCount(const PoseSamples& samples, size_t target, const
       f = (std::log(countLo) - std::log(double(target))) / (std::log(countLo) - std::log(countHi));
     f = std::clamp(f, 0.1, 0.9);
     const double mid = std::exp(llo + f * (lhi - llo));
-    ThinningResult r = thinPass(samples, float(mid), cap, axes);
+    ThinningResult r = thinPass(samples, float(mid), cap, axes, first);
     ++passes;
     const bool tooMany = r.truncated || r.kept.size() > target;
     if (miss(r) < miss(best) || (miss(r) == miss(best) && r.tolerance > best.tolerance)) best = r;

@@ -11,6 +11,11 @@
 //    distances, so only kept poses whose projections on the first three principal axes all lie within
 //    the tolerance need an (early-exit) distance check; kept poses are sorted by the first projection.
 // Neither changes the result: it is exactly the plain greedy pass over the samples in order.
+//
+// Growing a thinned set: a pass can start from poses already kept (`keepFirst`, for example the set a
+// smaller bake thinned to). They stay first, in their order, and the pass adds the samples farther
+// than the tolerance from every pose kept so far. A bake that grows its pose count this way keeps the
+// earlier poses' ids, so their simulations are reused (part1.thinning.grow_from).
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -21,20 +26,23 @@
 namespace swish::bake {
 
 struct ThinningResult {
-  std::vector<uint32_t> kept;  // sample indices, ascending (the greedy order)
+  std::vector<uint32_t> kept;  // sample indices: keepFirst as given, then ascending (the greedy order)
   float tolerance = 0.f;
   bool truncated = false;     // stopped early because more than maxKept poses were kept
   size_t distanceChecks = 0;  // full (early-exit) distance evaluations, for benchmarks
   int passes = 1;             // greedy passes run (thinPosesToCount: the search's iterations)
 };
 
-// One greedy pass. maxKept stops the pass once that many are kept (used by the bisection to give up
-// quickly on tolerances that are far too small); the result is then marked truncated.
-ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept = SIZE_MAX);
+// One greedy pass. maxKept stops the pass once that many are kept, keepFirst included (used by the
+// bisection to give up quickly on tolerances that are far too small); the result is then marked
+// truncated. keepFirst: sample indices kept before the pass starts (distinct, each < samples.size()).
+ThinningResult thinPoses(const PoseSamples& samples, float tolerance, size_t maxKept = SIZE_MAX,
+                         std::span<const uint32_t> keepFirst = {});
 
 struct ThinToCountOptions {
   double relativeSlack = 0.02;  // stop when |kept - target| <= slack * target
   int maxIterations = 60;
+  std::vector<uint32_t> keepFirst;  // kept before every pass (see above); the target counts them
 };
 
 // Search on the tolerance for `target` kept poses (bisection in log space, sped up by log-log

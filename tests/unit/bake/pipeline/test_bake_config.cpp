@@ -118,6 +118,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_EQ(d.part1->clips.size(), 1u);
   EXPECT_EQ(d.part1->targetPoses, 200u);
   EXPECT_EQ(d.part1->thinningTolerance, 0.f);
+  EXPECT_EQ(d.part1->growFrom, 0u);
   EXPECT_TRUE(d.part1->includeRestPose);
   EXPECT_EQ(d.part1->inputJoints, defaultInputJointNames());
   EXPECT_EQ(d.part1->simulation.material.name, "jersey");
@@ -199,6 +200,15 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"thinning", {{"target_poses", 1}}}}), "part1.thinning.target_poses: 1 is outside");
   says(part1Error({{"thinning", {{"target_poses", 10}, {"include_rest_pose", 1}}}}),
        "part1.thinning.include_rest_pose");
+  says(part1Error({{"thinning", {{"tolerance", 0.1}, {"grow_from", 10}}}}), "part1.thinning.grow_from: needs");
+  says(part1Error({{"thinning", {{"target_poses", 10}, {"grow_from", 10}}}}),
+       "part1.thinning.grow_from: is 10, not below target_poses (10)");
+  says(part1Error({{"thinning", {{"target_poses", 10}, {"grow_from", 1}}}}), "part1.thinning.grow_from: 1 is outside");
+  EXPECT_EQ(
+      parseBakeConfig({{"output", "o"}, {"part1", part1({{"thinning", {{"target_poses", 40}, {"grow_from", 20}}}})}},
+                      "recipe.json", "/base")
+          .part1->growFrom,
+      20u);
   says(part1Error({{"clips", {"/nonexistent/walk.bvh"}}}), "part1.clips[0]: file /nonexistent/walk.bvh does not exist");
   says(part1Error({{"clips", nlohmann::json::array()}}), "part1.clips: must be a non-empty array");
   says(part1Error({{"clips", {{{"file", kThisFile}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");

@@ -38,8 +38,8 @@ float distance(const PoseSamples& s, size_t a, size_t b) {
 }
 
 // The definition, without acceleration: the reference the fast pass must equal.
-std::vector<uint32_t> bruteForceGreedy(const PoseSamples& s, float tol) {
-  std::vector<uint32_t> kept;
+std::vector<uint32_t> bruteForceGreedy(const PoseSamples& s, float tol, const std::vector<uint32_t>& first = {}) {
+  std::vector<uint32_t> kept = first;
   for (size_t i = 0; i < s.size(); ++i) {
     bool covered = false;
     for (uint32_t k : kept) {
@@ -106,6 +106,40 @@ TEST(PoseThinning, BisectionReachesTargetCount) {
     EXPECT_EQ(thinPoses(s, r.tolerance).kept, r.kept);  // the reported tolerance reproduces the set
   }
   EXPECT_EQ(thinPosesToCount(s, s.size() + 5).kept.size(), s.size());
+}
+
+// Growing a smaller thinning (part1.thinning.grow_from): its poses stay first, in their order (so a bake
+// keeps their ids and simulations), the pass equals the plain greedy pass started from them, and the
+// grown set has both guarantees at its own, smaller tolerance.
+TEST(PoseThinning, GrowingKeepsTheFirstPosesAndCoversAtTheSmallerTolerance) {
+  const PoseSamples s = randomWalks(8, 1500, 30, test::testSeed(12));
+  const ThinningResult small = thinPosesToCount(s, 100);
+  ThinToCountOptions grow;
+  grow.keepFirst = small.kept;
+  const ThinningResult big = thinPosesToCount(s, 300, grow);
+  EXPECT_FALSE(big.truncated);
+  EXPECT_NEAR(double(big.kept.size()), 300.0, 0.03 * 300.0);
+  ASSERT_GT(big.kept.size(), small.kept.size());
+  EXPECT_EQ(std::vector<uint32_t>(big.kept.begin(), big.kept.begin() + long(small.kept.size())), small.kept);
+  EXPECT_LT(big.tolerance, small.tolerance);
+  EXPECT_EQ(thinPoses(s, big.tolerance, SIZE_MAX, small.kept).kept, bruteForceGreedy(s, big.tolerance, small.kept));
+  // Each added pose is farther than the tolerance from every pose kept before it, first ones included.
+  for (size_t a = small.kept.size(); a < big.kept.size(); ++a)
+    for (size_t b = 0; b < a; ++b) EXPECT_GT(distance(s, big.kept[a], big.kept[b]), big.tolerance) << a << " " << b;
+  // Every sample is within the tolerance of a kept pose.
+  for (size_t i = 0; i < s.size(); i += 5) {
+    float nearest = INFINITY;
+    for (uint32_t k : big.kept) nearest = std::min(nearest, distance(s, i, k));
+    EXPECT_LE(nearest, big.tolerance * (1.f + 1e-5f)) << "sample " << i;
+  }
+  // Growing to no more than is already kept, or from a list that is not a set of samples, is an error.
+  EXPECT_THROW(thinPosesToCount(s, 100, grow), Error);
+  ThinToCountOptions bad;
+  bad.keepFirst = {3, 3};
+  EXPECT_THROW(thinPosesToCount(s, 300, bad), Error);
+  bad.keepFirst = {uint32_t(s.size())};
+  EXPECT_THROW(thinPosesToCount(s, 300, bad), Error);
+  EXPECT_THROW(thinPoses(s, 1.f, SIZE_MAX, bad.keepFirst), Error);
 }
 
 TEST(PoseThinning, NearestKeptDistanceIsTheBruteForceMinimum) {

@@ -1,0 +1,59 @@
+// Part 1's pose plan (no simulation): growing a bake's pose list (part1.thinning.grow_from) keeps the
+// smaller bake's poses, rest pose included, with the same ids and the same simulation fingerprints, so
+// a re-run simulates only the poses it adds.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "support/paths.hpp"
+#include "swish/bake/pipeline/bake_config.hpp"
+#include "swish/bake/pipeline/part1_dataset.hpp"
+
+using namespace swish;
+using namespace swish::bake;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kClip = test::debianMocap("01_01.bvh");
+
+DatasetBuildSettings settings(const nlohmann::json& thinning) {
+  const nlohmann::json recipe = {{"name", "grow"},
+                                 {"output", "grow"},
+                                 {"part1",
+                                  {{"character", "default"},
+                                   {"clips", {kClip.string()}},
+                                   {"thinning", thinning},
+                                   {"simulation", {{"vertices", 0}, {"threads", 2}}}}}};
+  return *parseBakeConfig(recipe, "recipe.json", fs::current_path()).part1;
+}
+
+}  // namespace
+
+TEST(Part1Plan, GrowingAPoseListKeepsItsPosesAndTheirSimulations) {
+  if (!fs::exists(kClip)) GTEST_SKIP() << kClip << " is missing (Debian package assimp-testmodels)";
+  const DatasetPosePlan small = planDatasetPoses(settings({{"target_poses", 20}}), {});
+  const DatasetPosePlan grown = planDatasetPoses(settings({{"target_poses", 60}, {"grow_from", 20}}), {});
+  ASSERT_TRUE(small.result.restPoseAdded);  // 01_01 holds no A-pose: the rest pose is pose 20 or so
+  EXPECT_TRUE(grown.result.restPoseAdded);
+  const size_t n = small.toSimulate.size();
+  EXPECT_NEAR(double(n), 21.0, 1.0);
+  EXPECT_NEAR(double(grown.toSimulate.size()), 61.0, 3.0);
+  ASSERT_GT(grown.toSimulate.size(), n);
+
+  const std::vector<uint64_t> a = small.poseFingerprints(), b = grown.poseFingerprints();
+  ASSERT_EQ(b.size(), grown.toSimulate.size());
+  for (size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(a[i], b[i]) << "pose " << i << " of the smaller bake simulates again";
+    EXPECT_EQ(grown.result.origins[i], small.result.origins[i]) << "pose " << i;
+  }
+  EXPECT_EQ(small.settingsJson["rest_pose_id"], grown.settingsJson["rest_pose_id"]);
+  EXPECT_EQ(grown.result.origins[small.settingsJson["rest_pose_id"].get<size_t>()]["clip"], "rest pose");
+  // The added poses are new ones, at the smaller tolerance the larger count needs.
+  for (size_t i = n; i < b.size(); ++i)
+    for (size_t j = 0; j < n; ++j) EXPECT_NE(b[i], a[j]) << "pose " << i << " repeats pose " << j;
+  EXPECT_LT(grown.result.tolerance, small.result.tolerance);
+  // The dataset records the growth (a different pose list: its files are rebuilt, its simulations kept).
+  EXPECT_EQ(grown.settingsJson["thinning"]["grow_from"], 20);
+  EXPECT_FALSE(small.settingsJson["thinning"].contains("grow_from"));
+}
