@@ -127,7 +127,18 @@ TEST_F(ReplayE2E, RenderDrawsFramesAContactSheetAndSaysWhatTheyShow) {
   const fs::path dir = dir_ / "out/render";
   const replay::ReplayRenderResult r = replay::renderReplayFrames(s, models, dir, ro);
   ASSERT_EQ(r.frames.size(), 2u);
-  for (const fs::path& f : r.frames) EXPECT_TRUE(fs::exists(f)) << f;
+  for (const fs::path& f : r.frames) {
+    // Each frame at the asked size (`swish replay --render-size`): the PNG header's width and height.
+    std::ifstream png(f, std::ios::binary);
+    unsigned char header[24] = {};
+    ASSERT_TRUE(png.read(reinterpret_cast<char*>(header), sizeof header)) << f;
+    auto be32 = [&](int at) {
+      return uint32_t(header[at]) << 24 | uint32_t(header[at + 1]) << 16 | uint32_t(header[at + 2]) << 8 |
+             header[at + 3];
+    };
+    EXPECT_EQ(be32(16), 64u) << f;
+    EXPECT_EQ(be32(20), 80u) << f;
+  }
   EXPECT_EQ(r.contactSheet, dir / "contact_sheet.png");
   EXPECT_TRUE(fs::exists(r.contactSheet));
   EXPECT_TRUE(r.heatSheet.empty());

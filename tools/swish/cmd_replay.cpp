@@ -43,6 +43,7 @@ struct ReplayCliOptions {
   std::string scene, out, device;
   bool plan = false, quiet = false, validation = false, render = false;
   uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16, penetrationEvery = 30;
+  std::vector<uint32_t> renderSize = {320, 426};
   bool pushOut = false, noPushOut = false, noGuard = false, hideCoveredBody = false, showCoveredBody = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
@@ -221,6 +222,8 @@ int runReplay(const ReplayCliOptions& o) {
     replay::ReplayRenderOptions ro;
     ro.character = o.renderCharacter;
     ro.maxFrames = o.renderFrames;
+    ro.width = o.renderSize[0];
+    ro.height = o.renderSize[1];
     ro.device = o.device;
     ro.validation = o.validation;
     ro.truth = jo.engine.truth;
@@ -308,6 +311,11 @@ swish::cli::CommandRegistration reg{
                      "scene character index to draw with --render (default 0)");
       app.add_option("--render-frames", o->renderFrames, "at most this many frames, spread over the scene (default 16)")
           ->check(CLI::Range(1u, 10000u));
+      app.add_option("--render-size", o->renderSize,
+                     "WIDTH HEIGHT of each frame in pixels (default 320 426; the contact sheet holds 16 of them): "
+                     "larger to look at a fault up close")
+          ->expected(2)
+          ->check(CLI::Range(16u, 4096u));
       return [o] { return runReplay(*o); };
     }};
 
