@@ -170,6 +170,16 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     EXPECT_DOUBLE_EQ(subjects.levels.levels.back().vertexMeanMm, subjects.overall.meanSkinnedMm.mean);
     EXPECT_TRUE(std::isnan(subjects.levels.levels[0].cpuUsPerCharacter));  // it goes into the metadata too
     EXPECT_TRUE(subjects.toJson().contains("quality_levels"));
+    // The part of the subject's error that is the same in all its frames: never more than the error
+    // (|mean of e| <= mean of |e|), and not 0 on 16 poses of a network that does not fit them exactly.
+    ASSERT_EQ(subjects.perSubject.size(), 1u);
+    EXPECT_EQ(subjects.perSubject[0].subject, "99");
+    EXPECT_EQ(subjects.perSubject[0].poses, 16u);
+    EXPECT_GT(subjects.perSubject[0].systematicMm, 0.0);
+    EXPECT_LE(subjects.perSubject[0].systematicMm, subjects.perSubject[0].errorMm * (1 + 1e-9));
+    EXPECT_GT(subjects.perSubject[0].errorMm, 0.0);
+    EXPECT_EQ(subjects.toJson()["per_subject_systematic"][0]["systematic_mm"].get<double>(),
+              subjects.perSubject[0].systematicMm);
     const auto sdir = tmp / "report_subjects";
     const auto smd = writeBakeReport(out, ds, sdir, 0, &subjects);
     const auto sreport = nlohmann::json::parse(std::ifstream(sdir / "report.json"));
@@ -177,6 +187,9 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     std::ifstream mdIn(smd);
     const std::string text((std::istreambuf_iterator<char>(mdIn)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("held-out subjects mean mm"), std::string::npos) << text;
+    EXPECT_NE(text.find("| subject | poses | error mm (pre-skinning) | the same in every frame mm | share |"),
+              std::string::npos)
+        << text;
     // Their frames against the body too, beside the random frames: penetration of truth and model, and
     // the error with the push-out (the model has anchors).
     ASSERT_TRUE(subjects.overall.penetrationMeasured);

@@ -59,18 +59,20 @@ DistanceStats distanceStats(std::vector<double> v) {
   return s;
 }
 
-Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut) {
+Points3f predictPreSkin(const Model& model, const Pose& pose) {
   const runtime::MlpEvaluator mlp(model);
   const runtime::NoveltyGuardEvaluator guard(model);
   std::vector<float> lambda(size_t(mlp.outputSize()));
   const std::vector<float> theta = runtime::computeTheta(model.inputJoints, pose.local);
   mlp.evaluate(theta, lambda);
   guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(model.meshComponents())));
+  return runtime::referencePcaReconstruct(model.meshPca,
+                                          std::span<const float>(lambda.data(), size_t(model.meshComponents())));
+}
+
+Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut) {
   const auto mats = model.skeleton.skinningMatrices(pose);
-  Points3f p =
-      runtime::referenceSkin(runtime::referencePcaReconstruct(
-                                 model.meshPca, std::span<const float>(lambda.data(), size_t(model.meshComponents()))),
-                             model.gameMesh.skin, mats);
+  Points3f p = runtime::referenceSkin(predictPreSkin(model, pose), model.gameMesh.skin, mats);
   if (pushOut && !model.bodyAnchors.empty()) runtime::referencePushOut(p, model.bodyAnchors, mats);
   return p;
 }

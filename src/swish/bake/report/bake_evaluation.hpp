@@ -76,6 +76,9 @@ nlohmann::json penetrationJson(const BakeEvaluation& ev);
 // The model's skinned garment for a pose through the runtime path (Theta -> MLP -> PCA -> skinning, then
 // the push-out when asked and the model has body anchors).
 Points3f predictPositions(const Model& model, const Pose& pose, bool pushOut);
+// The same garment before skinning (pre-skinning space, as DatasetPose::gameMeshPreSkin): the PCA
+// reconstruction of the network's (guarded) mesh weights.
+Points3f predictPreSkin(const Model& model, const Pose& pose);
 
 // body (optional): the character's body, skinned to the model's skeleton: penetration is measured.
 BakeEvaluation evaluateModel(const Model& model, const std::vector<const DatasetPose*>& heldOut,

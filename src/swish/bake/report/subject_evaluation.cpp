@@ -22,6 +22,37 @@ std::string f2(double v) {
   std::snprintf(b, sizeof b, "%.2f", v);
   return b;
 }
+// SubjectEvaluation::perSubject: per subject (origins' "subject", in name order), the mean error and the
+// part of it that is the same in every frame (pre-skinning space).
+std::vector<SubjectEvaluation::Subject> systematicErrors(const Model& model,
+                                                         const std::vector<const DatasetPose*>& poses,
+                                                         const nlohmann::json& origins) {
+  struct Sum {
+    Eigen::MatrixXd offset;  // per vertex, summed error vectors
+    double error = 0.0;      // summed |error| over poses and vertices
+    size_t poses = 0;
+  };
+  std::map<std::string, Sum> sums;
+  for (const DatasetPose* p : poses) {
+    const std::string subject = origins.is_array() && p->id < origins.size()
+                                    ? origins[p->id].value("subject", std::string("?"))
+                                    : std::string("?");
+    const Points3f d = predictPreSkin(model, p->pose) - p->gameMeshPreSkin;
+    Sum& s = sums[subject];
+    if (s.poses == 0) s.offset = Eigen::MatrixXd::Zero(d.rows(), 3);
+    s.offset += d.cast<double>();
+    s.error += d.cast<double>().rowwise().norm().sum();
+    ++s.poses;
+  }
+  std::vector<SubjectEvaluation::Subject> out;
+  for (const auto& [subject, s] : sums) {
+    const double n = double(s.offset.rows());
+    out.push_back({subject, s.poses, 1000.0 * s.error / (n * double(s.poses)),
+                   1000.0 * (s.offset / double(s.poses)).rowwise().norm().sum() / n});
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json evaluationSummary(const BakeEvaluation& ev) {
@@ -45,6 +76,13 @@ nlohmann::json SubjectEvaluation::toJson() const {
                       {"poses_planned", posesPlanned},
                       {"overall", evaluationSummary(overall)},
                       {"per_clip", clips}};
+  nlohmann::json subj = nlohmann::json::array();
+  for (const Subject& x : perSubject)
+    subj.push_back({{"subject", x.subject},
+                    {"poses", x.poses},
+                    {"pre_skin_error_mm", x.errorMm},
+                    {"systematic_mm", x.systematicMm}});
+  j["per_subject_systematic"] = subj;
   if (overall.penetrationMeasured) j["penetration"] = penetrationJson(overall);
   if (!guard.rows.empty()) j["novelty_guard_study"] = guard.toJson();
   if (levels.measured()) j["quality_levels"] = runtime::toJson(levels);
@@ -213,6 +251,17 @@ std::string SubjectEvaluation::markdown(const BakeEvaluation& random) const {
   md << "\nHeld-out subjects over random frames (mean): "
      << (random.totalMm.mean > 0 ? f2(overall.totalMm.mean / random.totalMm.mean) + "x" : std::string("-"))
      << ". Clips whose p95 is worse than the rest shape skinned: " << worse << " of " << perClip.size() << ".\n\n";
+  if (!perSubject.empty()) {
+    md << "How much of each subject's error is the same in all its frames (pre-skinning space: the mean error "
+          "vector per vertex over the subject's poses, against the mean error there). A large share is an offset "
+          "the corpus does not teach (this subject's posture, or another fold the truth puts the garment in), "
+          "not its motion:\n\n| subject | poses | error mm (pre-skinning) | the same in every frame mm | share |\n"
+          "|---|---|---|---|---|\n";
+    for (const Subject& x : perSubject)
+      md << "| " << x.subject << " | " << x.poses << " | " << f2(x.errorMm) << " | " << f2(x.systematicMm) << " | "
+         << (x.errorMm > 0 ? f2(100.0 * x.systematicMm / x.errorMm) + " %" : std::string("-")) << " |\n";
+    md << "\n";
+  }
   if (!guard.rows.empty()) md << guard.markdown();
   return md.str();
 }
@@ -245,6 +294,7 @@ SubjectEvaluation evaluateHeldOutSubjects(const BakeTrainOutput& out, const Data
   // The body too, as for the random held-out frames: penetration, and the error with the push-out.
   const Mesh* body = holdout.character.body.triangleCount() > 0 ? &holdout.character.body : nullptr;
   r.overall = evaluateModel(out.model, all, out.databaseMaps, normalPca, body);
+  r.perSubject = systematicErrors(out.model, all, origins);
   for (const auto& [clip, entry] : byClip)
     r.perClip.push_back({clip, entry.first, evaluateModel(out.model, entry.second, out.databaseMaps, normalPca)});
   std::vector<const DatasetPose*> trained, random;

@@ -56,6 +56,18 @@ struct SubjectEvaluation {
     BakeEvaluation evaluation;
   };
   std::vector<Clip> perClip;
+  // Per held-out subject, how much of the error is the same in every one of its frames: the mean over
+  // its poses of the per-vertex error vector, in pre-skinning space (where a garment that sits
+  // differently on this subject's posture is the same offset whatever the limbs do), against the mean
+  // error there. A large share says the corpus lacks this subject's way of standing (or the truth sits
+  // it in another fold), not its motion; |mean of the errors| <= mean of |errors| bounds it.
+  struct Subject {
+    std::string subject;
+    size_t poses = 0;
+    double errorMm = 0.0;       // mean over poses and vertices of |predicted - truth|, pre-skinning space
+    double systematicMm = 0.0;  // mean over vertices of |mean over poses of (predicted - truth)|
+  };
+  std::vector<Subject> perSubject;
   GuardStudy guard;
   // The model's quality levels (the random held-out frames' ladder, BakeTrainOutput::ladder) on the
   // held-out subjects' frames: errors only (the times are the same work, in the ladder).
