@@ -260,7 +260,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   // Set only where used, so that recipes without them keep their datasets.
   if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
   if (evenPoses > 0) out["even_poses"] = evenPoses;
-  if (growFrom > 0) out["thinning"]["grow_from"] = growFrom;
+  if (growFrom > 0 && evenPoses == 0) out["thinning"]["grow_from"] = growFrom;
   // Only when overridden, so that the settings (and so the datasets) of other bakes stay as they were.
   const auto& presets = clothMaterialPresets();
   const auto preset =
@@ -408,7 +408,7 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   }
   // Growing a smaller bake's pose list: its poses (and its rest pose) keep their ids, so their
   // simulations are reused; a second greedy pass at a smaller tolerance adds the rest after them.
-  if (s.growFrom > 0) {
+  if (s.growFrom > 0 && s.evenPoses == 0) {
     const auto t2 = Clock::now();
     const size_t first = thin.kept.size();
     const float firstTolerance = thin.tolerance;

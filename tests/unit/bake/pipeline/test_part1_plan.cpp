@@ -56,4 +56,12 @@ TEST(Part1Plan, GrowingAPoseListKeepsItsPosesAndTheirSimulations) {
   // The dataset records the growth (a different pose list: its files are rebuilt, its simulations kept).
   EXPECT_EQ(grown.settingsJson["thinning"]["grow_from"], 20);
   EXPECT_FALSE(small.settingsJson["thinning"].contains("grow_from"));
+
+  // Evenly spaced frames (the held-out subjects' dataset, made from the same settings) are not thinned,
+  // so there is nothing to grow: the frames as asked.
+  DatasetBuildSettings even = settings({{"target_poses", 60}, {"grow_from", 20}});
+  even.evenPoses = 30;
+  const DatasetPosePlan evenPlan = planDatasetPoses(even, {});
+  EXPECT_EQ(evenPlan.toSimulate.size(), 30u);
+  EXPECT_FALSE(evenPlan.settingsJson["thinning"].contains("grow_from"));
 }
