@@ -292,6 +292,13 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"tolerance", tolerance},
           {"poses_corrected", posesCorrected},
           {"max_correction_degrees", maxCorrectionDegrees},
+          {"corrections_by_joint",
+           [&] {
+             nlohmann::json j = nlohmann::json::object();
+             for (const auto& [joint, c] : correctionsByJoint)
+               j[joint] = {{"poses", c.poses}, {"mean_degrees", c.meanDegrees}, {"max_degrees", c.maxDegrees}};
+             return j;
+           }()},
           {"max_correction_towards_rest", maxTowardsRest},
           {"simulation_vertices", simulationVertices},
           {"simulated", simulated},
@@ -451,7 +458,19 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
       for (const LimbCorrection& x : c) {
         res.maxCorrectionDegrees = std::max(res.maxCorrectionDegrees, x.degrees);
         if (x.depthAfter > 0.f) ++stillInside;
+        DatasetBuildResult::JointCorrections& j = res.correctionsByJoint[x.joint];
+        ++j.poses;
+        j.meanDegrees += double(x.degrees);  // a sum until divided below
+        j.maxDegrees = std::max(j.maxDegrees, double(x.degrees));
       }
+    }
+    std::string byJoint;
+    for (auto& [joint, j] : res.correctionsByJoint) {
+      j.meanDegrees /= double(std::max<size_t>(1, j.poses));
+      char one[160];
+      std::snprintf(one, sizeof one, "%s%s %zu poses (mean %.0f, max %.0f degrees)", byJoint.empty() ? "" : ", ",
+                    joint.c_str(), j.poses, j.meanDegrees, j.maxDegrees);
+      byJoint += one;
     }
     if (!clearance.skipped().empty()) log("part 1: limb clearance skipped: " + clearance.skipped());
     char line[240];
@@ -462,6 +481,7 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
                     1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
                     double(res.maxCorrectionDegrees), stillInside, since(t));
     if (clearance.limbCount() > 0) log(line);
+    if (!byJoint.empty()) log("part 1: turned out, by joint: " + byJoint);
     if (clearance.checksHead()) {
       for (const auto& c : corrections)
         for (const LimbCorrection& x : c) res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);

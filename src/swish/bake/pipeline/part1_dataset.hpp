@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -149,6 +150,13 @@ struct DatasetBuildResult {
   bool restPoseAdded = false;  // the rest pose was appended to the thinned poses (after the first stage's)
   size_t posesCorrected = 0;   // poses whose limbs (or one-surface head) were turned out of the body
   float maxCorrectionDegrees = 0.f;
+  // Per root joint turned (limb clearance): in how many poses, by how much (mean and largest degrees).
+  // Tells which of the body's limbs its clips put through the trunk (the mannequin's hanging arms).
+  struct JointCorrections {
+    size_t poses = 0;
+    double meanDegrees = 0.0, maxDegrees = 0.0;
+  };
+  std::map<std::string, JointCorrections> correctionsByJoint;
   float maxTowardsRest = 0.f;  // head clearance: the largest fraction of the neck turned back to rest
   float tolerance = 0.f;       // the thinning tolerance used
   size_t simulationVertices = 0;

@@ -57,6 +57,23 @@ TEST(Part1Plan, GrowingAPoseListKeepsItsPosesAndTheirSimulations) {
   EXPECT_EQ(grown.settingsJson["thinning"]["grow_from"], 20);
   EXPECT_FALSE(small.settingsJson["thinning"].contains("grow_from"));
 
+  // Which limbs the clearance turned out of the trunk, per joint: 01_01 hangs its arms, which the
+  // mannequin's arm tubes cannot do outside its torso. Every corrected pose names at least one joint.
+  const auto& byJoint = grown.result.correctionsByJoint;
+  ASSERT_FALSE(byJoint.empty());
+  size_t sum = 0;
+  for (const auto& [joint, c] : byJoint) {
+    EXPECT_GT(c.poses, 0u) << joint;
+    EXPECT_LE(c.poses, grown.result.posesCorrected) << joint;
+    EXPECT_GT(c.meanDegrees, 0.0) << joint;
+    EXPECT_LE(c.meanDegrees, c.maxDegrees) << joint;
+    EXPECT_LE(c.maxDegrees, double(grown.result.maxCorrectionDegrees) + 1e-6) << joint;
+    sum += c.poses;
+  }
+  EXPECT_GE(sum, grown.result.posesCorrected);
+  EXPECT_TRUE(byJoint.count("LeftArm") + byJoint.count("RightArm") > 0);
+  EXPECT_EQ(grown.result.toJson()["corrections_by_joint"].size(), byJoint.size());
+
   // Evenly spaced frames (the held-out subjects' dataset, made from the same settings) are not thinned,
   // so there is nothing to grow: the frames as asked.
   DatasetBuildSettings even = settings({{"target_poses", 60}, {"grow_from", 20}});
