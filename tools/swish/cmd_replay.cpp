@@ -43,7 +43,8 @@ struct ReplayCliOptions {
   std::string scene, out, device;
   bool plan = false, quiet = false, validation = false, render = false;
   uint32_t truthEvery = 0, frames = 0, renderCharacter = 0, renderFrames = 16, penetrationEvery = 30;
-  std::vector<uint32_t> renderSize = {320, 426};
+  std::vector<uint32_t> renderSize = {swish::replay::ReplayRenderOptions{}.width,
+                                      swish::replay::ReplayRenderOptions{}.height};
   bool pushOut = false, noPushOut = false, noGuard = false, hideCoveredBody = false, showCoveredBody = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
@@ -312,8 +313,11 @@ swish::cli::CommandRegistration reg{
       app.add_option("--render-frames", o->renderFrames, "at most this many frames, spread over the scene (default 16)")
           ->check(CLI::Range(1u, 10000u));
       app.add_option("--render-size", o->renderSize,
-                     "WIDTH HEIGHT of each frame in pixels (default 320 426; the contact sheet holds 16 of them): "
-                     "larger to look at a fault up close")
+                     "WIDTH HEIGHT of each frame in pixels (default " +
+                         std::to_string(swish::replay::ReplayRenderOptions{}.width) + " " +
+                         std::to_string(swish::replay::ReplayRenderOptions{}.height) +
+                         "; the contact sheet holds 16 of them): "
+                         "larger to look at a fault up close")
           ->expected(2)
           ->check(CLI::Range(16u, 4096u));
       return [o] { return runReplay(*o); };
