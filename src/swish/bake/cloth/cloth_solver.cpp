@@ -20,6 +20,15 @@ namespace swish::bake {
 namespace {
 
 using Affine34 = Eigen::Matrix<float, 3, 4>;
+
+// Where on the garment something happened, for errors: the vertex, its strongest joint and its rest position.
+std::string describeVertex(const SimulationMesh& mesh, const Skeleton& skeleton, uint32_t v) {
+  const Vec3f p = mesh.restPositions.row(v);
+  char at[96];
+  std::snprintf(at, sizeof at, " (rest %.3f %.3f %.3f)", p.x(), p.y(), p.z());
+  return "simulation vertex " + std::to_string(v) + ", near joint '" +
+         skeleton.joints[mesh.skin.strongestJoint(v)].name + "'" + at;
+}
 // How far from the body a band vertex may be to be anchored to it (m).
 constexpr float kAnchorReach = 0.1f;
 // Band vertices this close to a body part other than the trunk are not attached (m); over the next
@@ -219,9 +228,9 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
     if (p > worst) worst = p, worstVertex = v;
   }
   if (worst - settings_.thickness > settings_.failPenetration)
-    throw Error("garment of character '" + ch.name + "' starts inside the body: simulation vertex " +
-                std::to_string(worstVertex) + " is " + std::to_string(worst - settings_.thickness) +
-                " m below the body surface in the rest pose");
+    throw Error("garment of character '" + ch.name +
+                "' starts inside the body: " + describeVertex(mesh_, skeleton_, worstVertex) + " is " +
+                std::to_string(worst - settings_.thickness) + " m below the body surface in the rest pose");
 
   Fnv1a f;
   // The solver's own revision: results of an older solver are never resumed into a new run.
@@ -360,13 +369,7 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown) const
     return out;
   };
   // Where on the garment a failure happened: the vertex, its strongest joint and its rest position.
-  auto whereIs = [&](uint32_t v) {
-    const Vec3f p = mesh_.restPositions.row(v);
-    char at[96];
-    std::snprintf(at, sizeof at, " (rest %.3f %.3f %.3f)", p.x(), p.y(), p.z());
-    return "at simulation vertex " + std::to_string(v) + ", near joint '" +
-           skeleton_.joints[mesh_.skin.strongestJoint(v)].name + "'" + at;
-  };
+  auto whereIs = [&](uint32_t v) { return "at " + describeVertex(mesh_, skeleton_, v); };
   out.retryable = false;  // bad input: no other setting can help
   if (target.local.size() != skeleton_.size())
     return fail("pose has " + std::to_string(target.local.size()) + " joint rotations, the skeleton has " +

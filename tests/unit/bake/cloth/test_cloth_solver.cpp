@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "support/cloth_fixture.hpp"
+#include "support/error_message.hpp"
 #include "support/random_model.hpp"
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/body_collider.hpp"
@@ -657,7 +658,13 @@ TEST(ClothSolver, RejectsAGarmentInsideTheBody) {
   test::CapsuleSpec spec;
   spec.gap = -0.03f;  // the tube 3 cm inside the capsule
   const Character ch = test::capsuleCharacter(spec);
-  EXPECT_THROW(ClothSolver(ch, buildSimulationMesh(ch, 0), quickSettings()), Error);
+  const std::string e = test::errorOf([&] { ClothSolver(ch, buildSimulationMesh(ch, 0), quickSettings()); });
+  // Says where, so that a person editing a character's recipe can find the spot: the vertex, its joint
+  // and its rest position.
+  EXPECT_NE(e.find("starts inside the body: simulation vertex "), std::string::npos) << e;
+  EXPECT_NE(e.find(", near joint '"), std::string::npos) << e;
+  EXPECT_NE(e.find("(rest "), std::string::npos) << e;
+  EXPECT_NE(e.find(" m below the body surface"), std::string::npos) << e;
 }
 
 // The end condition: frames at the goal pose until the residual (the unbalanced share of gravity's
