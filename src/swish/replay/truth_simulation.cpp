@@ -175,7 +175,8 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
           cs.material.name + "', " + std::to_string(cs.substeps) + " substeps x " + std::to_string(cs.iterations) +
           " iterations at " + fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) +
           " s transition + " + fmtNum("%g", cs.settleSeconds) + " s settle, limb clearance " +
-          fmtNum("%g", 1000.0 * ps.limbClearance.clearance) + " mm, smoothing " +
+          fmtNum("%g", 1000.0 * ps.limbClearance.clearance) + " mm (trunk within " +
+          fmtNum("%g", 1000.0 * ps.limbClearance.garmentReach) + " mm of the garment; 0: all), smoothing " +
           std::to_string(ps.transfer.smoothing.iterations) + " x " + fmtNum("%g", ps.transfer.smoothing.strength) +
           (overridden.empty() ? std::string() : "; overridden for this run (not the bake's):" + overridden) + mapNote;
 }

@@ -91,6 +91,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "threads",
                                                   "gravity",
                                                   "limb_clearance",
+                                                  "limb_garment_reach",
                                                   "attach_band",
                                                   "equilibrium_tolerance",
                                                   "equilibrium_seconds",
@@ -134,6 +135,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   cs.gravity = Vec3f(0.f, -float(sim.number("gravity", 0, 100, -cs.gravity.y())), 0.f);
   // Metres kept between a limb and the trunk (limb_clearance.hpp); 0 leaves the poses as recorded.
   s.limbClearance.clearance = float(sim.number("limb_clearance", 0, 0.1, s.limbClearance.clearance));
+  // Only the trunk within this of the garment at rest is kept clear (limb_clearance.hpp); 0: all of it.
+  s.limbClearance.garmentReach = float(sim.number("limb_garment_reach", 0, 1, s.limbClearance.garmentReach));
   // The top band of the garment held on the body (share of its rest height; cloth_solver.hpp).
   cs.attachTopFraction = float(sim.number("attach_band", 0, 0.5, cs.attachTopFraction));
   // The end condition (cloth_solver.hpp): frames at the goal pose until the residual (the unbalanced
@@ -272,6 +275,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
     s.simulation.retries = 0;
     s.simulation.finalProjection = false;
   }
+  // Settings recorded before the limb clearance looked only under the garment kept the whole trunk clear.
+  if (sim.is_object() && !sim.contains("limb_garment_reach")) s.limbClearance.garmentReach = 0.f;
   return s.poseShape();
 }
 

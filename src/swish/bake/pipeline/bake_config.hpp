@@ -32,6 +32,7 @@
 //                      "transition_seconds", "settle_seconds",
 //                      "frame_rate", "substeps", "iterations", "threads", "gravity" (m/s^2 along -Y),
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
+//                      "limb_garment_reach" (m: only the trunk this near the garment is kept clear, 0: all),
 //                      "attach_band" (top share of the garment's height held on the body),
 //                      "equilibrium_tolerance", "equilibrium_seconds", "equilibrium_iterations" (the
 //                      end condition: cloth_solver.hpp), "static_solve" (true: a Newton static solve

@@ -244,6 +244,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
         {"final_projection", m.finalProjection},
         {"gravity", -m.gravity.y()},
         {"limb_clearance", limbClearance.clearance},
+        {"limb_garment_reach", limbClearance.garmentReach},
         {"attach_band", m.attachTopFraction}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength},
@@ -473,13 +474,16 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
       byJoint += one;
     }
     if (!clearance.skipped().empty()) log("part 1: limb clearance skipped: " + clearance.skipped());
-    char line[240];
+    char line[320];
     if (clearance.limbCount() > 0)
-      std::snprintf(line, sizeof line,
-                    "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk (%zu limbs of the body "
-                    "checked); turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
-                    1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
-                    double(res.maxCorrectionDegrees), stillInside, since(t));
+      std::snprintf(
+          line, sizeof line,
+          "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk where the garment is (%zu "
+          "limbs of the body checked, %zu of the trunk's %zu triangles within %.0f mm of the garment); "
+          "turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
+          1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
+          clearance.guardedTriangles(), clearance.trunkTriangles(), 1000.0 * s.limbClearance.garmentReach,
+          double(res.maxCorrectionDegrees), stillInside, since(t));
     if (clearance.limbCount() > 0) log(line);
     if (!byJoint.empty()) log("part 1: turned out, by joint: " + byJoint);
     if (clearance.checksHead()) {

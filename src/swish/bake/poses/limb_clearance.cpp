@@ -50,6 +50,28 @@ int smallestClearing(int most, float before, DepthAt&& depthAt, float& after) {
   return hi;
 }
 
+// Per triangle of `trunk` (rest positions of `body`): whether a corner or the centroid lies within
+// `reach` of a vertex of `garment` (rest positions). Vertices sorted by height, so each point looks
+// only at the band of garment vertices `reach` above and below it.
+std::vector<char> trianglesNearGarment(const Points3f& body, const Triangles& trunk, const Points3f& garment,
+                                       float reach) {
+  std::vector<std::pair<float, uint32_t>> byY(size_t(garment.rows()));
+  for (Eigen::Index v = 0; v < garment.rows(); ++v) byY[size_t(v)] = {garment(v, 1), uint32_t(v)};
+  std::sort(byY.begin(), byY.end());
+  auto near = [&](const Vec3f& p) {
+    auto it = std::lower_bound(byY.begin(), byY.end(), std::make_pair(p.y() - reach, uint32_t(0)));
+    for (; it != byY.end() && it->first <= p.y() + reach; ++it)
+      if ((garment.row(it->second).transpose() - p).squaredNorm() <= reach * reach) return true;
+    return false;
+  };
+  std::vector<char> out(size_t(trunk.rows()), 0);
+  for (Eigen::Index t = 0; t < trunk.rows(); ++t) {
+    const Vec3f a = body.row(trunk(t, 0)), b = body.row(trunk(t, 1)), c = body.row(trunk(t, 2));
+    out[size_t(t)] = near(a) || near(b) || near(c) || near((a + b + c) / 3.f);
+  }
+  return out;
+}
+
 int depthOf(const Skeleton& s, int j) {
   int d = 0;
   while (s.joints[size_t(j)].parent >= 0) j = s.joints[size_t(j)].parent, ++d;
@@ -69,6 +91,7 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   check(std::isfinite(settings_.rootRadius) && settings_.rootRadius >= 0.f, "rootRadius must be >= 0");
   check(std::isfinite(settings_.maxDegrees) && settings_.maxDegrees > 0.f && settings_.maxDegrees <= 180.f,
         "maxDegrees must be in (0, 180]");
+  check(std::isfinite(settings_.garmentReach) && settings_.garmentReach >= 0.f, "garmentReach must be >= 0");
   body_.validate(what, skeleton_.size());
   if (body_.skin.vertexCount() != body_.vertexCount())
     throw Error(what + " has no skin weights: limbs cannot be posed");
@@ -100,6 +123,9 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
                " edges not shared by two triangles): inside and outside are undefined";
     return;
   }
+  guarded_.assign(size_t(trunk_->triangles().rows()), 1);
+  if (settings_.garmentReach > 0.f && ch.garment.vertexCount() > 0 && ch.garment.positions.allFinite())
+    guarded_ = trianglesNearGarment(body_.positions, trunk_->triangles(), ch.garment.positions, settings_.garmentReach);
   const Pose rest = skeleton_.restPose();
   BodyCollider trunkCollider = *trunk_;
   trunkCollider.pose(skeleton_.skinningMatrices(rest));
@@ -142,6 +168,8 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   }
 }
 
+size_t LimbClearance::guardedTriangles() const { return size_t(std::count(guarded_.begin(), guarded_.end(), char(1))); }
+
 std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   std::vector<LimbCorrection> out;
   if ((limbs_.empty() && !head_) || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite())
@@ -176,7 +204,7 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
         const Vec3f x = b.topLeftCorner<3, 3>() * body_.positions.row(v).transpose() + b.topRightCorner<3, 1>();
         const float want = std::min(settings_.clearance, limb.restDistance[i]);
         const BodyCollider::Hit hit = trunk.closest(x, want + kSearch);
-        if (!hit.found) continue;
+        if (!hit.found || !guarded_[size_t(hit.triangle)]) continue;
         const float d = want - hit.signedDistance;
         if (!(d > 0.f)) continue;
         worst = std::max(worst, d);

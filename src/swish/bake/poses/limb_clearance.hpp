@@ -10,6 +10,11 @@
 // leaves a clearance, just as datasets of simulated clothing filter or correct self-intersecting
 // body poses. The bake simulates the corrected pose and stores the recorded one (part1_dataset.cpp).
 //
+// Only where the garment is: a limb counts as inside the trunk where the trunk's surface nearest it lies
+// within garmentReach of the garment at rest. Cloth cannot be pinched where there is none, and a
+// limb turned out for nothing moves the garment's simulated shape away from the recorded pose's (the
+// thighs of the embedded mannequin touch its crotch, 7 cm below the jersey's hem, in most strides).
+//
 // Parts are the body's connected components; the trunk is the one with the most triangles. A limb's
 // root joint is the shallowest joint carrying a tenth of its skin weight. Only limb vertices that lie
 // outside the trunk in the rest pose and farther than rootRadius from the root joint are checked:
@@ -43,6 +48,10 @@ struct LimbClearanceSettings {
   float clearance = 0.015f;  // m between a limb and the trunk: room for two layers of cloth
   float rootRadius = 0.10f;  // m: limb vertices this close to their root joint are not checked
   float maxDegrees = 60.f;   // the largest correction; a limb still inside after it is reported
+  // m: only the trunk surface within this distance of the garment at rest is kept clear, where a limb
+  // can pinch the cloth (the hem can ride up this far). A thigh against the crotch, below a jersey's
+  // hem, is left as recorded. 0, or a character without a garment: the whole trunk.
+  float garmentReach = 0.03f;
   float headBorder =
       0.03f;  // m: one-surface bodies' head vertices this close to the rest of the body at rest are not checked
 };
@@ -67,6 +76,9 @@ class LimbClearance {
   std::vector<LimbCorrection> apply(Pose& pose) const;
 
   size_t limbCount() const { return limbs_.size(); }
+  // Trunk triangles kept clear (within garmentReach of the garment), of how many.
+  size_t guardedTriangles() const;
+  size_t trunkTriangles() const { return guarded_.size(); }
   // Why no limb is checked (empty when some are).
   const std::string& skipped() const { return skipped_; }
   // Whether the head of a one-surface body is checked (see above), and how many of its vertices.
@@ -82,6 +94,7 @@ class LimbClearance {
   Skeleton skeleton_;
   Mesh body_;
   std::optional<BodyCollider> trunk_;  // the trunk alone, unposed: copied and posed per pose
+  std::vector<char> guarded_;          // per trunk triangle (trunk_'s numbering): near the garment at rest
   LimbClearanceSettings settings_;
   std::vector<Limb> limbs_;
   std::string skipped_;

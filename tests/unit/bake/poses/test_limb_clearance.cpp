@@ -77,6 +77,45 @@ TEST(LimbClearance, RestPoseOfTheMannequinNeedsNoCorrection) {
   EXPECT_TRUE(lc.apply(p).empty());
 }
 
+// Cloth is only pinched where there is cloth: a thigh drawn in towards the other (20 degrees) touches
+// the mannequin's crotch, 7 cm below the jersey's hem, and stays as recorded; with the whole trunk kept
+// clear (garmentReach 0, the behaviour before) it was turned out. A thigh raised to the belly (90
+// degrees, sitting), under the hem, is still turned out.
+TEST(LimbClearance, OnlyTheTrunkUnderTheGarmentIsKeptClear) {
+  const Character& c = mannequin();
+  const Skeleton& s = c.skeleton;
+  const int thigh = s.find("LeftUpLeg");
+  auto turned = [&](const Vec3f& axis, float degrees) {
+    Pose p = s.restPose();
+    p.local[size_t(thigh)] = Quatf(Eigen::AngleAxisf(-degrees * float(M_PI) / 180.f, axis));
+    return p;
+  };
+  const LimbClearanceSettings defaults;
+  LimbClearanceSettings whole;
+  whole.garmentReach = 0.f;
+  const LimbClearance underGarment(c, defaults), everywhere(c, whole);
+  EXPECT_EQ(everywhere.guardedTriangles(), everywhere.trunkTriangles());
+  EXPECT_LT(underGarment.guardedTriangles(), underGarment.trunkTriangles());
+  EXPECT_GT(underGarment.guardedTriangles(), underGarment.trunkTriangles() / 2);
+
+  Pose crossing = turned(Vec3f::UnitZ(), 20.f);
+  EXPECT_TRUE(underGarment.apply(crossing).empty());
+  crossing = turned(Vec3f::UnitZ(), 20.f);
+  const std::vector<LimbCorrection> before = everywhere.apply(crossing);
+  ASSERT_EQ(before.size(), 1u);
+  EXPECT_EQ(before[0].joint, "LeftUpLeg");
+
+  Pose sitting = turned(Vec3f::UnitX(), 90.f);
+  const std::vector<LimbCorrection> fixes = underGarment.apply(sitting);
+  ASSERT_EQ(fixes.size(), 1u);
+  EXPECT_EQ(fixes[0].joint, "LeftUpLeg");
+  EXPECT_GT(fixes[0].degrees, 5.f);
+
+  LimbClearanceSettings bad;
+  bad.garmentReach = -1.f;
+  EXPECT_THROW(LimbClearance(c, bad), Error);
+}
+
 TEST(LimbClearance, HangingArmsAreTurnedOutOfTheTorsoAndNothingElseMoves) {
   const Character& c = mannequin();
   const Skeleton& s = c.skeleton;
