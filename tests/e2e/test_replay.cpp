@@ -143,6 +143,7 @@ TEST_F(ReplayE2E, RenderDrawsFramesAContactSheetAndSaysWhatTheyShow) {
   EXPECT_TRUE(fs::exists(r.contactSheet));
   EXPECT_TRUE(r.heatSheet.empty());
   EXPECT_TRUE(has(r.note, "no mannequin drawn")) << r.note;
+  EXPECT_TRUE(r.bodyThrough.empty());  // no body drawn, nothing to measure
   const std::string md = replay::renderReportSection(r, ro, dir_ / "out");
   EXPECT_TRUE(has(md, "## Pictures")) << md;
   EXPECT_TRUE(has(md, "push-out was ON")) << md;

@@ -237,6 +237,13 @@ api::DeformedMesh PreviewRenderer::lastJersey() const {
   return s_->batch.readBackMesh(s_->frame - 1, 0);
 }
 
+std::vector<float> PreviewRenderer::lastBody() const {
+  if (s_->frame == 0) throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: nothing rendered yet");
+  if (!s_->body) return {};
+  const float* xyz = static_cast<const float*>(s_->bodyVertices.data);  // positions, then normals
+  return std::vector<float>(xyz, xyz + 3 * s_->body->vertexCount());
+}
+
 PreviewImage PreviewRenderer::render(const api::CharacterPose& pose, const std::vector<PreviewVariant>& variants) {
   State& s = *s_;
   if (variants.empty()) throw api::Error(api::ErrorCode::InvalidArgument, "preview renderer: no variant to draw");

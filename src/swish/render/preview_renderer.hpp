@@ -79,6 +79,8 @@ class PreviewRenderer {
   PreviewImage render(const api::CharacterPose& pose, const std::vector<PreviewVariant>& variants = {{}});
   // The last rendered frame's jersey as swish produced it (read back), for checks.
   api::DeformedMesh lastJersey() const;
+  // The last rendered frame's body as drawn (skinned on the CPU): 3 floats per vertex; empty without a body.
+  std::vector<float> lastBody() const;
   // Report of the last frame's swish CPU step (warnings, time).
   const api::FrameReport& lastReport() const;
 

@@ -1,7 +1,9 @@
 #include "swish/replay/replay_render.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 
@@ -86,6 +88,16 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
     popts.camera = render::frameBox(lo, hi, float(o.width) / float(o.height), 0.04f);
   }
   render::PreviewRenderer preview(device, runtime, model, popts);
+  // Skin the garment covers at rest, as drawn (without the triangles left out when they are).
+  std::optional<BodyThroughGarmentMeter> meter;
+  Triangles bodyTriangles;
+  if (popts.body) {
+    const render::BodyMesh& b = *popts.body;
+    const Points3f restBody = Eigen::Map<const Points3f>(b.positions.data(), Eigen::Index(b.positions.size() / 3), 3);
+    bodyTriangles = Eigen::Map<const Triangles>(b.triangles.data(), Eigen::Index(b.triangles.size() / 3), 3);
+    meter.emplace(restBody, bodyTriangles, entry.model.gameMesh.positions, entry.model.gameMesh.triangles);
+    result.coveredTriangles = meter->coveredTriangles();
+  }
 
   std::unique_ptr<ModelTruth> truth;
   if (o.truth.every > 0) {
@@ -122,6 +134,15 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
     std::snprintf(name, sizeof name, "frame_%04u.png", f);
     images.push_back(render::renderFramePng(preview, cp, dir / name));
     result.frames.push_back(dir / name);
+    result.frameNumbers.push_back(f);
+    if (meter) {
+      const std::vector<float> body = preview.lastBody();
+      const api::DeformedMesh jersey = preview.lastJersey();
+      result.bodyThrough.push_back(meter->measure(
+          Eigen::Map<const Points3f>(body.data(), Eigen::Index(body.size() / 3), 3),
+          Eigen::Map<const Points3f>(jersey.positions.data(), Eigen::Index(jersey.positions.size() / 3), 3),
+          preview.viewProjection(), o.width, o.height));
+    }
     if (truth) {
       HeatJob job{f, pose, Points3f()};
       job.pose.rootTranslation = skeleton.restPose().rootTranslation;  // drawn in place, as the preview
@@ -193,6 +214,33 @@ std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderO
     std::string note = r.note;
     note[0] = char(std::toupper(static_cast<unsigned char>(note[0])));
     s += " " + note + ".";
+  }
+  if (!r.bodyThrough.empty()) {
+    size_t showing = 0;
+    uint32_t most = 0, mostFrame = 0;
+    for (size_t i = 0; i < r.bodyThrough.size(); ++i) {
+      if (r.bodyThrough[i].pixels > 0) ++showing;
+      if (r.bodyThrough[i].pixels > most) most = r.bodyThrough[i].pixels, mostFrame = r.frameNumbers[i];
+    }
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "\n\nBody through the garment (skin that the garment covers at rest, %zu body triangles, drawn where "
+                  "the garment should be; measured by casting each pixel's ray): **%zu of %zu frames**",
+                  r.coveredTriangles, showing, r.bodyThrough.size());
+    s += line;
+    if (showing > 0) {
+      std::snprintf(line, sizeof line, ", at most %u pixels (frame %u, %.2f %% of the garment's)", most, mostFrame,
+                    100.0 * r.bodyThrough[size_t(std::find(r.frameNumbers.begin(), r.frameNumbers.end(), mostFrame) -
+                                                 r.frameNumbers.begin())]
+                                .share());
+      s += line;
+    }
+    s += ".\n\n| frame | pixels | share of the garment's |\n|---|---|---|\n";
+    for (size_t i = 0; i < r.bodyThrough.size(); ++i) {
+      std::snprintf(line, sizeof line, "| %u | %u | %.2f %% |\n", r.frameNumbers[i], r.bodyThrough[i].pixels,
+                    100.0 * r.bodyThrough[i].share());
+      s += line;
+    }
   }
   s += "\n\n![contact sheet](" + rel(r.contactSheet) + ")\n";
   if (!r.heatSheet.empty())

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "swish/replay/body_through_garment.hpp"
 #include "swish/replay/model_library.hpp"
 #include "swish/replay/truth_simulation.hpp"
 #include "swish/runtime/scene.hpp"
@@ -34,6 +35,11 @@ struct ReplayRenderOptions {
 
 struct ReplayRenderResult {
   std::vector<std::filesystem::path> frames;
+  std::vector<uint32_t> frameNumbers;  // the scene frame of each drawn frame
+  // Per drawn frame: the pixels where skin the garment covers at rest is drawn (body_through_garment.hpp);
+  // empty when no body is drawn. `coveredTriangles`: how many body triangles the garment covers at rest.
+  std::vector<BodyThroughGarment> bodyThrough;
+  size_t coveredTriangles = 0;
   std::filesystem::path contactSheet;
   std::vector<std::filesystem::path> heatMaps;  // per frame with truth
   std::filesystem::path heatSheet;              // empty without truth
@@ -46,7 +52,8 @@ ReplayRenderResult renderReplayFrames(const runtime::Scene& scene, ModelLibrary&
                                       const std::filesystem::path& directory, const ReplayRenderOptions& options);
 
 // The report's section on the pictures (Markdown, links relative to `reportDirectory`): which character,
-// what the body shows (whole, or the covered triangles left out), whether the push-out ran, the sheets.
+// what the body shows (whole, or the covered triangles left out), whether the push-out ran, how many
+// frames show the body through the garment (and the pixels of each), the sheets.
 std::string renderReportSection(const ReplayRenderResult& result, const ReplayRenderOptions& options,
                                 const std::filesystem::path& reportDirectory);
 

@@ -24,6 +24,7 @@
 #include "swish/replay/pose_stream.hpp"
 #include "swish/replay/replay_engine.hpp"
 #include "swish/replay/replay_job.hpp"
+#include "swish/replay/replay_render.hpp"
 #include "swish/replay/report_writer.hpp"
 #include "swish/replay/truth_simulation.hpp"
 #include "swish/runtime/scene_file.hpp"
@@ -218,6 +219,35 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
   EXPECT_NE(text.find("Garment inside the body"), std::string::npos);
   EXPECT_TRUE(fs::exists(job.directory / "plots/penetration_per_frame.svg"));
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
+}
+
+// `swish replay --render` on the default model draws the mannequin, and measures on each picture the skin
+// the jersey covers at rest that is drawn where the jersey should be (body_through_garment.hpp); the
+// report's section gives the frames that show it and the pixels of each.
+TEST_F(ReplayTruth, RenderMeasuresTheBodyThroughTheGarmentPerFrame) {
+  const runtime::Scene s = scene(6, json::array({character("walker", true)}));
+  replay::ModelLibrary models(s);
+  replay::ReplayRenderOptions ro;
+  ro.maxFrames = 2;
+  ro.width = 96;
+  ro.height = 128;
+  ro.validation = true;
+  const fs::path dir = *tmp_ / "out/render";
+  const replay::ReplayRenderResult r = replay::renderReplayFrames(s, models, dir, ro);
+  ASSERT_EQ(r.frames.size(), 2u);
+  ASSERT_EQ(r.bodyThrough.size(), 2u);
+  ASSERT_EQ(r.frameNumbers.size(), 2u);
+  EXPECT_GT(r.coveredTriangles, 500u);  // the mannequin's trunk under the jersey
+  for (const replay::BodyThroughGarment& b : r.bodyThrough) {
+    EXPECT_GT(b.garmentPixels, 500u);  // the jersey fills the framed picture
+    EXPECT_LT(b.pixels, 96u * 128u - b.garmentPixels);
+  }
+  const std::string md = replay::renderReportSection(r, ro, *tmp_ / "out");
+  EXPECT_NE(md.find("Body through the garment"), std::string::npos) << md;
+  EXPECT_NE(md.find("| frame | pixels | share of the garment's |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| " + std::to_string(r.frameNumbers[1]) + " | " + std::to_string(r.bodyThrough[1].pixels) + " |"),
+            std::string::npos)
+      << md;
 }
 
 TEST_F(ReplayTruth, SameFiguresTwiceAndFarFromTheOrigin) {
