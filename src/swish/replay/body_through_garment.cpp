@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <utility>
 #include <string>
+#include <utility>
 
 #include "swish/bake/transfer/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"

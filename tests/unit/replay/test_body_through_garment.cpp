@@ -89,12 +89,14 @@ TEST(BodyThroughGarment, BadInputIsAClearError) {
             std::string::npos);
   const BodyThroughGarmentMeter meter(body.positions, body.triangles, shirt.positions, shirt.triangles);
   const Points3f fewer = shirt.positions.topRows(10);
-  EXPECT_NE(test::errorOf([&] { meter.measure(body.positions, fewer, frontCamera(), kWidth, kHeight); })
-                .find("the posed body has"),
+  EXPECT_NE(test::errorOf([&] {
+              meter.measure(body.positions, fewer, frontCamera(), kWidth, kHeight);
+            }).find("the posed body has"),
             std::string::npos);
   api::Mat4 zero{};
-  EXPECT_NE(test::errorOf([&] { meter.measure(body.positions, shirt.positions, zero, kWidth, kHeight); })
-                .find("not invertible"),
+  EXPECT_NE(test::errorOf([&] {
+              meter.measure(body.positions, shirt.positions, zero, kWidth, kHeight);
+            }).find("not invertible"),
             std::string::npos);
   Points3f nan = shirt.positions;
   nan(3, 1) = std::numeric_limits<float>::quiet_NaN();
