@@ -44,10 +44,14 @@ namespace {
 
 const fs::path kClip = test::debianMocap("01_01.bvh");
 
+// The limb clearance keeps the whole trunk clear (limb_garment_reach 0) as when the model comparison's
+// bound below was set: with the 30 mm default the ten poses' thighs are corrected differently, and this
+// tiny network's training amplifies the OBJ rounding (0.7 um in the dataset) to 0.125 mm in its
+// predictions instead of 0.004 mm (measured), a property of the training, not of the files' path.
 nlohmann::json recipe(const std::string& name, const nlohmann::json& simulationExtra = nlohmann::json::object()) {
-  nlohmann::json sim = {{"vertices", 0},         {"transition_seconds", 0.3},
-                        {"settle_seconds", 0.2}, {"frame_rate", 20},
-                        {"threads", 2},          {"gravity", 0}};
+  nlohmann::json sim = {
+      {"vertices", 0}, {"transition_seconds", 0.3}, {"settle_seconds", 0.2}, {"frame_rate", 20}, {"threads", 2},
+      {"gravity", 0},  {"limb_garment_reach", 0}};
   sim.update(simulationExtra);
   return {{"name", name},
           {"output", name},
