@@ -25,8 +25,9 @@ namespace swish::replay {
 
 struct BodyThroughGarment {
   uint32_t pixels = 0;         // pixels where covered skin is drawn: the body through the garment
-  uint32_t garmentPixels = 0;  // pixels where the garment is drawn (what the share is of)
-  double share() const { return garmentPixels ? double(pixels) / double(garmentPixels + pixels) : 0.0; }
+  uint32_t garmentPixels = 0;  // pixels where the garment is drawn
+  // Of the pixels where the garment is drawn or should be, those that show the body instead.
+  double share() const { return pixels ? double(pixels) / double(garmentPixels + pixels) : 0.0; }
 };
 
 class BodyThroughGarmentMeter {

@@ -1,6 +1,5 @@
 #include "swish/replay/replay_render.hpp"
 
-#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <optional>
@@ -90,11 +89,11 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   render::PreviewRenderer preview(device, runtime, model, popts);
   // Skin the garment covers at rest, as drawn (without the triangles left out when they are).
   std::optional<BodyThroughGarmentMeter> meter;
-  Triangles bodyTriangles;
   if (popts.body) {
     const render::BodyMesh& b = *popts.body;
     const Points3f restBody = Eigen::Map<const Points3f>(b.positions.data(), Eigen::Index(b.positions.size() / 3), 3);
-    bodyTriangles = Eigen::Map<const Triangles>(b.triangles.data(), Eigen::Index(b.triangles.size() / 3), 3);
+    const Triangles bodyTriangles =
+        Eigen::Map<const Triangles>(b.triangles.data(), Eigen::Index(b.triangles.size() / 3), 3);
     meter.emplace(restBody, bodyTriangles, entry.model.gameMesh.positions, entry.model.gameMesh.triangles);
     result.coveredTriangles = meter->coveredTriangles();
   }
@@ -216,11 +215,10 @@ std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderO
     s += " " + note + ".";
   }
   if (!r.bodyThrough.empty()) {
-    size_t showing = 0;
-    uint32_t most = 0, mostFrame = 0;
+    size_t showing = 0, most = 0;  // frames with any; the frame with the most
     for (size_t i = 0; i < r.bodyThrough.size(); ++i) {
       if (r.bodyThrough[i].pixels > 0) ++showing;
-      if (r.bodyThrough[i].pixels > most) most = r.bodyThrough[i].pixels, mostFrame = r.frameNumbers[i];
+      if (r.bodyThrough[i].pixels > r.bodyThrough[most].pixels) most = i;
     }
     char line[320];
     std::snprintf(line, sizeof line,
@@ -229,10 +227,8 @@ std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderO
                   r.coveredTriangles, showing, r.bodyThrough.size());
     s += line;
     if (showing > 0) {
-      std::snprintf(line, sizeof line, ", at most %u pixels (frame %u, %.2f %% of the garment's)", most, mostFrame,
-                    100.0 * r.bodyThrough[size_t(std::find(r.frameNumbers.begin(), r.frameNumbers.end(), mostFrame) -
-                                                 r.frameNumbers.begin())]
-                                .share());
+      std::snprintf(line, sizeof line, ", at most %u pixels (frame %u, %.2f %% of the garment's)",
+                    r.bodyThrough[most].pixels, r.frameNumbers[most], 100.0 * r.bodyThrough[most].share());
       s += line;
     }
     s += ".\n\n| frame | pixels | share of the garment's |\n|---|---|---|\n";
