@@ -147,7 +147,13 @@ swish::cli::RunFn setup(CLI::App& sub) {
       if (!cfg.part1)
         throw swish::Error(o->config + ": --export-poses needs a \"part1\" section (the poses come from it)");
       const auto log = [](const std::string& l) { std::fprintf(stderr, "%s\n", l.c_str()); };
-      const auto r = swish::bake::exportPoses(*cfg.part1, o->exportPoses, log);
+      // The bake's own pose list: part1.holdout's subjects are not among its training poses, so they are
+      // not exported either (the results' pose-list digest must match what the bake then reads).
+      const auto [training, heldOut] = swish::bake::splitHeldOutSubjects(*cfg.part1);
+      if (!heldOut.clips.empty())
+        log("export: the bake's training poses; the " + std::to_string(heldOut.clips.size()) +
+            " clips of the held-out subjects (part1.holdout) are not exported");
+      const auto r = swish::bake::exportPoses(training, o->exportPoses, log);
       std::printf("exported %zu poses to %s; read %s/README.md\n", r.poses, o->exportPoses.c_str(),
                   o->exportPoses.c_str());
       return 0;
