@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 
+#include "swish/bake/transfer/body_coverage.hpp"
 #include "swish/bake/transfer/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/mesh.hpp"
@@ -60,13 +62,10 @@ BodyThroughGarmentMeter::BodyThroughGarmentMeter(const Points3f& restBody, const
     for (int k = 0; k < 3; ++k) nearOpening_[size_t(t)] |= char(nearOpening(restGarment.row(garmentTriangles(t, k))));
   covered_.assign(size_t(bodyTriangles.rows()), 0);
   for (Eigen::Index t = 0; t < bodyTriangles.rows(); ++t) {
-    const Vec3f a = restBody.row(bodyTriangles(t, 0)), b = restBody.row(bodyTriangles(t, 1)),
-                c = restBody.row(bodyTriangles(t, 2));
-    const Vec3f n = (b - a).cross(c - a);
-    if (!(n.norm() > 0.f)) continue;  // degenerate: no outward direction
-    const Vec3f dir = n.normalized(), centroid = (a + b + c) / 3.f;
-    const bake::SurfacePoint hit = garment.intersect(centroid + kLift * dir, dir, 0.f, reach);
-    covered_[size_t(t)] = hit.found && !nearOpening(hit.point);
+    const std::optional<bake::SurfacePoint> hit =
+        bake::garmentAlongNormal(restBody.row(bodyTriangles(t, 0)), restBody.row(bodyTriangles(t, 1)),
+                                 restBody.row(bodyTriangles(t, 2)), garment, kLift, reach);
+    covered_[size_t(t)] = hit && hit->found && !nearOpening(hit->point);  // degenerate: no outward direction
   }
 }
 

@@ -71,7 +71,6 @@ std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const
     throw Error("bake part 1: part1.holdout holds out every clip: nothing is left to train on");
   // Frames as a game plays them, one character, unmirrored; nothing added, nothing previewed.
   heldOut.evenPoses = s.holdoutPoses;
-  heldOut.growFrom = 0;  // no thinning to grow
   heldOut.includeRestPose = false;
   heldOut.previewPoses = 0;
   heldOut.sampling.characters = 1;

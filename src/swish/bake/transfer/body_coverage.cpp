@@ -13,6 +13,16 @@
 
 namespace swish::bake {
 
+std::optional<SurfacePoint> garmentAlongNormal(const Vec3f& a, const Vec3f& b, const Vec3f& c,
+                                               const TriangleRayScene& garment, float from, float length) {
+  const Vec3f n = (b - a).cross(c - a);
+  const float len = n.norm();
+  if (!(len > 0.f)) return std::nullopt;
+  const Vec3f centroid = (a + b + c) / 3.f;
+  const Vec3f dir = n / len;
+  return garment.intersect(centroid + from * dir, dir, 0.f, length);
+}
+
 BodyCoverageResult coveredBodyTriangles(const Character& character, const std::vector<const DatasetPose*>& poses,
                                         const BodyCoverageOptions& o) {
   const Mesh& body = character.body;
@@ -41,13 +51,11 @@ BodyCoverageResult coveredBodyTriangles(const Character& character, const std::v
     tbb::parallel_for(size_t(0), nt, [&](size_t t) {
       const Vec3f a = posed.row(body.triangles(Eigen::Index(t), 0)), b = posed.row(body.triangles(Eigen::Index(t), 1)),
                   c = posed.row(body.triangles(Eigen::Index(t), 2));
-      const Vec3f n = (b - a).cross(c - a);
-      const float len = n.norm();
-      if (!(len > 0.f)) return;  // degenerate: never covered
-      const Vec3f centroid = (a + b + c) / 3.f;
-      const Vec3f dir = n / len;
-      hit[t] = garment.intersect(centroid - o.maxInside * dir, dir, 0.f, o.maxInside + o.maxGap).found;
+      const std::optional<SurfacePoint> g = garmentAlongNormal(a, b, c, garment, -o.maxInside, o.maxInside + o.maxGap);
+      if (!g) return;  // degenerate: never covered
+      hit[t] = g->found;
       if (!hit[t] && collider) {
+        const Vec3f centroid = (a + b + c) / 3.f;
         const int part = int(collider->triangleRegions()[t]);
         const BodyCollider::Hit q = collider->closest(centroid, kBuriedSearch, -1, part);
         buried[t] = q.found && q.signedDistance < -kBuriedDepth;

@@ -21,9 +21,11 @@
 // tube's upper end, which the jersey's shoulder covers when the arm hangs and the trunk hides when it
 // is raised, was never listed, and it is what showed through the shoulders of the default scene.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "swish/bake/dataset/dataset.hpp"
+#include "swish/bake/transfer/triangle_ray_scene.hpp"
 #include "swish/core/character.hpp"
 
 namespace swish::bake {
@@ -52,5 +54,13 @@ struct BodyCoverageResult {
 
 BodyCoverageResult coveredBodyTriangles(const Character& character, const std::vector<const DatasetPose*>& poses,
                                         const BodyCoverageOptions& options = {});
+
+// The test above for one body triangle (corners a, b, c, winding outwards): the garment's first hit on
+// the line along the triangle's outward normal through its centroid, from `from` metres along the normal
+// (negative: below the skin) over `length` metres. nullopt for a degenerate triangle (no normal). The
+// replay's body-through-the-garment measure (replay/body_through_garment.hpp) decides coverage at rest
+// with it too.
+std::optional<SurfacePoint> garmentAlongNormal(const Vec3f& a, const Vec3f& b, const Vec3f& c,
+                                               const TriangleRayScene& garment, float from, float length);
 
 }  // namespace swish::bake
