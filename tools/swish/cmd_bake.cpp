@@ -149,9 +149,10 @@ swish::cli::RunFn setup(CLI::App& sub) {
       const auto log = [](const std::string& l) { std::fprintf(stderr, "%s\n", l.c_str()); };
       // The bake's own pose list: part1.holdout's subjects are not among its training poses, so they are
       // not exported either (the results' pose-list digest must match what the bake then reads).
-      const auto [training, heldOut] = swish::bake::splitHeldOutSubjects(*cfg.part1);
-      if (!heldOut.clips.empty())
-        log("export: the bake's training poses; the " + std::to_string(heldOut.clips.size()) +
+      const swish::bake::DatasetBuildSettings training = swish::bake::bakeTrainingSettings(cfg);
+      if (training.clips.size() < cfg.part1->clips.size())
+        log("export: the bake's training poses; the " +
+            std::to_string(cfg.part1->clips.size() - training.clips.size()) +
             " clips of the held-out subjects (part1.holdout) are not exported");
       const auto r = swish::bake::exportPoses(training, o->exportPoses, log);
       std::printf("exported %zu poses to %s; read %s/README.md\n", r.poses, o->exportPoses.c_str(),

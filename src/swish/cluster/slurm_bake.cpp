@@ -301,8 +301,9 @@ nlohmann::json submitSlurmBake(const bake::BakeConfig& cfg, const fs::path& conf
   }
 
   const auto t0 = Clock::now();
-  bake::DatasetBuildSettings s = *cfg.part1;
-  s.alsoRequiredJoints = cfg.train.inputJoints;
+  // The local bake's training poses (part1.holdout's subjects out): the array's pose list must be the
+  // one the part 1 job then checks it against.
+  const bake::DatasetBuildSettings s = bake::bakeTrainingSettings(cfg);
   log("slurm: part 1 up to the simulation (character, clips, sampling, thinning), once, here");
   const bake::DatasetPosePlan plan = bake::planDatasetPoses(s, o.log);
   double setup = 0.0;
@@ -499,7 +500,7 @@ void runSlurmStage(const bake::BakeConfig& cfg, const std::string& stage, uint64
     throw Error((dir / "poses.bin").string() + " holds the pose list " + fingerprintHex(list.fingerprint) +
                 ", but this job was submitted for " + fingerprintHex(poseList) +
                 ": the bake was submitted again with another recipe; this job stops without writing anything");
-  bake::DatasetBuildSettings s = *cfg.part1;
+  const bake::DatasetBuildSettings s = bake::bakeTrainingSettings(cfg);  // as the submission digested it
   if (settingsDigest(s) != list.settingsDigest)
     throw Error("the recipe's part 1 settings changed after `swish bake --slurm` wrote " +
                 (dir / "poses.bin").string() + "; this job stops without writing anything: submit again");

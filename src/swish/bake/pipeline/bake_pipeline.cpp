@@ -78,6 +78,13 @@ std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const
   return {training, heldOut};
 }
 
+DatasetBuildSettings bakeTrainingSettings(const BakeConfig& cfg) {
+  if (!cfg.part1) throw Error("bake: the config has no part1 section");
+  DatasetBuildSettings s = splitHeldOutSubjects(*cfg.part1).first;
+  s.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
+  return s;
+}
+
 BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   const auto t0 = Clock::now();
   auto log = [&](const std::string& s) {

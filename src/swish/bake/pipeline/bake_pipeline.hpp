@@ -37,6 +37,11 @@ struct BakeRunResult {
 // no clips. Throws Error when every clip is held out.
 std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const DatasetBuildSettings& settings);
 
+// The settings of the poses the bake simulates and trains on (config.part1, which it must have): the
+// training split above, with the network's input joints required of the clips. `swish bake`, its Slurm
+// array and `--export-poses` all plan their pose list from this, so the lists (and their digests) agree.
+DatasetBuildSettings bakeTrainingSettings(const BakeConfig& config);
+
 BakeRunResult runBake(const BakeConfig& config, const BakeRunOptions& options = {});
 
 }  // namespace swish::bake
