@@ -126,6 +126,13 @@ TEST(BakeWhole, DefaultCharacterAndMocapToLoadableModel) {
     EXPECT_GT(q["convergence_p95_mm"].get<double>(), 0.0);
   }
   EXPECT_GE(q["noise_mean_mm"].get<double>(), 0.0);
+  // What of the convergence figure the path explains, and the stretch at both settings.
+  EXPECT_GE(q["path_sensitivity_poses"].get<size_t>() + q["reference_failures"].size(), 2u);
+  EXPECT_GE(q["path_sensitivity_mean_mm"].get<double>(), 0.0);
+  if (q["convergence_poses"].get<size_t>() > 0) {
+    EXPECT_TRUE(std::isfinite(q["edge_strain_mean_percent"].get<double>()));
+    EXPECT_NE(q["edge_strain_mean_percent"].get<double>(), q["reference_edge_strain_mean_percent"].get<double>());
+  }
   EXPECT_TRUE(fs::exists(w.config.previewDir() / "preview.json"));
 
   // Progress lines with the time left for the long steps.

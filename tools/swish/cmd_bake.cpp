@@ -15,6 +15,7 @@
 
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/pose_export.hpp"
+#include "swish/bake/cloth/simulation_quality.hpp"
 #include "swish/bake/pipeline/bake_config.hpp"
 #include "swish/bake/pipeline/bake_pipeline.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
@@ -193,6 +194,7 @@ swish::cli::RunFn setup(CLI::App& sub) {
             size_t(q.value("convergence_poses", 0)), q.value("convergence_mean_mm", 0.0),
             q.value("convergence_p95_mm", 0.0), q.value("noise_turn_degrees", 0.0), size_t(q.value("noise_poses", 0)),
             q.value("noise_mean_mm", 0.0), q.value("noise_p95_mm", 0.0));
+        std::printf("%s\n", swish::bake::simulationQualityDetail(q).c_str());
       }
       std::printf("report: %s\n", file.string().c_str());
       return 0;

@@ -115,6 +115,7 @@ class ClothSolver {
   const SimulationMesh& mesh() const { return mesh_; }
   const ClothSimSettings& settings() const { return settings_; }
   const std::vector<uint32_t>& attachedVertices() const { return attached_; }
+  const ClothConstraints& constraints() const { return constraints_; }
   // A 64-bit digest of everything that decides the result (mesh, body, skeleton, settings): the pose
   // driver stores it with each result so that a re-run never reuses results of another setup.
   uint64_t fingerprint() const { return fingerprint_; }

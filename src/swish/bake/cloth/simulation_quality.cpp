@@ -23,6 +23,13 @@ double percentile(std::vector<double> v, double q) {
   return v[k];
 }
 
+// The mean signed strain of the garment's edges (stretch constraints) at `x`, in percent.
+double meanEdgeStrainPercent(const ClothConstraints& cc, const Points3f& x) {
+  double sum = 0.0;
+  for (const DistanceConstraint& c : cc.stretch) sum += double(((x.row(c.i) - x.row(c.j)).norm() - c.rest) / c.rest);
+  return cc.stretch.empty() ? 0.0 : 100.0 * sum / double(cc.stretch.size());
+}
+
 double mean(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += x;
@@ -50,8 +57,26 @@ nlohmann::json SimulationQuality::toJson() const {
           {"noise_poses", noisePoses},
           {"noise_mean_mm", noiseMeanMm},
           {"noise_p95_mm", noiseP95Mm},
+          {"path_sensitivity_reference", "the transition one frame longer, the same substeps"},
+          {"path_sensitivity_poses", pathPoses},
+          {"path_sensitivity_mean_mm", pathMeanMm},
+          {"path_sensitivity_p95_mm", pathP95Mm},
+          {"edge_strain_mean_percent", edgeStrainPercent},
+          {"reference_edge_strain_mean_percent", referenceEdgeStrainPercent},
           {"reference_failures", referenceFailures},
           {"seconds", seconds}};
+}
+
+std::string simulationQualityDetail(const nlohmann::json& quality) {
+  if (!quality.contains("path_sensitivity_mean_mm")) return "path sensitivity and edge strain: not measured";
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "path sensitivity (the transition one frame longer; %zu poses) %.2f mm mean, %.2f mm p95; mean "
+                "edge strain %.2f %% (%.2f %% at 2x substeps)",
+                size_t(quality.value("path_sensitivity_poses", 0)), quality.value("path_sensitivity_mean_mm", 0.0),
+                quality.value("path_sensitivity_p95_mm", 0.0), quality.value("edge_strain_mean_percent", 0.0),
+                quality.value("reference_edge_strain_mean_percent", 0.0));
+  return line;
 }
 
 std::string failureCategory(const std::string& failure) {
@@ -135,7 +160,7 @@ std::vector<uint32_t> sampleQualityPoses(const std::vector<uint32_t>& candidates
 uint64_t simulationQualityFingerprint(const ClothSolver& solver, const std::vector<Pose>& poses,
                                       const std::vector<uint32_t>& ids, const SimulationQualitySettings& settings) {
   Fnv1a f(solver.fingerprint() ^ 0x0DD5'11A7ull);
-  f.value(uint32_t(1));  // this measure's revision
+  f.value(uint32_t(2));  // this measure's revision (2: path sensitivity and edge strain)
   for (uint32_t id : ids) {
     f.value(id);
     for (const Quatf& q : poses[id].local) f.matrix(q.coeffs());
@@ -158,10 +183,14 @@ SimulationQuality measureSimulationQuality(const Character& character, const Clo
   fine.equilibriumTolerance *= 0.5f;
   fine.staticTolerance *= 0.5f;
   const ClothSolver reference(character, solver.mesh(), fine);
+  ClothSimSettings longer = solver.settings();
+  longer.transitionSeconds += 1.f / longer.frameRate;
+  const ClothSolver otherPath(character, solver.mesh(), longer);
 
-  // Three solves per pose: the reference, and the pose turned by +a and -a.
+  // Four solves per pose: the reference, the pose turned by +a and -a, and the longer path.
+  constexpr size_t kSolves = 4;
   const size_t n = ids.size();
-  std::vector<PoseSimulation> results(3 * n);
+  std::vector<PoseSimulation> results(kSolves * n);
   Rng axes(qs.seed ^ 0xA7E5ull);
   std::vector<Vec3f> axis(n);
   for (Vec3f& a : axis) {
@@ -173,38 +202,49 @@ SimulationQuality measureSimulationQuality(const Character& character, const Clo
   std::mutex mutex;
   size_t done = 0;
   auto one = [&](size_t task) {
-    const size_t k = task / 3, kind = task % 3;
+    const size_t k = task / kSolves, kind = task % kSolves;
     const Pose& p = poses[ids[k]];
-    results[task] =
-        kind == 0 ? reference.simulate(p) : solver.simulate(turned(p, axis[k], kind == 1 ? radians : -radians));
+    results[task] = kind == 0   ? reference.simulate(p)
+                    : kind == 3 ? otherPath.simulate(p)
+                                : solver.simulate(turned(p, axis[k], kind == 1 ? radians : -radians));
     std::lock_guard<std::mutex> lock(mutex);
     ++done;
     if (log) {
       char line[160];
-      std::snprintf(line, sizeof line, "simulation check: %zu/%zu solves (convergence and noise on %zu poses)", done,
-                    3 * n, n);
+      std::snprintf(line, sizeof line,
+                    "simulation check: %zu/%zu solves (convergence, noise and path sensitivity on %zu poses)", done,
+                    kSolves * n, n);
       log(line);
     }
   };
   if (qs.threads > 0) {
     tbb::task_arena arena(qs.threads);
-    arena.execute([&] { tbb::parallel_for(size_t(0), 3 * n, size_t(1), one); });
+    arena.execute([&] { tbb::parallel_for(size_t(0), kSolves * n, size_t(1), one); });
   } else {
-    tbb::parallel_for(size_t(0), 3 * n, size_t(1), one);
+    tbb::parallel_for(size_t(0), kSolves * n, size_t(1), one);
   }
 
-  std::vector<double> conv, noise;
+  std::vector<double> conv, noise, path, strain, referenceStrain;
   for (size_t k = 0; k < n; ++k) {
     const Points3f& x0 = shapes[k];
-    const PoseSimulation &ref = results[3 * k], &plus = results[3 * k + 1], &minus = results[3 * k + 2];
+    const PoseSimulation* r = &results[kSolves * k];
+    const PoseSimulation &ref = r[0], &plus = r[1], &minus = r[2], &other = r[3];
     const std::string pose = "pose " + std::to_string(ids[k]);
     if (!ref.ok) q.referenceFailures.push_back(pose + " (reference): " + ref.failure);
     if (!plus.ok) q.referenceFailures.push_back(pose + " (+turn): " + plus.failure);
     if (!minus.ok) q.referenceFailures.push_back(pose + " (-turn): " + minus.failure);
+    if (!other.ok) q.referenceFailures.push_back(pose + " (longer path): " + other.failure);
     if (ref.ok && ref.positions.rows() == x0.rows()) {
       ++q.convergencePoses;
       for (Eigen::Index v = 0; v < x0.rows(); ++v)
         conv.push_back(1000.0 * double((ref.positions.row(v) - x0.row(v)).norm()));
+      strain.push_back(meanEdgeStrainPercent(solver.constraints(), x0));
+      referenceStrain.push_back(meanEdgeStrainPercent(solver.constraints(), ref.positions));
+    }
+    if (other.ok && other.positions.rows() == x0.rows()) {
+      ++q.pathPoses;
+      for (Eigen::Index v = 0; v < x0.rows(); ++v)
+        path.push_back(1000.0 * double((other.positions.row(v) - x0.row(v)).norm()));
     }
     if (plus.ok && minus.ok && plus.positions.rows() == x0.rows()) {
       ++q.noisePoses;
@@ -218,6 +258,10 @@ SimulationQuality measureSimulationQuality(const Character& character, const Clo
   q.convergenceMaxMm = conv.empty() ? 0.0 : *std::max_element(conv.begin(), conv.end());
   q.noiseMeanMm = mean(noise);
   q.noiseP95Mm = percentile(noise, 0.95);
+  q.pathMeanMm = mean(path);
+  q.pathP95Mm = percentile(path, 0.95);
+  q.edgeStrainPercent = mean(strain);
+  q.referenceEdgeStrainPercent = mean(referenceStrain);
   q.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return q;
 }

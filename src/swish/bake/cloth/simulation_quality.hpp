@@ -10,6 +10,13 @@
 //     leaves the simulation's own noise, sqrt(6) times one simulation's if that noise is independent
 //     per simulation, so the figure is |second difference| / sqrt(6) per vertex (mean / p95, mm). The
 //     measure of docs/baking.md ("the truth's noise floor"), here on the simulation mesh.
+//   - path sensitivity: on the same sample, the shape with the transition one frame longer (same
+//     substeps) against the shape at the solver's settings (mean / p95, mm). The path picks which
+//     equilibrium the cloth settles in; this is how much a path that differs by nothing the pose
+//     decides moves it, so the part of the convergence figure that more substeps cannot remove.
+//   - edge strain: the mean signed strain of the garment's edges at the solver's settings and at the
+//     reference's. Where the two differ the stretch is the solver's (its sweeps and substeps), not
+//     the material's: XPBD with few sweeps on a light, long garment (docs/baking.md, "the stiff regime").
 //   - failures per reason with their share, the poses that needed a retry, the equilibrium residuals
 //     and the seconds each pose's solve took on its core.
 #include <cstdint>
@@ -36,10 +43,18 @@ struct SimulationQuality {
   size_t noisePoses = 0;  // sampled poses whose two turned solves succeeded
   double noiseMeanMm = 0, noiseP95Mm = 0;
   float noiseTurnDegrees = 0.f;
+  size_t pathPoses = 0;  // sampled poses whose longer-path solve succeeded
+  double pathMeanMm = 0, pathP95Mm = 0;
+  // Mean signed edge strain (%) of the sampled shapes at the solver's settings and of the reference's.
+  double edgeStrainPercent = 0, referenceEdgeStrainPercent = 0;
   std::vector<std::string> referenceFailures;  // reference or turned solves that failed: "pose 12 (+2 deg): why"
   double seconds = 0;                          // wall time of the measurement
   nlohmann::json toJson() const;
 };
+
+// The path sensitivity and edge strain figures of a measurement (SimulationQuality::toJson's form) as
+// one line for a log; says so when the measurement predates them.
+std::string simulationQualityDetail(const nlohmann::json& quality);
 
 // One pose's simulation outcome as the report needs it.
 struct SimulatedPoseSummary {

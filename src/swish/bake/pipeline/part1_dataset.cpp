@@ -809,6 +809,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
                     quality.value("noise_turn_degrees", 0.0), quality.value("noise_mean_mm", 0.0),
                     quality.value("noise_p95_mm", 0.0));
       log(line);
+      log("part 1: simulation " + simulationQualityDetail(quality));
       step("simulation quality", t);
     }
     char line[200];
@@ -905,7 +906,8 @@ nlohmann::json checkSimulation(const DatasetBuildSettings& s, size_t poseCount, 
     SimulationQualitySettings qs = s.quality;
     qs.threads = s.threads;
     qs.seed = seed;
-    log("simulation check: convergence and noise on " + std::to_string(q.size()) + " poses (3 solves each)");
+    log("simulation check: convergence, noise and path sensitivity on " + std::to_string(q.size()) +
+        " poses (4 solves each)");
     ProgressThrottle qThrottle;
     out["simulation"]["quality"] =
         measureSimulationQuality(character, solver, poses, q, qShapes, qs, [&](const std::string& l) {
