@@ -176,7 +176,8 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
           " iterations at " + fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) +
           " s transition + " + fmtNum("%g", cs.settleSeconds) + " s settle, limb clearance " +
           fmtNum("%g", 1000.0 * ps.limbClearance.clearance) + " mm (trunk within " +
-          fmtNum("%g", 1000.0 * ps.limbClearance.garmentReach) + " mm of the garment; 0: all), smoothing " +
+          fmtNum("%g", 1000.0 * ps.limbClearance.garmentReach) + " mm of the garment; 0: all), neck range " +
+          fmtNum("%g", ps.limbClearance.neckRangeDegrees) + " deg (0: as recorded), smoothing " +
           std::to_string(ps.transfer.smoothing.iterations) + " x " + fmtNum("%g", ps.transfer.smoothing.strength) +
           (overridden.empty() ? std::string() : "; overridden for this run (not the bake's):" + overridden) + mapNote;
 }

@@ -357,6 +357,7 @@ TEST(ReplayTruthSettings, MetadataGivesBackTheBakeSettings) {
   s.simulation.gravity = Vec3f(0.f, -4.5f, 0.f);
   s.limbClearance.clearance = 0.02f;
   s.limbClearance.garmentReach = 0.04f;
+  s.limbClearance.neckRangeDegrees = 75.f;
   s.simulation.attachTopFraction = 0.03f;
   s.transfer.smoothing.strength = 0.3f;
   s.transfer.smoothing.iterations = 5;
@@ -378,10 +379,14 @@ TEST(ReplayTruthSettings, MetadataGivesBackTheBakeSettings) {
   EXPECT_EQ(a.simulation.gravity, b.simulation.gravity);
   EXPECT_EQ(a.limbClearance.clearance, b.limbClearance.clearance);
   EXPECT_EQ(a.limbClearance.garmentReach, b.limbClearance.garmentReach);
+  EXPECT_EQ(a.limbClearance.neckRangeDegrees, b.limbClearance.neckRangeDegrees);
   // A model baked before the clearance looked only under the garment kept the whole trunk clear.
   json old = json::parse(s.toJson().dump());
   old["simulation"].erase("limb_garment_reach");
   EXPECT_EQ(bake::poseShapeSettingsFromJson(old, "test").limbClearance.garmentReach, 0.f);
+  // A model baked before the neck range: its truth leaves the neck as recorded.
+  old["simulation"].erase("limb_neck_range");
+  EXPECT_EQ(bake::poseShapeSettingsFromJson(old, "test").limbClearance.neckRangeDegrees, 0.f);
   EXPECT_EQ(a.simulation.attachTopFraction, b.simulation.attachTopFraction);
   EXPECT_EQ(a.transfer.smoothing.strength, b.transfer.smoothing.strength);
   EXPECT_EQ(a.transfer.smoothing.iterations, b.transfer.smoothing.iterations);

@@ -92,6 +92,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "gravity",
                                                   "limb_clearance",
                                                   "limb_garment_reach",
+                                                  "limb_neck_range",
                                                   "attach_band",
                                                   "equilibrium_tolerance",
                                                   "equilibrium_seconds",
@@ -137,6 +138,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   s.limbClearance.clearance = float(sim.number("limb_clearance", 0, 0.1, s.limbClearance.clearance));
   // Only the trunk within this of the garment at rest is kept clear (limb_clearance.hpp); 0: all of it.
   s.limbClearance.garmentReach = float(sim.number("limb_garment_reach", 0, 1, s.limbClearance.garmentReach));
+  // Degrees the neck chain may turn from rest, all its joints together (limb_clearance.hpp); 0: as recorded.
+  s.limbClearance.neckRangeDegrees = float(sim.number("limb_neck_range", 0, 720, s.limbClearance.neckRangeDegrees));
   // The top band of the garment held on the body (share of its rest height; cloth_solver.hpp).
   cs.attachTopFraction = float(sim.number("attach_band", 0, 0.5, cs.attachTopFraction));
   // The end condition (cloth_solver.hpp): frames at the goal pose until the residual (the unbalanced
@@ -277,6 +280,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   }
   // Settings recorded before the limb clearance looked only under the garment kept the whole trunk clear.
   if (sim.is_object() && !sim.contains("limb_garment_reach")) s.limbClearance.garmentReach = 0.f;
+  // Settings recorded before the neck range left the neck as recorded.
+  if (sim.is_object() && !sim.contains("limb_neck_range")) s.limbClearance.neckRangeDegrees = 0.f;
   return s.poseShape();
 }
 

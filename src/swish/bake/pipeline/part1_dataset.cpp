@@ -245,6 +245,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
         {"gravity", -m.gravity.y()},
         {"limb_clearance", limbClearance.clearance},
         {"limb_garment_reach", limbClearance.garmentReach},
+        {"limb_neck_range", limbClearance.neckRangeDegrees},
         {"attach_band", m.attachTopFraction}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength},

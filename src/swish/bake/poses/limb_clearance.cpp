@@ -78,6 +78,9 @@ int depthOf(const Skeleton& s, int j) {
   return d;
 }
 
+// The head joint and its neck ancestors (defined with the head clearance below).
+std::vector<int> neckChain(const Skeleton& skeleton);
+
 }  // namespace
 
 LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings)
@@ -92,6 +95,10 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   check(std::isfinite(settings_.maxDegrees) && settings_.maxDegrees > 0.f && settings_.maxDegrees <= 180.f,
         "maxDegrees must be in (0, 180]");
   check(std::isfinite(settings_.garmentReach) && settings_.garmentReach >= 0.f, "garmentReach must be >= 0");
+  check(std::isfinite(settings_.neckRangeDegrees) && settings_.neckRangeDegrees >= 0.f &&
+            settings_.neckRangeDegrees <= 720.f,
+        "neckRangeDegrees must be in [0, 720]");
+  neckChain_ = neckChain(skeleton_);
   body_.validate(what, skeleton_.size());
   if (body_.skin.vertexCount() != body_.vertexCount())
     throw Error(what + " has no skin weights: limbs cannot be posed");
@@ -172,10 +179,13 @@ size_t LimbClearance::guardedTriangles() const { return size_t(std::count(guarde
 
 std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   std::vector<LimbCorrection> out;
-  if ((limbs_.empty() && !head_) || pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite())
+  if ((limbs_.empty() && !head_ && !(settings_.neckRangeDegrees > 0.f && !neckChain_.empty())) ||
+      pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite())
     return out;
   for (const Quatf& q : pose.local)
     if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
+  // The neck within its range first: the head's position decides whether it is inside anything.
+  if (std::optional<LimbCorrection> c = limitNeck(pose)) out.push_back(*c);
   // Measured with the root at rest, as the solver simulates it (the shape ignores the root).
   Pose p = pose;
   p.local[0] = skeleton_.joints[0].rest.rotation;
@@ -244,25 +254,55 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   return out;
 }
 
-void LimbClearance::setUpHead() {
-  const std::string what = "body";
+namespace {
+
+// The angle between two rotations, degrees.
+float angleDegrees(const Quatf& a, const Quatf& b) {
+  const float d = std::min(1.f, std::abs(a.normalized().dot(b.normalized())));
+  return 2.f * std::acos(d) * 180.f / float(M_PI);
+}
+
+std::vector<int> neckChain(const Skeleton& skeleton) {
   // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
   int headJoint = -1;
-  for (int j = 1; j < int(skeleton_.size()); ++j)
-    if (io::normaliseJointName(skeleton_.joints[size_t(j)].name).ends_with("head") &&
-        (headJoint < 0 || depthOf(skeleton_, j) < depthOf(skeleton_, headJoint)))
+  for (int j = 1; j < int(skeleton.size()); ++j)
+    if (io::normaliseJointName(skeleton.joints[size_t(j)].name).ends_with("head") &&
+        (headJoint < 0 || depthOf(skeleton, j) < depthOf(skeleton, headJoint)))
       headJoint = j;
-  if (headJoint < 0) {
+  if (headJoint < 0) return {};
+  std::vector<int> chain = {headJoint};
+  for (int a = skeleton.joints[size_t(headJoint)].parent;
+       a > 0 && io::normaliseJointName(skeleton.joints[size_t(a)].name).find("neck") != std::string::npos;
+       a = skeleton.joints[size_t(a)].parent)
+    chain.push_back(a);
+  return chain;
+}
+
+}  // namespace
+
+std::optional<LimbCorrection> LimbClearance::limitNeck(Pose& pose) const {
+  if (!(settings_.neckRangeDegrees > 0.f) || neckChain_.empty()) return std::nullopt;
+  float total = 0.f;
+  for (int j : neckChain_) total += angleDegrees(skeleton_.joints[size_t(j)].rest.rotation, pose.local[size_t(j)]);
+  if (!(total > settings_.neckRangeDegrees)) return std::nullopt;
+  const float keep = settings_.neckRangeDegrees / total;
+  for (int j : neckChain_)
+    pose.local[size_t(j)] = slerpShortest(skeleton_.joints[size_t(j)].rest.rotation, pose.local[size_t(j)], keep);
+  LimbCorrection c{skeleton_.joints[size_t(neckChain_.front())].name, total - settings_.neckRangeDegrees, 0.f, 0.f};
+  c.towardsRest = 1.f - keep;
+  return c;
+}
+
+void LimbClearance::setUpHead() {
+  const std::string what = "body";
+  if (neckChain_.empty()) {
     skipped_ += "; no joint named 'Head': the head is not checked either";
     return;
   }
   Head h;
-  h.joint = headJoint;
-  h.chain.push_back(headJoint);
-  for (int a = skeleton_.joints[size_t(headJoint)].parent;
-       a > 0 && io::normaliseJointName(skeleton_.joints[size_t(a)].name).find("neck") != std::string::npos;
-       a = skeleton_.joints[size_t(a)].parent)
-    h.chain.push_back(a);
+  h.joint = neckChain_.front();
+  h.chain = neckChain_;
+  const int headJoint = h.joint;
   std::vector<char> inHead(skeleton_.size(), 0);
   for (size_t j = 0; j < skeleton_.size(); ++j)
     for (int a = int(j); a >= 0; a = skeleton_.joints[size_t(a)].parent)

@@ -54,6 +54,15 @@ struct LimbClearanceSettings {
   float garmentReach = 0.03f;
   float headBorder =
       0.03f;  // m: one-surface bodies' head vertices this close to the rest of the body at rest are not checked
+  // Neck range (degrees; 0: none): where the neck chain's joints (the head joint and its "...Neck..."
+  // ancestors) together turn further than this from rest, every one of them is turned back towards
+  // rest by the same share of the way (slerp) until they turn this far. Why: a neck bowed or thrown
+  // back beyond what a neck does (CMU rolls and retargeting, up to 88 degrees in each of Neck1 and
+  // Head) sweeps the head's neck through the collar the garment's top band holds, and the solve
+  // tears it there: 35 of the 44 poses the committed default bake lost to explosions turn the chain
+  // by 90 degrees or more; at 90, 26 of the 44 are kept instead of 9 (docs/baking.md). The network
+  // reads no neck joint, so what the neck does beyond this only adds shapes it cannot explain.
+  float neckRangeDegrees = 90.f;
 };
 
 struct LimbCorrection {
@@ -108,7 +117,10 @@ class LimbClearance {
     int wholePart = 0;
   };
   std::optional<Head> head_;
+  std::vector<int> neckChain_;  // the head joint and its neck ancestors (empty: no joint named "Head")
   void setUpHead();
+  // The neck chain within settings_.neckRangeDegrees (see the settings); what it changed, if anything.
+  std::optional<LimbCorrection> limitNeck(Pose& pose) const;
   // `p`: `pose` checked and with its root at rest (as apply measures it).
   std::optional<LimbCorrection> applyHead(Pose& pose, Pose p) const;
 };

@@ -140,6 +140,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"attach_band", 0.03},
                           {"damping", 1.5},
                           {"limb_garment_reach", 0.1},
+                          {"limb_neck_range", 45},
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25}}},
@@ -165,6 +166,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_FLOAT_EQ(s.simulation.material.damping, 1.5f);
   EXPECT_FLOAT_EQ(s.limbClearance.garmentReach, 0.1f);
   EXPECT_FLOAT_EQ(d.part1->limbClearance.garmentReach, LimbClearanceSettings{}.garmentReach);
+  EXPECT_FLOAT_EQ(s.limbClearance.neckRangeDegrees, 45.f);
+  EXPECT_FLOAT_EQ(d.part1->limbClearance.neckRangeDegrees, 90.f);
   EXPECT_FLOAT_EQ(d.part1->simulation.material.damping, clothMaterialPreset("jersey").damping);
   EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(s.toJson(), "dataset settings").simulation.material.damping, 1.5f);
   EXPECT_FALSE(d.part1->toJson()["simulation"].contains("damping"));  // the preset's: not recorded
@@ -197,6 +200,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"simulation", {{"attach_band", 0.9}}}}), "part1.simulation.attach_band: 0.9 is outside");
   says(part1Error({{"simulation", {{"limb_garment_reach", -0.1}}}}),
        "part1.simulation.limb_garment_reach: -0.1 is outside");
+  says(part1Error({{"simulation", {{"limb_neck_range", 800}}}}), "part1.simulation.limb_neck_range: 800 is outside");
   says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
   says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
   says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");

@@ -228,7 +228,9 @@ float headInsideBody(const HeadedCapsule& h, const Pose& pose) {
 TEST(LimbClearance, OneSurfaceHeadBowedIntoTheBodyIsTurnedBackTowardsRest) {
   const HeadedCapsule h;
   const Skeleton& s = h.character.skeleton;
-  const LimbClearance lc(h.character);
+  LimbClearanceSettings noRange;  // the head step alone (the neck range would turn 170 degrees back first)
+  noRange.neckRangeDegrees = 0.f;
+  const LimbClearance lc(h.character, noRange);
   ASSERT_TRUE(lc.checksHead()) << lc.skipped();
   EXPECT_TRUE(lc.skipped().empty()) << lc.skipped();
   EXPECT_EQ(lc.limbCount(), 0u);
@@ -285,4 +287,53 @@ TEST(LimbClearance, BodiesOfPartsNeverGetTheHeadStep) {
   ASSERT_GE(neck, 0);
   p.local[size_t(neck)] = Quatf(Eigen::AngleAxisf(1.4f, Vec3f::UnitX()));
   for (const LimbCorrection& f : lc.apply(p)) EXPECT_EQ(f.towardsRest, 0.f) << f.joint;
+}
+
+// The neck range: a neck chain (Neck, Neck1, Head on the mannequin) turned further from rest than the
+// range, all its joints together, is turned back to the range, every joint by the same share; a neck
+// within it, and every other joint, is left as recorded.
+TEST(LimbClearance, ANeckBeyondItsRangeIsTurnedBackToIt) {
+  const Character& c = mannequin();
+  const Skeleton& s = c.skeleton;
+  auto degreesFromRest = [&](const Pose& p, const char* joint) {
+    const size_t j = size_t(s.find(joint));
+    const float d = std::min(1.f, std::abs(s.joints[j].rest.rotation.normalized().dot(p.local[j].normalized())));
+    return 2.f * std::acos(d) * 180.f / float(M_PI);
+  };
+  Pose recorded = s.restPose();  // the A-pose: no limb in the torso
+  const float bow = 88.f * float(M_PI) / 180.f;
+  recorded.local[size_t(s.find("Neck1"))] = Quatf(Eigen::AngleAxisf(bow, Vec3f::UnitX()));
+  recorded.local[size_t(s.find("Head"))] = Quatf(Eigen::AngleAxisf(bow, Vec3f::UnitX()));
+  const LimbClearance lc(c);  // the default range: 90 degrees
+  Pose p = recorded;
+  const std::vector<LimbCorrection> fixes = lc.apply(p);
+  // First the range (the head joint names the chain), then limb clearance as for any pose: the head,
+  // still bowed 90 degrees, is a part in front of the torso, turned out of it at its root, the Neck.
+  ASSERT_GE(fixes.size(), 1u);
+  EXPECT_EQ(fixes[0].joint, "Head");
+  EXPECT_NEAR(fixes[0].degrees, 176.f - 90.f, 0.5f);
+  EXPECT_NEAR(fixes[0].towardsRest, 1.f - 90.f / 176.f, 0.01f);
+  for (size_t k = 1; k < fixes.size(); ++k) EXPECT_EQ(fixes[k].joint, "Neck");
+  EXPECT_NEAR(degreesFromRest(p, "Neck1"), 45.f, 0.5f);  // each by the same share of its 88 degrees
+  EXPECT_NEAR(degreesFromRest(p, "Head"), 45.f, 0.5f);
+  for (size_t j = 0; j < s.size(); ++j) {
+    const std::string& n = s.joints[j].name;
+    if (n != "Neck" && n != "Neck1" && n != "Head") EXPECT_EQ(p.local[j].coeffs(), recorded.local[j].coeffs()) << n;
+  }
+  // Within the range: as recorded.
+  Pose within = s.restPose();
+  within.local[size_t(s.find("Neck1"))] = Quatf(Eigen::AngleAxisf(0.7f, Vec3f::UnitX()));
+  const Pose before = within;
+  EXPECT_TRUE(lc.apply(within).empty());
+  for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(within.local[j].coeffs(), before.local[j].coeffs());
+  // Range 0: the neck as recorded, however far it turns.
+  LimbClearanceSettings off;
+  off.neckRangeDegrees = 0.f;
+  Pose q = recorded;
+  for (const LimbCorrection& f : LimbClearance(c, off).apply(q)) EXPECT_EQ(f.joint, "Neck");  // the head limb only
+  EXPECT_EQ(q.local[size_t(s.find("Neck1"))].coeffs(), recorded.local[size_t(s.find("Neck1"))].coeffs());
+  EXPECT_EQ(q.local[size_t(s.find("Head"))].coeffs(), recorded.local[size_t(s.find("Head"))].coeffs());
+  LimbClearanceSettings bad;
+  bad.neckRangeDegrees = -1.f;
+  EXPECT_THROW(LimbClearance(c, bad), Error);
 }
