@@ -294,6 +294,7 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"tolerance", tolerance},
           {"poses_corrected", posesCorrected},
           {"max_correction_degrees", maxCorrectionDegrees},
+          {"neck_range_poses", neckRangePoses},
           {"corrections_by_joint",
            [&] {
              nlohmann::json j = nlohmann::json::object();
@@ -454,10 +455,17 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
     std::vector<std::vector<LimbCorrection>> corrections(poses.size());
     tbb::parallel_for(size_t(0), poses.size(),
                       [&](size_t i) { poses[i] = shapes.poseToSimulate(recorded[i], &corrections[i]); });
-    size_t stillInside = 0;
+    size_t stillInside = 0, neckPoses = 0;
+    double neckMean = 0.0, neckMax = 0.0;
     for (const auto& c : corrections) {
-      if (!c.empty()) ++res.posesCorrected;
+      if (std::any_of(c.begin(), c.end(), [](const LimbCorrection& x) { return !x.neckRange; })) ++res.posesCorrected;
       for (const LimbCorrection& x : c) {
+        if (x.neckRange) {  // reported on its own line below
+          ++neckPoses;
+          neckMean += double(x.degrees);
+          neckMax = std::max(neckMax, double(x.degrees));
+          continue;
+        }
         res.maxCorrectionDegrees = std::max(res.maxCorrectionDegrees, x.degrees);
         if (x.depthAfter > 0.f) ++stillInside;
         DatasetBuildResult::JointCorrections& j = res.correctionsByJoint[x.joint];
@@ -487,9 +495,19 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
           double(res.maxCorrectionDegrees), stillInside, since(t));
     if (clearance.limbCount() > 0) log(line);
     if (!byJoint.empty()) log("part 1: turned out, by joint: " + byJoint);
+    res.neckRangePoses = neckPoses;
+    if (neckPoses > 0) {
+      char neck[200];
+      std::snprintf(neck, sizeof neck,
+                    "part 1: neck range %.0f degrees: %zu poses turned the neck chain further, turned back to it "
+                    "(mean %.0f, max %.0f degrees taken off)",
+                    double(s.limbClearance.neckRangeDegrees), neckPoses, neckMean / double(neckPoses), neckMax);
+      log(neck);
+    }
     if (clearance.checksHead()) {
       for (const auto& c : corrections)
-        for (const LimbCorrection& x : c) res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);
+        for (const LimbCorrection& x : c)
+          if (!x.neckRange) res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);
       std::snprintf(line, sizeof line,
                     "part 1: head clearance (one-surface body, %zu head vertices checked): %zu of %zu poses had the "
                     "head inside the body; neck turned back towards rest by up to %.0f %% (%.0f degrees), %zu still "
@@ -499,6 +517,7 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
       log(line);
       for (size_t i = 0; i < corrections.size(); ++i)
         for (const LimbCorrection& x : corrections[i]) {
+          if (x.neckRange) continue;  // counted on the neck range's line
           std::snprintf(line, sizeof line,
                         "part 1: head clearance: pose %zu: head %.1f mm inside, neck turned %.0f %% back to rest "
                         "(%s %.1f degrees), %.1f mm after",

@@ -150,6 +150,7 @@ struct DatasetBuildResult {
   bool restPoseAdded = false;  // the rest pose was appended to the thinned poses (after the first stage's)
   size_t posesCorrected = 0;   // poses whose limbs (or one-surface head) were turned out of the body
   float maxCorrectionDegrees = 0.f;
+  size_t neckRangePoses = 0;  // poses whose neck chain the neck range turned back (limb_clearance.hpp)
   // Per root joint turned (limb clearance): in how many poses, by how much (mean and largest degrees).
   // Tells which of the body's limbs its clips put through the trunk (the mannequin's hanging arms).
   struct JointCorrections {

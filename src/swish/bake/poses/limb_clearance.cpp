@@ -290,6 +290,7 @@ std::optional<LimbCorrection> LimbClearance::limitNeck(Pose& pose) const {
     pose.local[size_t(j)] = slerpShortest(skeleton_.joints[size_t(j)].rest.rotation, pose.local[size_t(j)], keep);
   LimbCorrection c{skeleton_.joints[size_t(neckChain_.front())].name, total - settings_.neckRangeDegrees, 0.f, 0.f};
   c.towardsRest = 1.f - keep;
+  c.neckRange = true;
   return c;
 }
 

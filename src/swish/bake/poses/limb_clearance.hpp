@@ -73,6 +73,9 @@ struct LimbCorrection {
   // Head clearance only (joint: the head joint): the fraction of the way back to rest the neck chain
   // was turned (0.2: 20 %); `degrees` is then how far that turned the head joint in its chain's frame.
   float towardsRest = 0.f;
+  // The neck range (joint: the head joint; `degrees` taken off the chain's turn from rest), not a limb
+  // turned out of the trunk.
+  bool neckRange = false;
 };
 
 class LimbClearance {

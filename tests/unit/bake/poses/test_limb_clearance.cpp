@@ -311,9 +311,13 @@ TEST(LimbClearance, ANeckBeyondItsRangeIsTurnedBackToIt) {
   // still bowed 90 degrees, is a part in front of the torso, turned out of it at its root, the Neck.
   ASSERT_GE(fixes.size(), 1u);
   EXPECT_EQ(fixes[0].joint, "Head");
+  EXPECT_TRUE(fixes[0].neckRange);
   EXPECT_NEAR(fixes[0].degrees, 176.f - 90.f, 0.5f);
   EXPECT_NEAR(fixes[0].towardsRest, 1.f - 90.f / 176.f, 0.01f);
-  for (size_t k = 1; k < fixes.size(); ++k) EXPECT_EQ(fixes[k].joint, "Neck");
+  for (size_t k = 1; k < fixes.size(); ++k) {
+    EXPECT_EQ(fixes[k].joint, "Neck");
+    EXPECT_FALSE(fixes[k].neckRange);
+  }
   EXPECT_NEAR(degreesFromRest(p, "Neck1"), 45.f, 0.5f);  // each by the same share of its 88 degrees
   EXPECT_NEAR(degreesFromRest(p, "Head"), 45.f, 0.5f);
   for (size_t j = 0; j < s.size(); ++j) {
