@@ -186,6 +186,7 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
     if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
   // The neck within its range first: the head's position decides whether it is inside anything.
   if (std::optional<LimbCorrection> c = limitNeck(pose)) out.push_back(*c);
+  if (limbs_.empty() && !head_) return out;  // no parts to keep apart, no head to check (skipped() says why)
   // Measured with the root at rest, as the solver simulates it (the shape ignores the root).
   Pose p = pose;
   p.local[0] = skeleton_.joints[0].rest.rotation;

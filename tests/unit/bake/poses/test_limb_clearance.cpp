@@ -168,6 +168,13 @@ TEST(LimbClearance, OnePartBodiesAndBadPosesAreLeftAlone) {
   const LimbClearance holed(open);
   EXPECT_EQ(holed.limbCount(), 0u);
   EXPECT_NE(holed.skipped().find("not a closed surface"), std::string::npos) << holed.skipped();
+  // Its neck still keeps its range (and nothing else is looked at).
+  Pose bowed = open.skeleton.restPose();
+  bowed.local[size_t(open.skeleton.find("Neck1"))] = Quatf(Eigen::AngleAxisf(1.6f, Vec3f::UnitX()));
+  bowed.local[size_t(open.skeleton.find("Head"))] = Quatf(Eigen::AngleAxisf(1.6f, Vec3f::UnitX()));
+  const std::vector<LimbCorrection> neckOnly = holed.apply(bowed);
+  ASSERT_EQ(neckOnly.size(), 1u);
+  EXPECT_TRUE(neckOnly[0].neckRange);
   Pose p = capsule.skeleton.restPose();
   p.local[2] = Quatf(Eigen::AngleAxisf(1.2f, Vec3f::UnitX()));
   EXPECT_TRUE(lc.apply(p).empty());
