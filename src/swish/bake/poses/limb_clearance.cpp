@@ -81,6 +81,11 @@ int depthOf(const Skeleton& s, int j) {
 // The head joint and its neck ancestors (defined with the head clearance below).
 std::vector<int> neckChain(const Skeleton& skeleton);
 
+// The angle of the rotation between two orientations, degrees.
+float angleDegrees(const Quatf& a, const Quatf& b) {
+  return a.normalized().angularDistance(b.normalized()) * 180.f / float(M_PI);
+}
+
 }  // namespace
 
 LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings)
@@ -179,9 +184,7 @@ size_t LimbClearance::guardedTriangles() const { return size_t(std::count(guarde
 
 std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   std::vector<LimbCorrection> out;
-  if ((limbs_.empty() && !head_ && !(settings_.neckRangeDegrees > 0.f && !neckChain_.empty())) ||
-      pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite())
-    return out;
+  if (pose.local.size() != skeleton_.size() || !pose.rootTranslation.allFinite()) return out;
   for (const Quatf& q : pose.local)
     if (!q.coeffs().allFinite() || !(q.norm() > 0.f)) return out;
   // The neck within its range first: the head's position decides whether it is inside anything.
@@ -256,12 +259,6 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
 }
 
 namespace {
-
-// The angle between two rotations, degrees.
-float angleDegrees(const Quatf& a, const Quatf& b) {
-  const float d = std::min(1.f, std::abs(a.normalized().dot(b.normalized())));
-  return 2.f * std::acos(d) * 180.f / float(M_PI);
-}
 
 std::vector<int> neckChain(const Skeleton& skeleton) {
   // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
@@ -405,8 +402,7 @@ std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const
   for (int j : h.chain) pose.local[size_t(j)] = p.local[size_t(j)];
   LimbCorrection c{skeleton_.joints[size_t(h.joint)].name, 0.f, before, after > kTolerance ? after : 0.f,
                    float(percent) / 100.f};
-  const float dot = std::min(1.f, std::abs(headInChain(recorded).dot(headInChain(p))));
-  c.degrees = 2.f * std::acos(dot) * 180.f / float(M_PI);
+  c.degrees = angleDegrees(headInChain(recorded), headInChain(p));
   return c;
 }
 

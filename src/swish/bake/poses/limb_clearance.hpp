@@ -61,7 +61,8 @@ struct LimbClearanceSettings {
   // Head) sweeps the head's neck through the collar the garment's top band holds, and the solve
   // tears it there: 35 of the 44 poses the committed default bake lost to explosions turn the chain
   // by 90 degrees or more; at 90, 26 of the 44 are kept instead of 9 (docs/baking.md). The network
-  // reads no neck joint, so what the neck does beyond this only adds shapes it cannot explain.
+  // reads no neck joint, so what the neck does beyond this only adds shapes it cannot explain. Part of
+  // the limb clearance: a bake without it (limb_clearance 0) leaves the neck as recorded too.
   float neckRangeDegrees = 90.f;
 };
 
