@@ -28,9 +28,9 @@ TEST(PoseShape, ACorrectionReSkinsOnlyTheVerticesItsJointsMove) {
   const Character ch = makeDefaultCharacter();
   const Skeleton& sk = ch.skeleton;
   PoseShapeSettings s;
-  s.simulationVertices = 0;            // the welded game mesh: no refinement, quick to build
-  s.limbClearance.clearance = 0.f;     // the test sets the recorded pose itself
-  s.transfer.maxEdgeStrain = 1e6f;     // the skinned arm overhead is no cloth; only step 4 is tested
+  s.simulationVertices = 0;         // the welded game mesh: no refinement, quick to build
+  s.limbClearance.clearance = 0.f;  // the test sets the recorded pose itself
+  s.transfer.maxEdgeStrain = 1e6f;  // the skinned arm overhead is no cloth; only step 4 is tested
   const PoseShapeSimulator shapes(ch, s);
 
   // Simulated: the left arm turned 166 degrees from rest, so that the armpit's skinning collapses (115
@@ -70,7 +70,8 @@ TEST(PoseShape, ACorrectionReSkinsOnlyTheVerticesItsJointsMove) {
         blendedSkinMatrix(ch.garment.skin, size_t(v), simulatedMatrices).topLeftCorner<3, 3>());
     if (svd.singularValues().minCoeff() < s.transfer.unskin.minSingularValue) {
       ++damped;
-      dampedRoundTripMm = std::max(dampedRoundTripMm, 1000.0 * double((reskinned.row(v) - same.gameMeshWorld.row(v)).norm()));
+      dampedRoundTripMm =
+          std::max(dampedRoundTripMm, 1000.0 * double((reskinned.row(v) - same.gameMeshWorld.row(v)).norm()));
     }
   }
   EXPECT_GT(onThigh, 0u);
@@ -78,7 +79,8 @@ TEST(PoseShape, ACorrectionReSkinsOnlyTheVerticesItsJointsMove) {
   // The case this is for: collapsed vertices away from the thigh, which the round trip would have moved.
   EXPECT_GT(damped, 0u);
   EXPECT_GT(dampedRoundTripMm, 5.0);
-  std::printf("%zu vertices re-skinned (thigh weights), %zu kept as simulated, %zu of them damped by un-skinning "
-              "(the round trip would have moved them up to %.1f mm)\n",
-              onThigh, elsewhere, damped, dampedRoundTripMm);
+  std::printf(
+      "%zu vertices re-skinned (thigh weights), %zu kept as simulated, %zu of them damped by un-skinning "
+      "(the round trip would have moved them up to %.1f mm)\n",
+      onThigh, elsewhere, damped, dampedRoundTripMm);
 }
