@@ -34,8 +34,8 @@ TEST(PoseShape, ACorrectionReSkinsOnlyTheVerticesItsJointsMove) {
   const PoseShapeSimulator shapes(ch, s);
 
   // Simulated: the left arm turned 166 degrees from rest, so that the armpit's skinning collapses (115
-  // jersey vertices below the un-skinning floor; 150 degrees: none). Recorded: the
-  // same with the left thigh turned, as limb clearance turns a thigh out of the crotch.
+  // jersey vertices below the un-skinning floor; at 155 degrees none). Recorded: the same with the left
+  // thigh turned, as limb clearance turns a thigh out of the crotch.
   Pose simulated = sk.restPose();
   const int arm = sk.find("LeftArm"), thigh = sk.find("LeftUpLeg");
   ASSERT_GE(arm, 0);
