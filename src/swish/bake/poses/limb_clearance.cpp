@@ -78,8 +78,22 @@ int depthOf(const Skeleton& s, int j) {
   return d;
 }
 
-// The head joint and its neck ancestors (defined with the head clearance below).
-std::vector<int> neckChain(const Skeleton& skeleton);
+// The head joint and its neck ancestors.
+std::vector<int> neckChain(const Skeleton& skeleton) {
+  // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
+  int headJoint = -1;
+  for (int j = 1; j < int(skeleton.size()); ++j)
+    if (io::normaliseJointName(skeleton.joints[size_t(j)].name).ends_with("head") &&
+        (headJoint < 0 || depthOf(skeleton, j) < depthOf(skeleton, headJoint)))
+      headJoint = j;
+  if (headJoint < 0) return {};
+  std::vector<int> chain = {headJoint};
+  for (int a = skeleton.joints[size_t(headJoint)].parent;
+       a > 0 && io::normaliseJointName(skeleton.joints[size_t(a)].name).find("neck") != std::string::npos;
+       a = skeleton.joints[size_t(a)].parent)
+    chain.push_back(a);
+  return chain;
+}
 
 // The angle of the rotation between two orientations, degrees.
 float angleDegrees(const Quatf& a, const Quatf& b) {
@@ -258,26 +272,6 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   return out;
 }
 
-namespace {
-
-std::vector<int> neckChain(const Skeleton& skeleton) {
-  // The head joint: the shallowest joint named "Head" or "...Head" (not the root).
-  int headJoint = -1;
-  for (int j = 1; j < int(skeleton.size()); ++j)
-    if (io::normaliseJointName(skeleton.joints[size_t(j)].name).ends_with("head") &&
-        (headJoint < 0 || depthOf(skeleton, j) < depthOf(skeleton, headJoint)))
-      headJoint = j;
-  if (headJoint < 0) return {};
-  std::vector<int> chain = {headJoint};
-  for (int a = skeleton.joints[size_t(headJoint)].parent;
-       a > 0 && io::normaliseJointName(skeleton.joints[size_t(a)].name).find("neck") != std::string::npos;
-       a = skeleton.joints[size_t(a)].parent)
-    chain.push_back(a);
-  return chain;
-}
-
-}  // namespace
-
 std::optional<LimbCorrection> LimbClearance::limitNeck(Pose& pose) const {
   if (!(settings_.neckRangeDegrees > 0.f) || neckChain_.empty()) return std::nullopt;
   float total = 0.f;
@@ -299,9 +293,7 @@ void LimbClearance::setUpHead() {
     return;
   }
   Head h;
-  h.joint = neckChain_.front();
-  h.chain = neckChain_;
-  const int headJoint = h.joint;
+  const int headJoint = neckChain_.front();
   std::vector<char> inHead(skeleton_.size(), 0);
   for (size_t j = 0; j < skeleton_.size(); ++j)
     for (int a = int(j); a >= 0; a = skeleton_.joints[size_t(a)].parent)
@@ -384,14 +376,14 @@ std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const
   if (before <= kTolerance) return std::nullopt;
   const Pose recorded = p;
   // The head joint in the frame of its chain's parent, to tell how far the head turned.
-  const int top = skeleton_.joints[size_t(h.chain.back())].parent;
+  const int top = skeleton_.joints[size_t(neckChain_.back())].parent;
   auto headInChain = [&](const Pose& q) {
     const std::vector<RigidTransform> g = skeleton_.globalTransforms(q);
-    return Quatf(g[size_t(top)].rotation.conjugate() * g[size_t(h.joint)].rotation);
+    return Quatf(g[size_t(top)].rotation.conjugate() * g[size_t(neckChain_.front())].rotation);
   };
   // The smallest whole percentage of the way back to rest that clears the head.
   auto depthAt = [&](int percent) {
-    for (int j : h.chain)
+    for (int j : neckChain_)
       p.local[size_t(j)] =
           slerpShortest(recorded.local[size_t(j)], skeleton_.joints[size_t(j)].rest.rotation, float(percent) / 100.f)
               .normalized();
@@ -399,8 +391,8 @@ std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const
   };
   float after = before;
   const int percent = smallestClearing(100, before, depthAt, after);
-  for (int j : h.chain) pose.local[size_t(j)] = p.local[size_t(j)];
-  LimbCorrection c{skeleton_.joints[size_t(h.joint)].name, 0.f, before, after > kTolerance ? after : 0.f,
+  for (int j : neckChain_) pose.local[size_t(j)] = p.local[size_t(j)];
+  LimbCorrection c{skeleton_.joints[size_t(neckChain_.front())].name, 0.f, before, after > kTolerance ? after : 0.f,
                    float(percent) / 100.f};
   c.degrees = angleDegrees(headInChain(recorded), headInChain(p));
   return c;

@@ -113,15 +113,15 @@ class LimbClearance {
   std::string skipped_;
 
   struct Head {
-    int joint = -1;                     // the head joint
-    std::vector<int> chain;             // the joints turned back to rest: the head joint and its neck ancestors
-    std::vector<uint32_t> vertices;     // checked head vertices
+    std::vector<uint32_t> vertices;     // checked head vertices (the joints turned back: neckChain_)
     std::optional<BodyCollider> rest;   // the body without the head's triangles, unposed
     std::optional<BodyCollider> whole;  // the whole closed body, unposed: its winding number confirms inside
     int wholePart = 0;
   };
   std::optional<Head> head_;
-  std::vector<int> neckChain_;  // the head joint and its neck ancestors (empty: no joint named "Head")
+  // The head joint and its neck ancestors (empty: no joint named "Head"): what the neck range limits and
+  // the head step turns back to rest.
+  std::vector<int> neckChain_;
   void setUpHead();
   // The neck chain within settings_.neckRangeDegrees (see the settings); what it changed, if anything.
   std::optional<LimbCorrection> limitNeck(Pose& pose) const;

@@ -329,7 +329,9 @@ TEST(LimbClearance, ANeckBeyondItsRangeIsTurnedBackToIt) {
   EXPECT_NEAR(degreesFromRest(p, "Head"), 45.f, 0.5f);
   for (size_t j = 0; j < s.size(); ++j) {
     const std::string& n = s.joints[j].name;
-    if (n != "Neck" && n != "Neck1" && n != "Head") EXPECT_EQ(p.local[j].coeffs(), recorded.local[j].coeffs()) << n;
+    if (n != "Neck" && n != "Neck1" && n != "Head") {
+      EXPECT_EQ(p.local[j].coeffs(), recorded.local[j].coeffs()) << n;
+    }
   }
   // Within the range: as recorded.
   Pose within = s.restPose();
