@@ -16,12 +16,6 @@ std::optional<LimbClearance> makeClearance(const Character& c, const LimbClearan
   return std::nullopt;
 }
 
-bool samePose(const Pose& a, const Pose& b) {
-  return a.local.size() == b.local.size() &&
-         std::equal(a.local.begin(), a.local.end(), b.local.begin(),
-                    [](const Quatf& x, const Quatf& y) { return x.coeffs() == y.coeffs(); });
-}
-
 }  // namespace
 
 Pose canonicalPose(const Skeleton& skeleton, Pose p) {
@@ -53,26 +47,28 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
   // corrected simulation; the world shape is that shape skinned as the run time will skin it with
   // the recorded pose. The model so learns its real inputs, and the sleeves of a hanging arm pass
   // into the torso with the arm, as the body does.
-  if (!samePose(simulated, recorded)) {
-    const SkinWeights& skin = character_->garment.skin;
-    const std::vector<Mat4f> simulatedMatrices = character_->skeleton.skinningMatrices(simulated);
-    const std::vector<Mat4f> recordedMatrices = character_->skeleton.skinningMatrices(recorded);
+  //
+  // Only the vertices whose skinning the correction changed, i.e. weighted on a joint it moved. Elsewhere
+  // both poses skin alike, and the round trip through pre-skin space would give the simulated shape
+  // back, except where un-skinning damps a collapsed matrix (core/skinning.hpp): an armpit vertex half
+  // on the spine and half on a raised arm then falls towards its collapsed rest position while its
+  // neighbours stay where the cloth is: a thigh turned out of the crotch alone tore the jersey under
+  // the arms. On the session-19 default bake's 3884 cached simulations 13 poses tear instead of 25 (7
+  // of 10 torn poses looked at had only a thigh turned; the worst edge 163-354 % as simulated,
+  // 448-3170 % round-tripped).
+  const SkinWeights& skin = character_->garment.skin;
+  const std::vector<Mat4f> simulatedMatrices = character_->skeleton.skinningMatrices(simulated);
+  const std::vector<Mat4f> recordedMatrices = character_->skeleton.skinningMatrices(recorded);
+  std::vector<char> moved(recordedMatrices.size(), 0);
+  for (size_t j = 0; j < moved.size(); ++j) moved[j] = simulatedMatrices[j] != recordedMatrices[j];
+  if (std::find(moved.begin(), moved.end(), 1) != moved.end()) {
     const Points3f reskinned = skinPositions(tp.gameMeshPreSkin, skin, recordedMatrices);
-    // Only the vertices whose skinning the correction changed. Elsewhere both poses skin alike, and
-    // the round trip through pre-skin space would give the simulated shape back, except where
-    // un-skinning damps a collapsed matrix (core/skinning.hpp): an armpit vertex half on the spine and
-    // half on a raised arm then falls towards its collapsed rest position while its neighbours stay
-    // where the cloth is: a thigh turned out of the crotch alone tore the jersey under the arms. On the
-    // session-19 default bake's 3884 cached simulations 13 poses tear instead of 25 (7 of 10 torn poses
-    // looked at had only a thigh turned; the worst edge 163-354 % as simulated, 448-3170 % round-tripped).
-    for (Eigen::Index v = 0; v < tp.gameMeshWorld.rows(); ++v) {
-      const size_t base = size_t(v) * size_t(skin.influences);
-      for (size_t k = base; k < base + size_t(skin.influences); ++k)
-        if (skin.weights[k] > 0.f && simulatedMatrices[skin.joints[k]] != recordedMatrices[skin.joints[k]]) {
+    for (Eigen::Index v = 0; v < tp.gameMeshWorld.rows(); ++v)
+      for (size_t k = size_t(v) * size_t(skin.influences); k < size_t(v + 1) * size_t(skin.influences); ++k)
+        if (skin.weights[k] > 0.f && moved[skin.joints[k]]) {
           tp.gameMeshWorld.row(v) = reskinned.row(v);
           break;
         }
-    }
   }
   const EdgeStretch worst = transfer_.worstEdge(tp.gameMeshWorld);
   if (!(worst.strain <= settings_.transfer.maxEdgeStrain)) {
