@@ -203,6 +203,7 @@ void BodyCollider::rebuild() {
     if (pass == 1) {
       for (size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
       cellTriangles_.resize(cellStart_[cells]);
+      cellSpheres_.resize(cellStart_[cells]);
       fill.assign(cellStart_.begin(), cellStart_.end() - 1);
     }
     for (size_t t = 0; t < nt; ++t) {
@@ -213,8 +214,10 @@ void BodyCollider::rebuild() {
             const size_t c = (size_t(z) * gridDims_[1] + y) * gridDims_[0] + x;
             if (pass == 0)
               ++cellStart_[c + 1];
-            else
+            else {
+              cellSpheres_[fill[c]] = triangleSpheres_[t];
               cellTriangles_[fill[c]++] = uint32_t(t);
+            }
           }
     }
   }
@@ -251,44 +254,74 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
   constexpr size_t kMaxParts = 16;
   std::array<PartBest, kMaxParts> parts;
   size_t partCount = 0;
-  for (int z = a[2]; z <= b[2]; ++z)
-    for (int y = a[1]; y <= b[1]; ++y)
-      for (int x = a[0]; x <= b[0]; ++x) {
-        const size_t c = (size_t(z) * gridDims_[1] + y) * gridDims_[0] + x;
-        for (uint32_t i = cellStart_[c]; i < cellStart_[c + 1]; ++i) {
-          const uint32_t t = cellTriangles_[i];
-          const Vec4f& s = triangleSpheres_[t];
-          const float lower = (p - s.head<3>()).norm() - s[3];
-          if (lower > maxDistance) continue;
-          const uint32_t part = triangleComponent_[t];
-          if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
-          const uint32_t key = byRegion ? triangleRegion_[t] : part;
-          size_t slot = 0;
-          while (slot < partCount && parts[slot].key != key) ++slot;
-          if (slot < partCount && lower > parts[slot].distance) continue;
-          const ClosestOnTriangle q = closestOnTriangle(
-              p, positions_.row(triangles_(t, 0)), positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
-          const float d = (p - q.point).norm();
-          if (!(d <= maxDistance)) continue;
-          if (slot == partCount) {
-            if (partCount == kMaxParts) {
-              // More parts within reach than kept: replace the farthest answer if this is nearer.
-              size_t worst = 0;
-              for (size_t k = 1; k < partCount; ++k)
-                if (parts[k].distance > parts[worst].distance) worst = k;
-              if (!(d < parts[worst].distance)) continue;
-              parts[worst] = {key, part, d, int(t), q};
-              continue;
-            }
-            parts[partCount++] = {key, part, d, int(t), q};
-            continue;
-          }
-          // Ties (a triangle seen from two cells, or two triangles sharing the closest feature) keep
-          // the lowest triangle index, so the answer does not depend on the visiting order.
-          PartBest& pb = parts[slot];
-          if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {key, part, d, int(t), q};
+  // The rejects below only skip triangles that cannot be within maxDistance (or cannot beat the best
+  // answer so far): the answer does not depend on which triangles are visited beyond those, nor in
+  // what order (ties go to the lower triangle), so they change its cost, never its value. Both are
+  // conservative by a margin far above float rounding (kSlack), so a triangle at the bound is visited.
+  constexpr float kSlack = 1e-4f;  // metres, and a relative 1e-4 on squared distances
+  const float reachSq = (maxDistance + kSlack) * (maxDistance + kSlack);
+  // Squared distance from p to a slab of cells along one axis (0 inside it).
+  auto slabSq = [&](int k, int i) {
+    const float lo = gridOrigin_[k] + float(i) * cellSize_, hi = lo + cellSize_;
+    const float d = p[k] < lo ? lo - p[k] : (p[k] > hi ? p[k] - hi : 0.f);
+    return d * d;
+  };
+  // The triangles binned in cell c (rejects, then the exact closest point).
+  auto visitCell = [&](size_t c) {
+    for (uint32_t i = cellStart_[c]; i < cellStart_[c + 1]; ++i) {
+      // Sphere reject on squared distances (no square root): |p - centre| > maxDistance + r.
+      const Vec4f& s = cellSpheres_[i];
+      const float reach = maxDistance + s[3];
+      if ((p - s.head<3>()).squaredNorm() > reach * reach * (1.f + kSlack) + kSlack * kSlack) continue;
+      const uint32_t t = cellTriangles_[i];
+      const uint32_t part = triangleComponent_[t];
+      if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
+      const uint32_t key = byRegion ? triangleRegion_[t] : part;
+      size_t slot = 0;
+      while (slot < partCount && parts[slot].key != key) ++slot;
+      if (slot < partCount && (p - s.head<3>()).norm() - s[3] > parts[slot].distance) continue;
+      const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
+                                                    positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
+      const float d = (p - q.point).norm();
+      if (!(d <= maxDistance)) continue;
+      if (slot == partCount) {
+        if (partCount == kMaxParts) {
+          // More parts within reach than kept: replace the farthest answer if this is nearer.
+          size_t worst = 0;
+          for (size_t k = 1; k < partCount; ++k)
+            if (parts[k].distance > parts[worst].distance) worst = k;
+          if (!(d < parts[worst].distance)) continue;
+          parts[worst] = {key, part, d, int(t), q};
+          continue;
         }
+        parts[partCount++] = {key, part, d, int(t), q};
+        continue;
       }
+      // Ties (a triangle seen from two cells, or two triangles sharing the closest feature) keep
+      // the lowest triangle index, so the answer does not depend on the visiting order.
+      PartBest& pb = parts[slot];
+      if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {key, part, d, int(t), q};
+    }
+  };
+  // The cell holding p first: its triangles are usually the nearest, and once a part has an answer the
+  // reject of triangles that cannot beat it skips most of the others.
+  const Eigen::Vector3i home =
+      ((p - gridOrigin_) / cellSize_).array().floor().cast<int>().max(a.array()).min(b.array());
+  visitCell((size_t(home[2]) * gridDims_[1] + home[1]) * gridDims_[0] + home[0]);
+  for (int z = a[2]; z <= b[2]; ++z) {
+    const float dz = slabSq(2, z);
+    for (int y = a[1]; y <= b[1]; ++y) {
+      const float dzy = dz + slabSq(1, y);
+      if (dzy > reachSq) continue;
+      for (int x = a[0]; x <= b[0]; ++x) {
+        // A cell the search ball does not reach (a corner of the ball's box) holds nothing within
+        // reach that another visited cell does not also hold: each triangle is binned in every cell
+        // its box overlaps, so its point nearest p is in a cell at most that far from p.
+        if (dzy + slabSq(0, x) > reachSq || (x == home[0] && y == home[1] && z == home[2])) continue;
+        visitCell((size_t(z) * gridDims_[1] + y) * gridDims_[0] + x);
+      }
+    }
+  }
   // Each part's signed distance from its own closest feature's pseudo-normal. A region of a split part
   // is an open patch, its closest feature not always the part's: a point outside the part (by the
   // part's closest region, confirmed as ever) is outside each of its patches; a point inside it is

@@ -472,6 +472,57 @@ TEST(ClothBodyCollider, TheDefaultMannequinIsNotSplitIntoRegions) {
   }
 }
 
+TEST(ClothBodyCollider, GridQueriesAnswerAsIfEveryTriangleWereVisited) {
+  // A query visits only the grid cells its search ball reaches, the cell holding the point first, and
+  // rejects triangles by bounds: none of that may change an answer. Against a collider of one cell
+  // (every triangle visited, in index order), bit for bit, on the default mannequin with an arm
+  // raised through its shoulder (overlapping parts) and its elbows bent, at the solver's contact reach,
+  // the band's anchor reach and the final projection's widest search.
+  const Character ch = makeDefaultCharacter();
+  Pose pose = ch.skeleton.restPose();
+  auto turn = [&](const char* joint, float radians, const Vec3f& axis) {
+    const size_t j = size_t(ch.skeleton.find(joint));
+    pose.local[j] = pose.local[j] * Quatf(Eigen::AngleAxisf(radians, axis.normalized()));
+  };
+  turn("LeftArm", 1.6f, Vec3f(0.2f, 0.1f, 1.f));
+  turn("RightArm", -0.9f, Vec3f(0.f, 0.3f, 1.f));
+  turn("LeftForeArm", 1.9f, Vec3f(0.f, 1.f, 0.2f));
+  turn("Spine1", 0.4f, Vec3f(1.f, 0.f, 0.3f));
+  const std::vector<Mat4f> m = ch.skeleton.skinningMatrices(pose);
+  BodyCollider grid(ch.body, 0.024f, "default body"), whole(ch.body, 100.f, "default body");
+  grid.pose(m);
+  whole.pose(m);
+  const Vec3f lo = grid.positions().colwise().minCoeff().transpose().array() - 0.05f;
+  const Vec3f hi = grid.positions().colwise().maxCoeff().transpose().array() + 0.05f;
+  Rng rng(test::testSeed(59));
+  size_t answered = 0, twoParts = 0;
+  for (int i = 0; i < 3000; ++i) {
+    // Half the points near the surface (where the solver asks), half anywhere in the body's box.
+    Vec3f p(rng.uniformf(lo.x(), hi.x()), rng.uniformf(lo.y(), hi.y()), rng.uniformf(lo.z(), hi.z()));
+    if (i % 2 == 0) {
+      const Vec3f q = grid.positions().row(Eigen::Index(rng.below(uint64_t(grid.positions().rows()))));
+      p = q + Vec3f(rng.uniformf(-0.03f, 0.03f), rng.uniformf(-0.03f, 0.03f), rng.uniformf(-0.03f, 0.03f));
+    }
+    for (float reach : {0.024f, 0.1f, 0.384f}) {
+      std::array<BodyCollider::Hit, 3> a, b;
+      const size_t na = grid.closestParts(p, reach, std::span(a)), nb = whole.closestParts(p, reach, std::span(b));
+      ASSERT_EQ(na, nb) << "point " << p.transpose() << ", reach " << reach;
+      answered += na > 0;
+      twoParts += na > 1;
+      for (size_t k = 0; k < na; ++k) {
+        ASSERT_EQ(a[k].triangle, b[k].triangle) << "point " << p.transpose() << ", reach " << reach;
+        EXPECT_EQ(a[k].signedDistance, b[k].signedDistance);
+        EXPECT_EQ(a[k].point, b[k].point);
+        EXPECT_EQ(a[k].normal, b[k].normal);
+        EXPECT_EQ(a[k].part, b[k].part);
+      }
+    }
+  }
+  // The sample reaches the surface and the overlaps (not a test of empty answers).
+  EXPECT_GT(answered, 3000u);
+  EXPECT_GT(twoParts, 300u);
+}
+
 namespace {
 
 // Winding number of a closed triangle mesh at p, by the textbook sum of solid angles in double
