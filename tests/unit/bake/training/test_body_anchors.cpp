@@ -441,7 +441,7 @@ TEST(PushOutReference, KnownAnswersAndContinuity) {
     Points3f x(1, 3);
     x << 0.f, 1.f, -0.04f + 0.00015f * float(s);
     Points3f y = x;
-    runtime::referencePushOut(y, BodyAnchors{0.002f, {a}}, mats);
+    runtime::referencePushOut(y, BodyAnchors{0.002f, {a}, {}}, mats);
     EXPECT_GE(y(0, 2), x(0, 2) - 1e-7f);
     EXPECT_GE(y(0, 2), 0.002f - 1e-6f);
     if (s > 0) {
@@ -452,7 +452,7 @@ TEST(PushOutReference, KnownAnswersAndContinuity) {
   // On the centre there is no direction: the vertex stays.
   Points3f centre(1, 3);
   centre << 0.f, 1.f, -0.05f;
-  EXPECT_EQ(runtime::referencePushOut(centre, BodyAnchors{0.002f, {a}}, mats), 0u);
+  EXPECT_EQ(runtime::referencePushOut(centre, BodyAnchors{0.002f, {a}, {}}, mats), 0u);
 
   // Errors: anchors for another vertex count, a weighted joint without a matrix.
   Points3f two = p.topRows(2);
