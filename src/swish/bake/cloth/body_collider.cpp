@@ -256,8 +256,10 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
   size_t partCount = 0;
   // The rejects below only skip triangles that cannot be within maxDistance (or cannot beat the best
   // answer so far): the answer does not depend on which triangles are visited beyond those, nor in
-  // what order (ties go to the lower triangle), so they change its cost, never its value. Both are
-  // conservative by a margin far above float rounding (kSlack), so a triangle at the bound is visited.
+  // what order (ties go to the lower triangle), so they change its cost, never its value (with at most
+  // kMaxParts parts or regions within reach: 8 parts make the default mannequin, 3 regions a glTF body;
+  // beyond that which ones are dropped depends on the order). Both rejects are conservative by a margin
+  // far above float rounding (kSlack), so a triangle at the bound is visited.
   constexpr float kSlack = 1e-4f;  // metres, and a relative 1e-4 on squared distances
   const float reachSq = (maxDistance + kSlack) * (maxDistance + kSlack);
   // Squared distance from p to a slab of cells along one axis (0 inside it).
