@@ -153,7 +153,8 @@ void BodyCollider::rebuild() {
   faceNormals_.assign(nt, Vec3f::Zero());
   vertexNormals_.assign(nv, Vec3f::Zero());
   edgeNormals_.assign(edgeTriangles_.size(), Vec3f::Zero());
-  triangleSpheres_.resize(nt);
+  // Each triangle's bounding sphere (centre + radius), copied per cell below for the queries' reject.
+  std::vector<Vec4f> spheres(nt);
   for (size_t t = 0; t < nt; ++t) {
     const Vec3f p[3] = {positions_.row(triangles_(t, 0)), positions_.row(triangles_(t, 1)),
                         positions_.row(triangles_(t, 2))};
@@ -170,7 +171,7 @@ void BodyCollider::rebuild() {
     }
     const Vec3f centre = (p[0] + p[1] + p[2]) / 3.f;
     const float r = std::max({(p[0] - centre).norm(), (p[1] - centre).norm(), (p[2] - centre).norm()});
-    triangleSpheres_[t] =
+    spheres[t] =
         Vec4f(centre.x(), centre.y(), centre.z(), r);  // not "<< centre, r": GCC 12 warns (-Warray-bounds) on that
   }
   for (auto& n : vertexNormals_) n.normalize();
@@ -215,7 +216,7 @@ void BodyCollider::rebuild() {
             if (pass == 0)
               ++cellStart_[c + 1];
             else {
-              cellSpheres_[fill[c]] = triangleSpheres_[t];
+              cellSpheres_[fill[c]] = spheres[t];
               cellTriangles_[fill[c]++] = uint32_t(t);
             }
           }
@@ -273,15 +274,15 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
     for (uint32_t i = cellStart_[c]; i < cellStart_[c + 1]; ++i) {
       // Sphere reject on squared distances (no square root): |p - centre| > maxDistance + r.
       const Vec4f& s = cellSpheres_[i];
-      const float reach = maxDistance + s[3];
-      if ((p - s.head<3>()).squaredNorm() > reach * reach * (1.f + kSlack) + kSlack * kSlack) continue;
+      const float reach = maxDistance + s[3], centreSq = (p - s.head<3>()).squaredNorm();
+      if (centreSq > reach * reach * (1.f + kSlack) + kSlack * kSlack) continue;
       const uint32_t t = cellTriangles_[i];
       const uint32_t part = triangleComponent_[t];
       if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
       const uint32_t key = byRegion ? triangleRegion_[t] : part;
       size_t slot = 0;
       while (slot < partCount && parts[slot].key != key) ++slot;
-      if (slot < partCount && (p - s.head<3>()).norm() - s[3] > parts[slot].distance) continue;
+      if (slot < partCount && std::sqrt(centreSq) - s[3] > parts[slot].distance) continue;
       const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
                                                     positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
       const float d = (p - q.point).norm();

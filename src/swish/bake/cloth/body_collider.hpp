@@ -125,9 +125,8 @@ class BodyCollider {
 
   Points3f positions_;
   std::vector<Vec3f> faceNormals_, vertexNormals_, edgeNormals_;
-  std::vector<Vec4f> triangleSpheres_;  // centre + radius: a cheap reject before the exact test
-  // Each cell's triangles' spheres, in cellTriangles_' order: the reject reads them in a row instead of
-  // one cache line per triangle.
+  // The bounding sphere (centre + radius) of each of a cell's triangles, in cellTriangles_' order: a
+  // cheap reject before the exact test, read in a row instead of one cache line per triangle.
   std::vector<Vec4f> cellSpheres_;
   Vec3f gridOrigin_ = Vec3f::Zero();
   Eigen::Vector3i gridDims_ = Eigen::Vector3i::Zero();
