@@ -180,6 +180,26 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     EXPECT_GT(subjects.perSubject[0].errorMm, 0.0);
     EXPECT_EQ(subjects.toJson()["per_subject_systematic"][0]["systematic_mm"].get<double>(),
               subjects.perSubject[0].systematicMm);
+    // The same figures per skinning joint's vertices: a partition of the game mesh (each vertex with its
+    // strongest joint), so the vertex-weighted means give the whole-garment figures back.
+    {
+      const SubjectEvaluation::Subject& x = subjects.perSubject[0];
+      ASSERT_GE(x.byJoint.size(), 2u);
+      size_t vertices = 0;
+      double error = 0, systematic = 0;
+      for (const SubjectEvaluation::Subject::Region& r : x.byJoint) {
+        EXPECT_GT(r.vertices, 0u) << r.joint;
+        EXPECT_GE(out.model.skeleton.find(r.joint), 0) << r.joint;
+        EXPECT_LE(r.systematicMm, r.errorMm * (1 + 1e-9)) << r.joint;
+        vertices += r.vertices;
+        error += r.errorMm * double(r.vertices);
+        systematic += r.systematicMm * double(r.vertices);
+      }
+      EXPECT_EQ(vertices, out.model.gameMesh.vertexCount());
+      EXPECT_NEAR(error / double(vertices), x.errorMm, 1e-9 * x.errorMm);
+      EXPECT_NEAR(systematic / double(vertices), x.systematicMm, 1e-9 * x.systematicMm);
+      EXPECT_EQ(subjects.toJson()["per_subject_systematic"][0]["by_joint"].size(), x.byJoint.size());
+    }
     const auto sdir = tmp / "report_subjects";
     const auto smd = writeBakeReport(out, ds, sdir, 0, &subjects);
     const auto sreport = nlohmann::json::parse(std::ifstream(sdir / "report.json"));
@@ -187,6 +207,7 @@ TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
     std::ifstream mdIn(smd);
     const std::string text((std::istreambuf_iterator<char>(mdIn)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("held-out subjects mean mm"), std::string::npos) << text;
+    EXPECT_NE(text.find("| joint | vertices | subject 99 |"), std::string::npos) << text;
     EXPECT_NE(text.find("| subject | poses | error mm (pre-skinning) | the same in every frame mm | share |"),
               std::string::npos)
         << text;

@@ -28,8 +28,9 @@ std::vector<SubjectEvaluation::Subject> systematicErrors(const Model& model,
                                                          const std::vector<const DatasetPose*>& poses,
                                                          const nlohmann::json& origins) {
   struct Sum {
-    Eigen::MatrixXd offset;  // per vertex, summed error vectors
-    double error = 0.0;      // summed |error| over poses and vertices
+    Eigen::MatrixXd offset;       // per vertex, summed error vectors
+    Eigen::VectorXd vertexError;  // per vertex, summed |error| over poses
+    double error = 0.0;           // summed |error| over poses and vertices
     size_t poses = 0;
   };
   std::map<std::string, Sum> sums;
@@ -39,16 +40,38 @@ std::vector<SubjectEvaluation::Subject> systematicErrors(const Model& model,
                                     : std::string("?");
     const Points3f d = predictPreSkin(model, p->pose) - p->gameMeshPreSkin;
     Sum& s = sums[subject];
-    if (s.poses == 0) s.offset = Eigen::MatrixXd::Zero(d.rows(), 3);
+    if (s.poses == 0) s.offset = Eigen::MatrixXd::Zero(d.rows(), 3), s.vertexError = Eigen::VectorXd::Zero(d.rows());
     s.offset += d.cast<double>();
-    s.error += d.cast<double>().rowwise().norm().sum();
+    const Eigen::VectorXd e = d.cast<double>().rowwise().norm();
+    s.vertexError += e;
+    s.error += e.sum();
     ++s.poses;
+  }
+  // Each game vertex's region: its strongest skinning joint.
+  const SkinWeights& skin = model.gameMesh.skin;
+  const size_t nv = model.gameMesh.vertexCount();
+  std::vector<uint16_t> region(nv);
+  std::vector<size_t> regionVertices(model.skeleton.size(), 0);
+  for (size_t v = 0; v < nv; ++v) {
+    region[v] = skin.strongestJoint(v);
+    if (region[v] < regionVertices.size()) ++regionVertices[region[v]];
   }
   std::vector<SubjectEvaluation::Subject> out;
   for (const auto& [subject, s] : sums) {
     const double n = double(s.offset.rows());
-    out.push_back({subject, s.poses, 1000.0 * s.error / (n * double(s.poses)),
-                   1000.0 * (s.offset / double(s.poses)).rowwise().norm().sum() / n});
+    const Eigen::VectorXd same = (s.offset / double(s.poses)).rowwise().norm();
+    SubjectEvaluation::Subject x{
+        subject, s.poses, 1000.0 * s.error / (n * double(s.poses)), 1000.0 * same.sum() / n, {}};
+    std::vector<double> err(regionVertices.size(), 0.0), sys(regionVertices.size(), 0.0);
+    for (size_t v = 0; v < nv && v < size_t(same.size()); ++v)
+      if (region[v] < err.size())
+        err[region[v]] += s.vertexError[Eigen::Index(v)], sys[region[v]] += same[Eigen::Index(v)];
+    for (size_t j = 0; j < regionVertices.size(); ++j)
+      if (regionVertices[j] > 0)
+        x.byJoint.push_back({model.skeleton.joints[j].name, regionVertices[j],
+                             1000.0 * err[j] / (double(regionVertices[j]) * double(s.poses)),
+                             1000.0 * sys[j] / double(regionVertices[j])});
+    out.push_back(std::move(x));
   }
   return out;
 }
@@ -77,11 +100,19 @@ nlohmann::json SubjectEvaluation::toJson() const {
                       {"overall", evaluationSummary(overall)},
                       {"per_clip", clips}};
   nlohmann::json subj = nlohmann::json::array();
-  for (const Subject& x : perSubject)
+  for (const Subject& x : perSubject) {
+    nlohmann::json regions = nlohmann::json::array();
+    for (const Subject::Region& r : x.byJoint)
+      regions.push_back({{"joint", r.joint},
+                         {"vertices", r.vertices},
+                         {"pre_skin_error_mm", r.errorMm},
+                         {"systematic_mm", r.systematicMm}});
     subj.push_back({{"subject", x.subject},
                     {"poses", x.poses},
                     {"pre_skin_error_mm", x.errorMm},
-                    {"systematic_mm", x.systematicMm}});
+                    {"systematic_mm", x.systematicMm},
+                    {"by_joint", regions}});
+  }
   j["per_subject_systematic"] = subj;
   if (overall.penetrationMeasured) j["penetration"] = penetrationJson(overall);
   if (!guard.rows.empty()) j["novelty_guard_study"] = guard.toJson();
@@ -260,6 +291,22 @@ std::string SubjectEvaluation::markdown(const BakeEvaluation& random) const {
     for (const Subject& x : perSubject)
       md << "| " << x.subject << " | " << x.poses << " | " << f2(x.errorMm) << " | " << f2(x.systematicMm) << " | "
          << (x.errorMm > 0 ? f2(100.0 * x.systematicMm / x.errorMm) + " %" : std::string("-")) << " |\n";
+    md << "\n";
+    // Where on the garment: every subject has the same regions (one game mesh).
+    const std::vector<Subject::Region>& first = perSubject.front().byJoint;
+    md << "Where on the garment (each game vertex with its strongest skinning joint): error / the same in every "
+          "frame, mm, pre-skinning space.\n\n| joint | vertices |";
+    for (const Subject& x : perSubject) md << " subject " << x.subject << " |";
+    md << "\n|---|---|";
+    for (size_t i = 0; i < perSubject.size(); ++i) md << "---|";
+    md << "\n";
+    for (size_t r = 0; r < first.size(); ++r) {
+      md << "| " << first[r].joint << " | " << first[r].vertices << " |";
+      for (const Subject& x : perSubject)
+        md << " " << (r < x.byJoint.size() ? f2(x.byJoint[r].errorMm) + " / " + f2(x.byJoint[r].systematicMm) : "-")
+           << " |";
+      md << "\n";
+    }
     md << "\n";
   }
   if (!guard.rows.empty()) md << guard.markdown();

@@ -66,6 +66,15 @@ struct SubjectEvaluation {
     size_t poses = 0;
     double errorMm = 0.0;       // mean over poses and vertices of |predicted - truth|, pre-skinning space
     double systematicMm = 0.0;  // mean over vertices of |mean over poses of (predicted - truth)|
+    // The same two figures over the game vertices of each skinning joint (a vertex goes with its
+    // strongest joint): where on the garment the offset sits (a collar on the neck's posture, a hem on
+    // the hips', sleeves on the arms'). Joints in skeleton order, those with no vertex left out.
+    struct Region {
+      std::string joint;
+      size_t vertices = 0;
+      double errorMm = 0.0, systematicMm = 0.0;
+    };
+    std::vector<Region> byJoint;
   };
   std::vector<Subject> perSubject;
   GuardStudy guard;
