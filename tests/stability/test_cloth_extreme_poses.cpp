@@ -126,12 +126,12 @@ Pose limbThroughTheBody(const Skeleton& sk) {
 
 // A recorded pose that explodes at the bake's resolution (CMU 05_09 frame 183, a dancer's arm raised
 // forwards overhead, session 22): the right upper arm 171 degrees from rest and the collar bone raised
-// 18 degrees, as the clip has them (local rotations on top of the rest pose's). Without the collar bone,
-// or with it at 10 degrees, the same arm simulates; so does the pose at 3000 vertices. With both, the
-// raised collar bone carries the arm tube's root into the torso's shoulder, the two parts overlap in a
-// lens there, and the cloth caught in it is pushed out of the arm into the torso at one vertex and out
-// of the torso into the arm at its neighbour: edges 3 to 7 times their length (docs/baking.md, "Two leads
-// measured in session 22").
+// 18 degrees, as the clip has them to 3 decimals (local rotations on top of the rest pose's). Without
+// the collar bone, or with it at 10 degrees, the same arm simulates; so does the pose at 3000 vertices.
+// With both, the raised collar bone carries the arm tube's root into the torso's shoulder, the two
+// parts overlap in a lens there, and the cloth caught in it is pushed out of the arm into the torso at
+// one vertex and out of the torso into the arm at its neighbour: edges stretched by 230 to 700 %
+// (docs/baking.md, "Two leads measured in session 22").
 Pose collarBoneRaisedArmOverhead(const Skeleton& sk) {
   Pose p = sk.restPose();
   const int arm = sk.find("RightArm"), collar = sk.find("RightShoulder");
