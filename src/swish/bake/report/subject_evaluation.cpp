@@ -30,7 +30,6 @@ std::vector<SubjectEvaluation::Subject> systematicErrors(const Model& model,
   struct Sum {
     Eigen::MatrixXd offset;       // per vertex, summed error vectors
     Eigen::VectorXd vertexError;  // per vertex, summed |error| over poses
-    double error = 0.0;           // summed |error| over poses and vertices
     size_t poses = 0;
   };
   std::map<std::string, Sum> sums;
@@ -42,30 +41,27 @@ std::vector<SubjectEvaluation::Subject> systematicErrors(const Model& model,
     Sum& s = sums[subject];
     if (s.poses == 0) s.offset = Eigen::MatrixXd::Zero(d.rows(), 3), s.vertexError = Eigen::VectorXd::Zero(d.rows());
     s.offset += d.cast<double>();
-    const Eigen::VectorXd e = d.cast<double>().rowwise().norm();
-    s.vertexError += e;
-    s.error += e.sum();
+    s.vertexError += d.cast<double>().rowwise().norm();
     ++s.poses;
   }
-  // Each game vertex's region: its strongest skinning joint.
-  const SkinWeights& skin = model.gameMesh.skin;
+  // Each game vertex's region: its strongest skinning joint (Model::validate keeps every joint index
+  // inside the skeleton; predictPreSkin gives one row per game vertex).
   const size_t nv = model.gameMesh.vertexCount();
   std::vector<uint16_t> region(nv);
   std::vector<size_t> regionVertices(model.skeleton.size(), 0);
   for (size_t v = 0; v < nv; ++v) {
-    region[v] = skin.strongestJoint(v);
-    if (region[v] < regionVertices.size()) ++regionVertices[region[v]];
+    region[v] = model.gameMesh.skin.strongestJoint(v);
+    ++regionVertices[region[v]];
   }
   std::vector<SubjectEvaluation::Subject> out;
   for (const auto& [subject, s] : sums) {
-    const double n = double(s.offset.rows());
+    const double n = double(nv);
     const Eigen::VectorXd same = (s.offset / double(s.poses)).rowwise().norm();
     SubjectEvaluation::Subject x{
-        subject, s.poses, 1000.0 * s.error / (n * double(s.poses)), 1000.0 * same.sum() / n, {}};
+        subject, s.poses, 1000.0 * s.vertexError.sum() / (n * double(s.poses)), 1000.0 * same.sum() / n, {}};
     std::vector<double> err(regionVertices.size(), 0.0), sys(regionVertices.size(), 0.0);
-    for (size_t v = 0; v < nv && v < size_t(same.size()); ++v)
-      if (region[v] < err.size())
-        err[region[v]] += s.vertexError[Eigen::Index(v)], sys[region[v]] += same[Eigen::Index(v)];
+    for (size_t v = 0; v < nv; ++v)
+      err[region[v]] += s.vertexError[Eigen::Index(v)], sys[region[v]] += same[Eigen::Index(v)];
     for (size_t j = 0; j < regionVertices.size(); ++j)
       if (regionVertices[j] > 0)
         x.byJoint.push_back({model.skeleton.joints[j].name, regionVertices[j],
@@ -292,7 +288,7 @@ std::string SubjectEvaluation::markdown(const BakeEvaluation& random) const {
       md << "| " << x.subject << " | " << x.poses << " | " << f2(x.errorMm) << " | " << f2(x.systematicMm) << " | "
          << (x.errorMm > 0 ? f2(100.0 * x.systematicMm / x.errorMm) + " %" : std::string("-")) << " |\n";
     md << "\n";
-    // Where on the garment: every subject has the same regions (one game mesh).
+    // Where on the garment: every subject has the same regions, in the same order (one game mesh).
     const std::vector<Subject::Region>& first = perSubject.front().byJoint;
     md << "Where on the garment (each game vertex with its strongest skinning joint): error / the same in every "
           "frame, mm, pre-skinning space.\n\n| joint | vertices |";
@@ -303,8 +299,7 @@ std::string SubjectEvaluation::markdown(const BakeEvaluation& random) const {
     for (size_t r = 0; r < first.size(); ++r) {
       md << "| " << first[r].joint << " | " << first[r].vertices << " |";
       for (const Subject& x : perSubject)
-        md << " " << (r < x.byJoint.size() ? f2(x.byJoint[r].errorMm) + " / " + f2(x.byJoint[r].systematicMm) : "-")
-           << " |";
+        md << " " << f2(x.byJoint[r].errorMm) << " / " << f2(x.byJoint[r].systematicMm) << " |";
       md << "\n";
     }
     md << "\n";
