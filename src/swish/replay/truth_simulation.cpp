@@ -174,7 +174,8 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
           "): " + std::to_string(simulator_->solver().mesh().vertexCount()) + " simulation vertices, preset '" +
           cs.material.name + "', " + std::to_string(cs.substeps) + " substeps x " + std::to_string(cs.iterations) +
           " iterations at " + fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) +
-          " s transition + " + fmtNum("%g", cs.settleSeconds) + " s settle, limb clearance " +
+          " s transition + " + fmtNum("%g", cs.settleSeconds) + " s settle, carried by " +
+          (cs.carry == bake::ClothCarry::Translation ? "translation" : "skinning") + ", limb clearance " +
           fmtNum("%g", 1000.0 * ps.limbClearance.clearance) + " mm (trunk within " +
           fmtNum("%g", 1000.0 * ps.limbClearance.garmentReach) + " mm of the garment; 0: all), neck range " +
           fmtNum("%g", ps.limbClearance.neckRangeDegrees) + " deg (0: as recorded), smoothing " +

@@ -287,6 +287,8 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
     f.value(s.staticTolerance);
     f.value(s.staticIterations);
   }
+  // (9, hashed only for the translation carry, for the same reason.)
+  if (s.carry == ClothCarry::Translation) f.value(uint32_t(9));
   fingerprint_ = f.h;
 }
 
@@ -418,12 +420,17 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown) const
     const std::vector<Mat4f> m = localSkinMatrices(p);
     blendAll(m, blendNew);
 
-    // Carry every vertex (and its velocity) by its own skinning change since the last frame.
+    // Carry every vertex by its skinning's change since the last frame (ClothCarry).
     for (size_t v = 0; v < nv; ++v) {
       const Mat3f aOld = blendOld[v].leftCols<3>(), aNew = blendNew[v].leftCols<3>();
       if (!(std::abs(aOld.determinant()) > 1e-6f)) continue;  // degenerate blend: leave it to the solve
-      const Mat3f d = aNew * aOld.inverse();
       V3 xv(x.data() + 3 * v), vv(vel.data() + 3 * v);
+      if (s.carry == ClothCarry::Translation) {
+        const Vec3f r = restLocal_.row(Eigen::Index(v)).transpose();
+        xv += (aNew - aOld) * r + (blendNew[v].col(3) - blendOld[v].col(3));
+        continue;
+      }
+      const Mat3f d = aNew * aOld.inverse();
       xv = d * (xv - blendOld[v].col(3)) + blendNew[v].col(3);
       vv = d * Vec3f(vv);
     }

@@ -4,9 +4,9 @@
 // stretch, shear and bending constraints, the skinned body as a collider with thickness and Coulomb
 // friction, gravity, damping, and the garment's top band softly attached to its skinned position.
 //
-// Following the body: at every frame the cloth is carried by the change of its own skinning (each
-// vertex moved by B_new * B_old^-1), so a fast limb drags its sleeve along instead of tunnelling
-// through it; the solver then corrects what skinning gets wrong (stretch, squash, penetration, drape).
+// Following the body: at every frame the cloth is carried by the change of its own skinning, so a fast
+// limb drags its sleeve along instead of tunnelling through it; the solver then corrects what skinning
+// gets wrong (stretch, squash, penetration, drape). How it is carried is ClothCarry below.
 //
 // Coordinates: the solve runs relative to the garment's rest centre (huge character coordinates lose
 // no precision inside the solve) and ignores the pose's root translation (the shape is a function of
@@ -20,6 +20,20 @@
 #include "swish/bake/dataset/dataset.hpp"
 
 namespace swish::bake {
+
+// How the cloth follows the body from one frame to the next, before the frame's solve.
+enum class ClothCarry {
+  // Each vertex moved by its own skinning change B_new * B_old^-1: the cloth's offset from the vertex's
+  // skinned place is turned with its blend. Where blends of very different rotations meet (an arm
+  // raised overhead with its collar bone: the shoulder's cloth lies on the torso but is skinned partly
+  // to the arm) neighbours turn their offsets differently, and every frame's solve starts from a
+  // sheared cloth (docs/baking.md, "The carry").
+  Skinning,
+  // Each vertex moved by the displacement of its skinned rest position (B_new - B_old applied to its
+  // rest position): the offset keeps its direction. Measured on the default bake's poses that
+  // explode with Skinning: 11 of 16 simulate (docs/baking.md).
+  Translation,
+};
 
 struct ClothSimSettings {
   ClothMaterial material = clothMaterialPreset("jersey");
@@ -73,6 +87,7 @@ struct ClothSimSettings {
   // the transition of the one before (the equilibrium phase at the base settings), before it is
   // left out.
   int retries = 1;
+  ClothCarry carry = ClothCarry::Skinning;
 
   // Throws Error naming the field that is out of range.
   void validate() const;

@@ -102,6 +102,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "static_iterations",
                                                   "retries",
                                                   "final_projection",
+                                                  "carry",
                                                   "check_poses",
                                                   "source",
                                                   "path",
@@ -157,6 +158,17 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   cs.retries = int(sim.wholeNumber("retries", 0, 4, cs.retries));
   // Vertices left within the thickness of the body at the end are moved out along its normal.
   cs.finalProjection = sim.boolean("final_projection", cs.finalProjection);
+  // How the cloth follows the body from frame to frame (cloth_solver.hpp, ClothCarry).
+  if (sim.has("carry")) {
+    const JsonReader carry = sim.child("carry");
+    const std::string how = carry.nonEmptyString();
+    if (how == "skinning")
+      cs.carry = ClothCarry::Skinning;
+    else if (how == "translation")
+      cs.carry = ClothCarry::Translation;
+    else
+      carry.fail("'" + how + "' is not \"skinning\" or \"translation\"");
+  }
   // Poses sampled for the report's convergence and noise figures (simulation_quality.hpp; 0: none).
   s.quality.poses = size_t(sim.wholeNumber("check_poses", 0, 1000, double(s.quality.poses)));
   try {
@@ -282,6 +294,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (sim.is_object() && !sim.contains("limb_garment_reach")) s.limbClearance.garmentReach = 0.f;
   // Settings recorded before the neck range left the neck as recorded.
   if (sim.is_object() && !sim.contains("limb_neck_range")) s.limbClearance.neckRangeDegrees = 0.f;
+  // Settings recorded before the carry was a setting carried the cloth by its skinning.
+  if (sim.is_object() && !sim.contains("carry")) s.simulation.carry = ClothCarry::Skinning;
   return s.poseShape();
 }
 

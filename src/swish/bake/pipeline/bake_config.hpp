@@ -38,8 +38,9 @@
 //                      end condition: cloth_solver.hpp), "static_solve" (true: a Newton static solve
 //                      instead, static_solve.hpp) with "static_tolerance", "static_iterations",
 //                      "retries" (of a failed pose, slower each),
-//                      "final_projection" (out of the body at the end), "check_poses" (sampled for the
-//                      report's convergence and noise, 0: none),
+//                      "final_projection" (out of the body at the end), "carry": "skinning" (default) |
+//                      "translation" (how the cloth follows the body between frames: cloth_solver.hpp),
+//                      "check_poses" (sampled for the report's convergence and noise, 0: none),
 
 //                      "source": "solver" (default) | "external" with "path" (a folder of pose_<id>.obj/
 //                      .glb/.gltf/.fbx results, or one multi-frame .glb/.gltf/.fbx) and "space":

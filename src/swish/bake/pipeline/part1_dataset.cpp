@@ -279,6 +279,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
     out["simulation"]["static_tolerance"] = m.staticTolerance;
     out["simulation"]["static_iterations"] = m.staticIterations;
   }
+  if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = "translation";  // likewise
   return out;
 }
 

@@ -118,6 +118,12 @@ TEST(ClothPoseDriver, RedoesPosesWhoseSetupChangedOrWhoseFileIsDamaged) {
   const ClothSolver other(ch, buildSimulationMesh(ch, 0), cotton);
   EXPECT_NE(other.fingerprint(), solver.fingerprint());
   EXPECT_EQ(simulatePoses(other, poses, dir).simulated, 2u);
+  // Another carry: likewise (the shapes differ; the skinning carry keeps the fingerprint it always had).
+  ClothSimSettings translated = fastSettings();
+  translated.carry = ClothCarry::Translation;
+  const ClothSolver third(ch, buildSimulationMesh(ch, 0), translated);
+  EXPECT_NE(third.fingerprint(), solver.fingerprint());
+  EXPECT_EQ(simulatePoses(third, poses, dir).simulated, 2u);
 }
 
 TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {

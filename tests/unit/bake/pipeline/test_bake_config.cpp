@@ -143,7 +143,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"limb_neck_range", 45},
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
-                          {"static_iterations", 25}}},
+                          {"static_iterations", 25},
+                          {"carry", "translation"}}},
                         {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
                         {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
       "recipe.json", "/base");
@@ -182,6 +183,15 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   const PoseShapeSettings back = poseShapeSettingsFromJson(s.toJson(), "dataset settings");
   EXPECT_TRUE(back.simulation.staticSolve);
   EXPECT_EQ(back.simulation.staticIterations, 25);
+  // The carry: recorded only when not the skinning one, read back; settings without it (a model
+  // baked before it was a setting) carry by skinning.
+  EXPECT_EQ(s.simulation.carry, ClothCarry::Translation);
+  EXPECT_EQ(d.part1->simulation.carry, ClothCarry::Skinning);
+  EXPECT_EQ(back.simulation.carry, ClothCarry::Translation);
+  EXPECT_FALSE(d.part1->toJson()["simulation"].contains("carry"));
+  nlohmann::json withoutCarry = s.toJson();
+  withoutCarry["simulation"].erase("carry");
+  EXPECT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").simulation.carry, ClothCarry::Skinning);
   EXPECT_FLOAT_EQ(d.part1->simulation.attachTopFraction, ClothSimSettings{}.attachTopFraction);
   EXPECT_EQ(s.simulation.gravity, Vec3f::Zero());
   EXPECT_FLOAT_EQ(d.part1->simulation.gravity.y(), -9.81f);
@@ -202,6 +212,8 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
        "part1.simulation.limb_garment_reach: -0.1 is outside");
   says(part1Error({{"simulation", {{"limb_neck_range", 800}}}}), "part1.simulation.limb_neck_range: 800 is outside");
   says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
+  says(part1Error({{"simulation", {{"carry", "rigid"}}}}),
+       "part1.simulation.carry: 'rigid' is not \"skinning\" or \"translation\"");
   says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
   says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");
