@@ -69,7 +69,7 @@ constexpr const char* kEmbeddedRecipe = R"recipe({
         {"joint": "Head", "center": [0.0, 1.835, 0.005], "halfWidth": 0.02, "halfDepth": 0.02}
       ]},
       {"name": "LeftArmPart", "mirror": true, "ringsPerSpan": 6, "segments": 16, "stations": [
-        {"joint": "LeftArm", "at": "LeftArm", "offset": [0.005, -0.005, 0.0], "halfWidth": 0.056, "halfDepth": 0.056},
+        {"joint": "LeftArm", "at": "LeftArm", "offset": [0.005, -0.005, 0.0], "halfWidth": 0.04, "halfDepth": 0.04},
         {"joint": "LeftArm", "at": "LeftArm", "offset": [0.06, -0.07, 0.0], "halfWidth": 0.055, "halfDepth": 0.052},
         {"joint": "LeftForeArm", "at": "LeftForeArm", "halfWidth": 0.043, "halfDepth": 0.043},
         {"joint": "LeftHand", "at": "LeftHand", "halfWidth": 0.032, "halfDepth": 0.026},
