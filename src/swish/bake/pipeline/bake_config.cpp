@@ -159,16 +159,10 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   // Vertices left within the thickness of the body at the end are moved out along its normal.
   cs.finalProjection = sim.boolean("final_projection", cs.finalProjection);
   // How the cloth follows the body from frame to frame (cloth_solver.hpp, ClothCarry).
-  if (sim.has("carry")) {
-    const JsonReader carry = sim.child("carry");
-    const std::string how = carry.nonEmptyString();
-    if (how == "skinning")
-      cs.carry = ClothCarry::Skinning;
-    else if (how == "translation")
-      cs.carry = ClothCarry::Translation;
-    else
-      carry.fail("'" + how + "' is not \"skinning\" or \"translation\"");
-  }
+  const std::string carry = sim.nonEmptyString("carry", "skinning");
+  if (carry != "skinning" && carry != "translation")
+    sim.child("carry").fail("'" + carry + "' is not \"skinning\" or \"translation\"");
+  cs.carry = carry == "translation" ? ClothCarry::Translation : ClothCarry::Skinning;
   // Poses sampled for the report's convergence and noise figures (simulation_quality.hpp; 0: none).
   s.quality.poses = size_t(sim.wholeNumber("check_poses", 0, 1000, double(s.quality.poses)));
   try {
