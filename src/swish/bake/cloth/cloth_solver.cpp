@@ -124,6 +124,9 @@ void ClothSimSettings::validate() const {
         "equilibriumSeconds must be in [0, 60]");
   check(equilibriumIterations >= 0 && equilibriumIterations <= 1000, "equilibriumIterations must be in [0, 1000]");
   check(retries >= 0 && retries <= 4, "retries must be in [0, 4]");
+  check(!retryCarries.empty() && retryCarries.size() <= 2 &&
+            (retryCarries.size() == 1 || retryCarries[0] != retryCarries[1]),
+        "retryCarries must name one or two different carries");
   check(std::isfinite(staticTolerance) && staticTolerance > 0.f, "staticTolerance must be positive");
   check(staticIterations >= 1 && staticIterations <= 1000, "staticIterations must be in [1, 1000]");
 }
@@ -289,6 +292,13 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   }
   // (9, hashed only for the translation carry, for the same reason.)
   if (s.carry == ClothCarry::Translation) f.value(uint32_t(9));
+  firstAttemptFingerprint_ = f.h;
+  // (10: the retries' carries, hashed only when they are not the skinning one alone. A first-attempt
+  // result does not depend on them: the pose driver reuses those by firstAttemptFingerprint.)
+  if (s.retryCarries != std::vector<ClothCarry>{ClothCarry::Skinning}) {
+    f.value(uint32_t(10));
+    for (ClothCarry c : s.retryCarries) f.value(uint32_t(c));
+  }
   fingerprint_ = f.h;
 }
 
@@ -338,29 +348,33 @@ SimResiduals ClothSolver::measure(const Pose& target, const Points3f& positions)
 }
 
 PoseSimulation ClothSolver::simulate(const Pose& target) const {
-  PoseSimulation first = simulateOnce(target, 1);
+  PoseSimulation first = simulateOnce(target, 1, settings_.carry);
   if (first.ok || !first.retryable || settings_.retries == 0) return first;
   // Failure handling that keeps the data: the pose is simulated again along a safer path (twice the
-  // substeps and twice the transition per retry), and only left out when that fails too. The
-  // equilibrium phase at the end runs at the base settings either way, so a retried pose is solved
-  // to the same fixed point as the others (measured: the substeps alone move the result by cm).
+  // substeps and twice the transition per retry, each retry tried with each of retryCarries in turn),
+  // and only left out when that fails too. The equilibrium phase at the end runs at the base settings
+  // either way, so a retried pose is solved to the same fixed point as the others (measured: the
+  // substeps alone move the result by cm).
   double seconds = first.residuals.seconds;
   PoseSimulation last;
-  for (int retry = 1; retry <= settings_.retries; ++retry) {
-    last = simulateOnce(target, 1 << retry);
-    seconds += last.residuals.seconds;
-    last.attempts = retry + 1;
-    last.firstFailure = first.failure;
-    last.residuals.seconds = seconds;
-    if (last.ok) return last;
-  }
+  int attempts = 1;
+  for (int retry = 1; retry <= settings_.retries; ++retry)
+    for (ClothCarry carry : settings_.retryCarries) {
+      last = simulateOnce(target, 1 << retry, carry);
+      seconds += last.residuals.seconds;
+      last.attempts = ++attempts;
+      last.firstFailure = first.failure;
+      last.residuals.seconds = seconds;
+      if (last.ok) return last;
+    }
   last.failure = "after " + std::to_string(last.attempts) + " attempts (the last with " +
-                 std::to_string(1 << settings_.retries) + "x the substeps and transition): " + last.failure +
-                 "; first attempt: " + first.failure;
+                 std::to_string(1 << settings_.retries) + "x the substeps and transition, the " +
+                 (settings_.retryCarries.back() == ClothCarry::Translation ? "translation" : "skinning") +
+                 " carry): " + last.failure + "; first attempt: " + first.failure;
   return last;
 }
 
-PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown) const {
+PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, ClothCarry carry) const {
   const double start = threadCpuSeconds();
   PoseSimulation out;
   auto fail = [&](std::string why) {
@@ -425,7 +439,7 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown) const
       const Mat3f aOld = blendOld[v].leftCols<3>(), aNew = blendNew[v].leftCols<3>();
       if (!(std::abs(aOld.determinant()) > 1e-6f)) continue;  // degenerate blend: leave it to the solve
       V3 xv(x.data() + 3 * v), vv(vel.data() + 3 * v);
-      if (s.carry == ClothCarry::Translation) {
+      if (carry == ClothCarry::Translation) {
         const Vec3f r = restLocal_.row(Eigen::Index(v)).transpose();
         xv += (aNew - aOld) * r + (blendNew[v].col(3) - blendOld[v].col(3));
         continue;

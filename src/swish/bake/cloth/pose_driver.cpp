@@ -14,7 +14,11 @@
 namespace swish::bake {
 
 uint64_t poseFingerprint(const ClothSolver& solver, const Pose& pose) {
-  Fnv1a f(solver.fingerprint() ^ 0x9E3779B97F4A7C15ull);
+  return poseFingerprint(solver.fingerprint(), pose);
+}
+
+uint64_t poseFingerprint(uint64_t solverFingerprint, const Pose& pose) {
+  Fnv1a f(solverFingerprint ^ 0x9E3779B97F4A7C15ull);
   for (const Quatf& q : pose.local) f.matrix(q.coeffs());
   // The root translation is ignored by the solve, so it is not part of the fingerprint.
   return f.h;
@@ -32,6 +36,15 @@ std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path&
   } catch (const Error&) {
     return std::nullopt;  // unreadable leftovers are simply simulated again (and overwritten)
   }
+}
+
+std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path& dir, uint32_t poseId,
+                                                    const ClothSolver& solver, const Pose& pose) {
+  if (auto rec = loadFinishedPose(dir, poseId, poseFingerprint(solver, pose))) return rec;
+  if (solver.firstAttemptFingerprint() == solver.fingerprint()) return std::nullopt;
+  auto rec = loadFinishedPose(dir, poseId, poseFingerprint(solver.firstAttemptFingerprint(), pose));
+  if (rec && rec->result.ok && rec->result.attempts == 1) return rec;
+  return std::nullopt;
 }
 
 PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pose>& poses,
@@ -66,7 +79,7 @@ PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pos
   };
   for (uint32_t i : ids) {
     fingerprints[i] = poseFingerprint(solver, poses[i]);
-    auto rec = loadFinishedPose(dir, i, fingerprints[i]);
+    auto rec = loadFinishedPose(dir, i, solver, poses[i]);
     if (rec && (!rec->result.ok || size_t(rec->result.positions.rows()) == nv)) {
       ++run.reused;
       summaries.push_back(summary(i, rec->result));

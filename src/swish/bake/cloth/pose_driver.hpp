@@ -34,6 +34,8 @@ struct PoseSimulationRun {
 
 // The fingerprint a pose's file must carry to be reused: the solver's setup and the pose's rotations.
 uint64_t poseFingerprint(const ClothSolver& solver, const Pose& pose);
+// The same from a solver digest (fingerprint() or firstAttemptFingerprint()).
+uint64_t poseFingerprint(uint64_t solverFingerprint, const Pose& pose);
 
 // Simulates poses[i] as pose id i into `dir` (created if needed). maxThreads 0: TBB's default.
 // Throws Error if the folder cannot be made or a result cannot be written.
@@ -49,5 +51,10 @@ PoseSimulationRun simulatePoses(const ClothSolver& solver, const std::vector<Pos
 // Pose id i's stored result when it is present, readable and made for this solver and pose.
 std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path& dir, uint32_t poseId,
                                                     uint64_t fingerprint);
+// The same by the solver and the pose: also a result made under other retry settings when it was
+// solved on its first attempt (ClothSolver::firstAttemptFingerprint), so that changing how failed
+// poses are retried simulates again only the poses that failed or needed a retry.
+std::optional<SimulatedPoseRecord> loadFinishedPose(const std::filesystem::path& dir, uint32_t poseId,
+                                                    const ClothSolver& solver, const Pose& pose);
 
 }  // namespace swish::bake

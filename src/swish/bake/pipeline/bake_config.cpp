@@ -103,6 +103,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "retries",
                                                   "final_projection",
                                                   "carry",
+                                                  "retry_carries",
                                                   "check_poses",
                                                   "source",
                                                   "path",
@@ -159,10 +160,20 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   // Vertices left within the thickness of the body at the end are moved out along its normal.
   cs.finalProjection = sim.boolean("final_projection", cs.finalProjection);
   // How the cloth follows the body from frame to frame (cloth_solver.hpp, ClothCarry).
-  const std::string carry = sim.nonEmptyString("carry", "skinning");
-  if (carry != "skinning" && carry != "translation")
-    sim.child("carry").fail("'" + carry + "' is not \"skinning\" or \"translation\"");
-  cs.carry = carry == "translation" ? ClothCarry::Translation : ClothCarry::Skinning;
+  auto carryOf = [](const JsonReader& at, const std::string& c) {
+    if (c != "skinning" && c != "translation") at.fail("'" + c + "' is not \"skinning\" or \"translation\"");
+    return c == "translation" ? ClothCarry::Translation : ClothCarry::Skinning;
+  };
+  cs.carry = carryOf(sim.child("carry"), sim.nonEmptyString("carry", "skinning"));
+  // The carries a failed pose's retries try in turn (cloth_solver.hpp, ClothSimSettings::retryCarries).
+  if (sim.has("retry_carries")) {
+    const JsonReader list = sim.child("retry_carries");
+    const std::vector<std::string> names = list.strings();
+    if (names.size() > 2 || (names.size() == 2 && names[0] == names[1]))
+      list.fail("must name one or two different carries (\"skinning\", \"translation\")");
+    cs.retryCarries.clear();
+    for (size_t i = 0; i < names.size(); ++i) cs.retryCarries.push_back(carryOf(list.at(i), names[i]));
+  }
   // Poses sampled for the report's convergence and noise figures (simulation_quality.hpp; 0: none).
   s.quality.poses = size_t(sim.wholeNumber("check_poses", 0, 1000, double(s.quality.poses)));
   try {
@@ -171,8 +182,9 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
     sim.fail(e.what());
   }
 
-  const JsonReader tr = j.section("transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
-                                               "unskin_min_singular_value", "max_edge_strain"});
+  const JsonReader tr =
+      j.section("transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
+                             "unskin_min_singular_value", "max_edge_strain", "reskin_min_singular_value"});
   LaplacianSmoothingSettings& ls = s.transfer.smoothing;
   ls.strength = float(tr.number("smoothing_strength", 0, 1, ls.strength));
   ls.iterations = int(tr.wholeNumber("smoothing_iterations", 0, 1000, ls.iterations));
@@ -186,6 +198,9 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   UnskinSettings& un = s.transfer.unskin;
   un.minSingularValue = float(tr.number("unskin_min_singular_value", 0.01, 1, un.minSingularValue));
   s.transfer.maxEdgeStrain = float(tr.number("max_edge_strain", 0.5, 1000, s.transfer.maxEdgeStrain));
+  // Where a corrected pose's vertex moves with its skinned rest position (pose_transfer.hpp; 0: nowhere).
+  s.transfer.reskinMinSingularValue =
+      float(tr.number("reskin_min_singular_value", 0, 0.5, s.transfer.reskinMinSingularValue));
 
   const JsonReader nm = j.section("normal_maps", {"size", "max_distance", "dilation_rings", "bit_depth"});
   NormalMapBakeSettings& nb = s.transfer.normalMap;
@@ -290,6 +305,11 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (sim.is_object() && !sim.contains("limb_neck_range")) s.limbClearance.neckRangeDegrees = 0.f;
   // Settings recorded before the carry was a setting carried the cloth by its skinning.
   if (sim.is_object() && !sim.contains("carry")) s.simulation.carry = ClothCarry::Skinning;
+  // Settings recorded before the retries had their own carries retried with the skinning one.
+  if (sim.is_object() && !sim.contains("retry_carries")) s.simulation.retryCarries = {ClothCarry::Skinning};
+  // Settings recorded before it carried every corrected vertex through pre-skin space.
+  const nlohmann::json tr = datasetSettings.value("transfer", nlohmann::json::object());
+  if (tr.is_object() && !tr.contains("reskin_min_singular_value")) s.transfer.reskinMinSingularValue = 0.f;
   return s.poseShape();
 }
 

@@ -40,6 +40,8 @@
 //                      "retries" (of a failed pose, slower each),
 //                      "final_projection" (out of the body at the end), "carry": "skinning" (default) |
 //                      "translation" (how the cloth follows the body between frames: cloth_solver.hpp),
+//                      "retry_carries": ["skinning"] (default) | ["skinning", "translation"] | ... (the
+//                      carries each retry tries in turn),
 //                      "check_poses" (sampled for the report's convergence and noise, 0: none),
 
 //                      "source": "solver" (default) | "external" with "path" (a folder of pose_<id>.obj/
@@ -50,7 +52,9 @@
 //       "transfer": {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
 //                    "unskin_min_singular_value" (0.01-1, default 0.2: core/skinning.hpp),
 //                    "max_edge_strain" (0.5-1000, default 4: a game-mesh edge stretched more fails
-//                    the pose as torn; transfer/pose_transfer.hpp)},
+//                    the pose as torn; transfer/pose_transfer.hpp),
+//                    "reskin_min_singular_value" (0-0.5, default 0.4: where a corrected pose's vertex
+//                    moves with its skinned rest position; pose_transfer.hpp)},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}
 //     },

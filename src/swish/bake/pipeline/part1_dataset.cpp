@@ -280,6 +280,12 @@ nlohmann::json DatasetBuildSettings::toJson() const {
     out["simulation"]["static_iterations"] = m.staticIterations;
   }
   if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = "translation";  // likewise
+  if (transfer.reskinMinSingularValue > 0.f)                                           // likewise
+    out["transfer"]["reskin_min_singular_value"] = transfer.reskinMinSingularValue;
+  if (m.retryCarries != std::vector<ClothCarry>{ClothCarry::Skinning}) {  // likewise
+    nlohmann::json& list = out["simulation"]["retry_carries"] = nlohmann::json::array();
+    for (ClothCarry c : m.retryCarries) list.push_back(c == ClothCarry::Translation ? "translation" : "skinning");
+  }
   return out;
 }
 
@@ -625,7 +631,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
     // Made by a cluster's array tasks: every pose must be there; none is simulated here.
     std::vector<uint32_t> missing;
     for (uint32_t id = 0; id < poses.size(); ++id)
-      if (!loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]))) missing.push_back(id);
+      if (!loadFinishedPose(simulationDir, id, solver, poses[id])) missing.push_back(id);
     if (!missing.empty()) {
       std::string ids;
       for (size_t k = 0; k < missing.size() && k < 10; ++k) ids += (k ? ", " : "") + std::to_string(missing[k]);
@@ -702,8 +708,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
           }
           writer.writePose(dp);
         }
-      } else if (const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
-                 !rec || !rec->result.ok) {
+      } else if (const auto rec = loadFinishedPose(simulationDir, id, solver, poses[id]); !rec || !rec->result.ok) {
         failure = "simulation result missing or not usable";
       } else {
         // The pre-skin shape from the corrected simulation, the world shape skinned with the
@@ -806,7 +811,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
       if (quality.is_null()) {
         std::vector<Points3f> shapes;
         for (uint32_t id : ids) {
-          const auto rec = loadFinishedPose(simulationDir, id, poseFingerprint(solver, poses[id]));
+          const auto rec = loadFinishedPose(simulationDir, id, solver, poses[id]);
           shapes.push_back(rec ? rec->result.positions : Points3f());
         }
         SimulationQualitySettings qs = s.quality;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/SVD>
+
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 
@@ -56,19 +58,51 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
   // the arms. On the session-19 default bake's 3884 cached simulations 13 poses tear instead of 25 (7
   // of 10 torn poses looked at had only a thigh turned; the worst edge 163-354 % as simulated,
   // 448-3170 % round-tripped).
+  //
+  // Where the simulated pose's blend of a vertex nearly collapses (an armpit vertex half on the spine,
+  // half on an arm the correction raised), the round trip amplifies the cloth's offset from the body
+  // and tears the armpit (pose_transfer.hpp, reskinMinSingularValue); there the vertex moves with its
+  // skinned rest position instead, and its pre-skin position is taken back through the recorded pose's
+  // blend, so that the run time's skinning gives the shape stored here.
   const SkinWeights& skin = character_->garment.skin;
+  const Mesh& garment = character_->garment;
   const std::vector<Mat4f> simulatedMatrices = character_->skeleton.skinningMatrices(simulated);
   const std::vector<Mat4f> recordedMatrices = character_->skeleton.skinningMatrices(recorded);
   std::vector<char> moved(recordedMatrices.size(), 0);
   for (size_t j = 0; j < moved.size(); ++j) moved[j] = simulatedMatrices[j] != recordedMatrices[j];
   if (std::find(moved.begin(), moved.end(), 1) != moved.end()) {
     const Points3f reskinned = skinPositions(tp.gameMeshPreSkin, skin, recordedMatrices);
-    for (Eigen::Index v = 0; v < tp.gameMeshWorld.rows(); ++v)
+    const float lo = settings_.transfer.reskinMinSingularValue, hi = 2.f * lo;
+    std::vector<Eigen::Index> carried;  // vertices moved (partly) with their skinned rest position
+    for (Eigen::Index v = 0; v < tp.gameMeshWorld.rows(); ++v) {
+      bool onMoved = false;
       for (size_t k = size_t(v) * size_t(skin.influences); k < size_t(v + 1) * size_t(skin.influences); ++k)
-        if (skin.weights[k] > 0.f && moved[skin.joints[k]]) {
-          tp.gameMeshWorld.row(v) = reskinned.row(v);
-          break;
-        }
+        onMoved = onMoved || (skin.weights[k] > 0.f && moved[skin.joints[k]]);
+      if (!onMoved) continue;
+      float w = 1.f;  // the round trip's share
+      Mat4f bs = Mat4f::Identity();
+      if (lo > 0.f) {
+        bs = blendedSkinMatrix(skin, size_t(v), simulatedMatrices);
+        const float s = Eigen::JacobiSVD<Mat3f>(bs.topLeftCorner<3, 3>()).singularValues().minCoeff();
+        const float x = std::clamp((s - lo) / (hi - lo), 0.f, 1.f);
+        w = x * x * (3.f - 2.f * x);  // smoothstep: no seam where the blend starts
+      }
+      if (w >= 1.f) {
+        tp.gameMeshWorld.row(v) = reskinned.row(v);
+        continue;
+      }
+      const Mat4f br = blendedSkinMatrix(skin, size_t(v), recordedMatrices);
+      const Vec3f rest = garment.positions.row(v).transpose();
+      const Vec3f shifted = tp.gameMeshWorld.row(v).transpose() + (br - bs).topLeftCorner<3, 3>() * rest +
+                            (br - bs).topRightCorner<3, 1>();
+      tp.gameMeshWorld.row(v) = (w * reskinned.row(v).transpose() + (1.f - w) * shifted).transpose();
+      carried.push_back(v);
+    }
+    if (!carried.empty()) {
+      const Points3f preSkin =
+          unskinPositions(tp.gameMeshWorld, garment.positions, skin, recordedMatrices, settings_.transfer.unskin);
+      for (Eigen::Index v : carried) tp.gameMeshPreSkin.row(v) = preSkin.row(v);
+    }
   }
   const EdgeStretch worst = transfer_.worstEdge(tp.gameMeshWorld);
   if (!(worst.strain <= settings_.transfer.maxEdgeStrain)) {

@@ -27,6 +27,16 @@ struct PoseTransferSettings {
   // median, 4.4x at p99; of the 13 above 5x the worst are sleeves torn into sheets (edges 32x), which
   // the re-skinning of a pose limb clearance changed (pose_shape.hpp) or the solver left.
   float maxEdgeStrain = 4.f;
+  // A pose whose limbs the limb clearance turned is simulated with them turned and its game-mesh shape
+  // carried to the recorded pose through pre-skin space (B_recorded * B_simulated^-1, per vertex:
+  // pose_shape.cpp). Where B_simulated nearly collapses (its smallest singular value s below twice
+  // this) that carry amplifies the cloth's offset from the body up to 1 / s and tears the armpit; there
+  // the vertex moves by its skinned rest position's displacement instead (B_recorded - B_simulated
+  // applied to its rest position: bounded, the offset keeps its direction), fully below this value and
+  // blended smoothly up to twice it. 0: the carry through pre-skin space everywhere (models baked
+  // before it was a setting). Measured on the default bake's 3929 poses (docs/baking.md): 0.4 keeps
+  // all 15 poses that tore, and moves the others' shapes 0.15 mm on average.
+  float reskinMinSingularValue = 0.4f;
 };
 
 // The game mesh's worst edge in a shape: its strain (length / max(rest length, half the median rest

@@ -126,6 +126,40 @@ TEST(ClothPoseDriver, RedoesPosesWhoseSetupChangedOrWhoseFileIsDamaged) {
   EXPECT_EQ(simulatePoses(third, poses, dir).simulated, 2u);
 }
 
+TEST(ClothPoseDriver, RetrySettingsKeepFirstAttemptResults) {
+  const Character ch = test::capsuleCharacter();
+  ClothSimSettings skinningRetry = fastSettings();
+  skinningRetry.retryCarries = {ClothCarry::Skinning};  // as bakes before the setting retried
+  const ClothSolver solver(ch, buildSimulationMesh(ch, 0), skinningRetry);
+  const std::vector<Pose> poses = somePoses(ch.skeleton, 2);
+  const test::TempDir tmp("cloth_retry_settings");
+  const fs::path dir = tmp / "retry";
+  const PoseSimulationRun first = simulatePoses(solver, poses, dir);
+  ASSERT_EQ(first.failed, 0u);
+  // Pose 1 as if it had needed a retry: its shape depends on the retry settings.
+  SimulatedPoseRecord rec = readSimulatedPose(simulatedPosePath(dir, 1));
+  ASSERT_EQ(rec.result.attempts, 1);
+  rec.result.attempts = 2;
+  rec.result.firstFailure = "the solve exploded (test)";
+  writeSimulatedPose(simulatedPosePath(dir, 1), rec);
+  // Other retry carries: only the first attempt's digest stays; pose 0 (solved on its first attempt)
+  // is reused, pose 1 is simulated again.
+  ClothSimSettings retried = fastSettings();
+  retried.retryCarries = {ClothCarry::Skinning, ClothCarry::Translation};
+  const ClothSolver other(ch, buildSimulationMesh(ch, 0), retried);
+  EXPECT_NE(other.fingerprint(), solver.fingerprint());
+  EXPECT_EQ(other.firstAttemptFingerprint(), solver.fingerprint());
+  EXPECT_TRUE(loadFinishedPose(dir, 0, other, poses[0]));
+  EXPECT_FALSE(loadFinishedPose(dir, 1, other, poses[1]));
+  EXPECT_FALSE(loadFinishedPose(dir, 0, poseFingerprint(other, poses[0])));  // not by the full digest
+  const PoseSimulationRun again = simulatePoses(other, poses, dir);
+  EXPECT_EQ(again.reused, 1u);
+  EXPECT_EQ(again.simulated, 1u);
+  // Written under the full digest, found by it.
+  EXPECT_TRUE(loadFinishedPose(dir, 1, poseFingerprint(other, poses[1])));
+  EXPECT_EQ(simulatePoses(other, poses, dir).simulated, 0u);
+}
+
 TEST(ClothPoseDriver, PoseFileRoundTripsAndRejectsGarbage) {
   SimulatedPoseRecord rec;
   rec.poseId = 42;

@@ -752,11 +752,16 @@ TEST(ClothSolver, AFailedPoseIsRetriedAndTheRetryIsRecorded) {
   s.failStrain = 1e-4f;
   s.failShare = 0.f;
   s.retries = 1;
+  // The retry tries each of its carries in turn: 3 attempts by default (skinning, then translation).
+  ASSERT_EQ(s.retryCarries, (std::vector<ClothCarry>{ClothCarry::Skinning, ClothCarry::Translation}));
   const PoseSimulation r = ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(bentPose(ch.skeleton, 0.3f));
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.attempts, 2);
+  EXPECT_EQ(r.attempts, 3);
   EXPECT_NE(r.firstFailure.find("exploded"), std::string::npos) << r.firstFailure;
-  EXPECT_NE(r.failure.find("after 2 attempts"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("after 3 attempts"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("the translation carry"), std::string::npos) << r.failure;
+  s.retryCarries = {ClothCarry::Skinning};
+  EXPECT_EQ(ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(bentPose(ch.skeleton, 0.3f)).attempts, 2);
   s.retries = 0;
   const PoseSimulation once = ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(bentPose(ch.skeleton, 0.3f));
   EXPECT_FALSE(once.ok);

@@ -144,7 +144,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25},
-                          {"carry", "translation"}}},
+                          {"carry", "translation"},
+                          {"retry_carries", {"translation"}}}},
                         {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}}},
                         {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
       "recipe.json", "/base");
@@ -192,6 +193,24 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   nlohmann::json withoutCarry = s.toJson();
   withoutCarry["simulation"].erase("carry");
   EXPECT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").simulation.carry, ClothCarry::Skinning);
+  // The retries' carries: the skinning one then the translation one unless the recipe says otherwise;
+  // recorded unless the skinning one alone, and settings without them (a model baked before) retry by
+  // the skinning carry alone.
+  const std::vector<ClothCarry> both = {ClothCarry::Skinning, ClothCarry::Translation};
+  EXPECT_EQ(s.simulation.retryCarries, std::vector<ClothCarry>{ClothCarry::Translation});
+  EXPECT_EQ(d.part1->simulation.retryCarries, both);
+  EXPECT_EQ(back.simulation.retryCarries, std::vector<ClothCarry>{ClothCarry::Translation});
+  EXPECT_EQ(d.part1->toJson()["simulation"]["retry_carries"], nlohmann::json({"skinning", "translation"}));
+  withoutCarry["simulation"].erase("retry_carries");
+  EXPECT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").simulation.retryCarries,
+            std::vector<ClothCarry>{ClothCarry::Skinning});
+  // The re-skinning of corrected poses (pose_transfer.hpp): 0.4 by default, recorded; absent: 0.
+  EXPECT_FLOAT_EQ(d.part1->transfer.reskinMinSingularValue, 0.4f);
+  EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(d.part1->toJson(), "dataset settings").transfer.reskinMinSingularValue,
+                  0.4f);
+  EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").transfer.reskinMinSingularValue, 0.4f);
+  withoutCarry["transfer"].erase("reskin_min_singular_value");
+  EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").transfer.reskinMinSingularValue, 0.f);
   EXPECT_FLOAT_EQ(d.part1->simulation.attachTopFraction, ClothSimSettings{}.attachTopFraction);
   EXPECT_EQ(s.simulation.gravity, Vec3f::Zero());
   EXPECT_FLOAT_EQ(d.part1->simulation.gravity.y(), -9.81f);
@@ -214,6 +233,12 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
   says(part1Error({{"simulation", {{"carry", "rigid"}}}}),
        "part1.simulation.carry: 'rigid' is not \"skinning\" or \"translation\"");
+  says(part1Error({{"simulation", {{"retry_carries", "translation"}}}}),
+       "part1.simulation.retry_carries: must be a non-empty array of strings");
+  says(part1Error({{"simulation", {{"retry_carries", {"skinning", "rigid"}}}}}),
+       "part1.simulation.retry_carries[1]: 'rigid' is not \"skinning\" or \"translation\"");
+  says(part1Error({{"simulation", {{"retry_carries", {"skinning", "skinning"}}}}}),
+       "part1.simulation.retry_carries: must name one or two different carries");
   says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
   says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");

@@ -84,3 +84,72 @@ TEST(PoseShape, ACorrectionReSkinsOnlyTheVerticesItsJointsMove) {
       "(the round trip would have moved them up to %.1f mm)\n",
       onThigh, elsewhere, damped, dampedRoundTripMm);
 }
+
+// Where the simulated pose's blend of a vertex nearly collapses, the round trip through pre-skin space
+// amplifies the cloth's offset from the body by up to 1 / s and tore the armpit of 15 of the default
+// bake's 3929 poses (pose_transfer.hpp, reskinMinSingularValue); there the vertex moves with its skinned
+// rest position instead, and its pre-skin position comes back through the recorded pose's blend.
+TEST(PoseShape, ACollapsedBlendMovesWithItsSkinnedRestPosition) {
+  const Character ch = makeDefaultCharacter();
+  const Skeleton& sk = ch.skeleton;
+  PoseShapeSettings s;
+  s.simulationVertices = 0;
+  s.limbClearance.clearance = 0.f;
+  s.transfer.maxEdgeStrain = 1e6f;
+  PoseShapeSettings off = s;
+  off.transfer.reskinMinSingularValue = 0.f;  // the round trip everywhere, as before the setting
+  const PoseShapeSimulator shapes(ch, s), roundTrip(ch, off);
+  const float lo = s.transfer.reskinMinSingularValue;
+  ASSERT_GT(lo, 0.f);
+
+  // Simulated: the left arm turned 166 degrees (its armpit's skinning collapses, as above); recorded:
+  // turned 110 degrees, as if limb clearance had raised it out of the trunk.
+  const int arm = sk.find("LeftArm");
+  ASSERT_GE(arm, 0);
+  Pose simulated = sk.restPose(), recorded = sk.restPose();
+  simulated.local[size_t(arm)] = sk.restPose().local[size_t(arm)] * Quatf(Eigen::AngleAxisf(2.9f, Vec3f::UnitZ()));
+  recorded.local[size_t(arm)] = sk.restPose().local[size_t(arm)] * Quatf(Eigen::AngleAxisf(1.9f, Vec3f::UnitZ()));
+  const std::vector<Mat4f> ms = sk.skinningMatrices(simulated), mr = sk.skinningMatrices(recorded);
+  Points3f cloth = skinPositions(shapes.solver().mesh().restPositions, shapes.solver().mesh().skin, ms);
+  cloth.col(1).array() += 0.02f;
+  const TransferredPose asSimulated = shapes.gameMeshShape(simulated, simulated, cloth);
+  const TransferredPose before = roundTrip.gameMeshShape(simulated, recorded, cloth);
+  const TransferredPose after = shapes.gameMeshShape(simulated, recorded, cloth);
+
+  size_t kept = 0, moved = 0;
+  for (Eigen::Index v = 0; v < after.gameMeshWorld.rows(); ++v) {
+    if (!hasJoint(ch.garment.skin, size_t(v), arm)) continue;
+    const Mat4f bs = blendedSkinMatrix(ch.garment.skin, size_t(v), ms);
+    const Mat4f br = blendedSkinMatrix(ch.garment.skin, size_t(v), mr);
+    const float smin = Eigen::JacobiSVD<Mat3f>(bs.topLeftCorner<3, 3>()).singularValues().minCoeff();
+    if (smin >= 2.f * lo) {  // well conditioned: the round trip, bit for bit
+      ++kept;
+      EXPECT_TRUE(after.gameMeshWorld.row(v).cwiseEqual(before.gameMeshWorld.row(v)).all()) << "vertex " << v;
+      EXPECT_TRUE(after.gameMeshPreSkin.row(v).cwiseEqual(before.gameMeshPreSkin.row(v)).all()) << "vertex " << v;
+    } else if (smin <= lo) {  // collapsed: moved by its skinned rest position's displacement
+      ++moved;
+      const Vec3f r = ch.garment.positions.row(v).transpose();
+      const Vec3f want = asSimulated.gameMeshWorld.row(v).transpose() + (br - bs).topLeftCorner<3, 3>() * r +
+                         (br - bs).topRightCorner<3, 1>();
+      EXPECT_LT((after.gameMeshWorld.row(v).transpose() - want).norm(), 1e-5f) << "vertex " << v;
+    }
+  }
+  EXPECT_GT(kept, 0u);
+  EXPECT_GT(moved, 0u);
+  // What the run time skins is what is stored: the recorded pose's skinning of the pre-skin shape gives
+  // the world shape back wherever that pose's blend is not itself collapsed.
+  const Points3f reskinned = skinPositions(after.gameMeshPreSkin, ch.garment.skin, mr);
+  for (Eigen::Index v = 0; v < after.gameMeshWorld.rows(); ++v) {
+    const Mat4f br = blendedSkinMatrix(ch.garment.skin, size_t(v), mr);
+    if (Eigen::JacobiSVD<Mat3f>(br.topLeftCorner<3, 3>()).singularValues().minCoeff() <
+        s.transfer.unskin.minSingularValue)
+      continue;
+    EXPECT_LT((reskinned.row(v) - after.gameMeshWorld.row(v)).norm(), 1e-4f) << "vertex " << v;
+  }
+  // And the armpit is no longer torn.
+  const float tornBefore = shapes.transfer().worstEdge(before.gameMeshWorld).strain;
+  const float tornAfter = shapes.transfer().worstEdge(after.gameMeshWorld).strain;
+  std::printf("%zu arm vertices kept, %zu moved with their rest position; worst edge %.0f%% -> %.0f%%\n", kept, moved,
+              100.0 * tornBefore, 100.0 * tornAfter);
+  EXPECT_LT(tornAfter, tornBefore);
+}
