@@ -40,8 +40,8 @@
 //                      "retries" (of a failed pose, slower each),
 //                      "final_projection" (out of the body at the end), "carry": "skinning" (default) |
 //                      "translation" (how the cloth follows the body between frames: cloth_solver.hpp),
-//                      "retry_carries": ["skinning"] (default) | ["skinning", "translation"] | ... (the
-//                      carries each retry tries in turn),
+//                      "retry_carries": ["skinning", "translation"] (default) | ["skinning"] (before
+//                      session 24) | ["translation"] (the carries each retry tries in turn),
 //                      "check_poses" (sampled for the report's convergence and noise, 0: none),
 
 //                      "source": "solver" (default) | "external" with "path" (a folder of pose_<id>.obj/
