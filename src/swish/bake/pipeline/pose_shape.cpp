@@ -99,9 +99,14 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
       carried.push_back(v);
     }
     if (!carried.empty()) {
+      // Stored is what the run time can draw: the recorded pose's skinning of the pre-skin position. Where
+      // that blend collapses too, un-skinning damps (core/skinning.hpp) and the shape moves to the nearest
+      // drawable one; a world shape no pre-skin shape gives would be error no model can take away.
       const Points3f preSkin =
           unskinPositions(tp.gameMeshWorld, garment.positions, skin, recordedMatrices, settings_.transfer.unskin);
       for (Eigen::Index v : carried) tp.gameMeshPreSkin.row(v) = preSkin.row(v);
+      const Points3f drawn = skinPositions(tp.gameMeshPreSkin, skin, recordedMatrices);
+      for (Eigen::Index v : carried) tp.gameMeshWorld.row(v) = drawn.row(v);
     }
   }
   const EdgeStretch worst = transfer_.worstEdge(tp.gameMeshWorld);
