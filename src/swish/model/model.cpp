@@ -33,9 +33,10 @@ void Model::validate(const std::string& what) const {
   }
   if (mlp.inputSize() != thetaSize())
     fail("mlp", "input size " + n2s(mlp.inputSize()) + " != 6 x " + n2s(inputJoints.size()) + " input joints");
-  if (mlp.outputSize() != lambdaSize())
-    fail("mlp", "output size " + n2s(mlp.outputSize()) + " != " + n2s(meshComponents()) + " mesh components + " +
-                    n2s(normalCodeDims()) + " normal-code dimensions");
+  // In 64 bits: a corrupt file's sizes may not fit an int (found by fuzz_model_loader).
+  if (int64_t(mlp.outputSize()) != int64_t(meshPca.basis.cols()) + int64_t(normalMaps.keys.cols()))
+    fail("mlp", "output size " + n2s(mlp.outputSize()) + " != " + n2s(meshPca.basis.cols()) + " mesh components + " +
+                    n2s(normalMaps.keys.cols()) + " normal-code dimensions");
   auto checkNorm = [&](const Normalisation& nrm, int size, const char* name) {
     if (nrm.mean.size() != size || nrm.scale.size() != size)
       fail(name, "size " + n2s(nrm.mean.size()) + "/" + n2s(nrm.scale.size()) + ", expected " + n2s(size));

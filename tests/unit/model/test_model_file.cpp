@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -617,6 +618,21 @@ TEST(ModelFile, BodyAnchorSectionOfVersion13) {
     ADD_FAILURE() << "anchors for another vertex count were accepted";
   } catch (const swish::Error& e) {
     EXPECT_CONTAINS(e.what(), "m: body anchors: 8 anchors for 9 game-mesh vertices");
+  }
+}
+
+// Sizes too large for an int are refused, not overflowed (fuzz_model_loader found a normal-code
+// dimension count of 2^31 - 1 that wrapped the network's expected output size).
+TEST(ModelFile, HugeSizesAreRefusedWithoutOverflow) {
+  swish::Rng rng(12);
+  Model m = swish::test::makeRandomModel(rng);
+  m.normalMaps.keys.resize(0, std::numeric_limits<int>::max());
+  try {
+    m.validate("m");
+    ADD_FAILURE() << "a huge normal-code size was accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "m: mlp: output size");
+    EXPECT_CONTAINS(e.what(), "2147483647 normal-code dimensions");
   }
 }
 
