@@ -171,17 +171,15 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
   }
   const bake::ClothSimSettings& cs = ps.simulation;
   std::string retriedBy;  // the retries' carries, when not the skinning one alone
-  if (cs.retryCarries != std::vector<bake::ClothCarry>{bake::ClothCarry::Skinning})
-    for (bake::ClothCarry c : cs.retryCarries)
-      retriedBy += std::string(retriedBy.empty() ? " (retries: " : ", then ") +
-                   (c == bake::ClothCarry::Translation ? "translation" : "skinning");
-  if (!retriedBy.empty()) retriedBy += ")";
+  for (size_t k = 0; !cs.skinningRetriesOnly() && k < cs.retryCarries.size(); ++k)
+    retriedBy += std::string(k == 0 ? " (retries: " : ", then ") + bake::clothCarryName(cs.retryCarries[k]) +
+                 (k + 1 == cs.retryCarries.size() ? ")" : "");
   note_ = "the bake's source simulation of character '" + character_->name + "' (" + how +
           "): " + std::to_string(simulator_->solver().mesh().vertexCount()) + " simulation vertices, preset '" +
           cs.material.name + "', " + std::to_string(cs.substeps) + " substeps x " + std::to_string(cs.iterations) +
           " iterations at " + fmtNum("%g", cs.frameRate) + " fps, " + fmtNum("%g", cs.transitionSeconds) +
           " s transition + " + fmtNum("%g", cs.settleSeconds) + " s settle, carried by " +
-          (cs.carry == bake::ClothCarry::Translation ? "translation" : "skinning") + retriedBy + ", limb clearance " +
+          bake::clothCarryName(cs.carry) + retriedBy + ", limb clearance " +
           fmtNum("%g", 1000.0 * ps.limbClearance.clearance) + " mm (trunk within " +
           fmtNum("%g", 1000.0 * ps.limbClearance.garmentReach) + " mm of the garment; 0: all), neck range " +
           fmtNum("%g", ps.limbClearance.neckRangeDegrees) + " deg (0: as recorded), smoothing " +

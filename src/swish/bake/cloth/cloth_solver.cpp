@@ -94,6 +94,8 @@ std::vector<uint8_t> colliderJointGroups(const Skeleton& sk) {
   return group;
 }
 
+const char* clothCarryName(ClothCarry carry) { return carry == ClothCarry::Translation ? "translation" : "skinning"; }
+
 void ClothSimSettings::validate() const {
   validateClothMaterial(material);
   auto check = [](bool ok, const std::string& what) {
@@ -295,7 +297,7 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   firstAttemptFingerprint_ = f.h;
   // (10: the retries' carries, hashed only when they are not the skinning one alone. A first-attempt
   // result does not depend on them: the pose driver reuses those by firstAttemptFingerprint.)
-  if (s.retryCarries != std::vector<ClothCarry>{ClothCarry::Skinning}) {
+  if (!s.skinningRetriesOnly()) {
     f.value(uint32_t(10));
     for (ClothCarry c : s.retryCarries) f.value(uint32_t(c));
   }
@@ -369,8 +371,8 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
     }
   last.failure = "after " + std::to_string(last.attempts) + " attempts (the last with " +
                  std::to_string(1 << settings_.retries) + "x the substeps and transition, the " +
-                 (settings_.retryCarries.back() == ClothCarry::Translation ? "translation" : "skinning") +
-                 " carry): " + last.failure + "; first attempt: " + first.failure;
+                 clothCarryName(settings_.retryCarries.back()) + " carry): " + last.failure +
+                 "; first attempt: " + first.failure;
   return last;
 }
 

@@ -35,6 +35,8 @@ enum class ClothCarry {
   // 9.7 mm mean on 16 poses), so it is not the default (docs/baking.md, "The carry").
   Translation,
 };
+// "skinning" | "translation": the names recipes and reports use.
+const char* clothCarryName(ClothCarry carry);
 
 struct ClothSimSettings {
   ClothMaterial material = clothMaterialPreset("jersey");
@@ -93,6 +95,9 @@ struct ClothSimSettings {
   // on the default bake's 3929 poses: the skinning carry then the translation carry keeps every pose
   // the skinning retry keeps, with the same shape, and 13 of the 24 it loses (docs/baking.md, "The carry").
   std::vector<ClothCarry> retryCarries = {ClothCarry::Skinning, ClothCarry::Translation};
+  // The retries of bakes from before retryCarries was a setting: the skinning carry alone. Fingerprints,
+  // dataset settings and descriptions name retryCarries only when it differs from that.
+  bool skinningRetriesOnly() const { return retryCarries == std::vector<ClothCarry>{ClothCarry::Skinning}; }
 
   // Throws Error naming the field that is out of range.
   void validate() const;

@@ -161,8 +161,9 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   cs.finalProjection = sim.boolean("final_projection", cs.finalProjection);
   // How the cloth follows the body from frame to frame (cloth_solver.hpp, ClothCarry).
   auto carryOf = [](const JsonReader& at, const std::string& c) {
-    if (c != "skinning" && c != "translation") at.fail("'" + c + "' is not \"skinning\" or \"translation\"");
-    return c == "translation" ? ClothCarry::Translation : ClothCarry::Skinning;
+    for (ClothCarry k : {ClothCarry::Skinning, ClothCarry::Translation})
+      if (c == clothCarryName(k)) return k;
+    at.fail("'" + c + "' is not \"skinning\" or \"translation\"");
   };
   cs.carry = carryOf(sim.child("carry"), sim.nonEmptyString("carry", "skinning"));
   // The carries a failed pose's retries try in turn (cloth_solver.hpp, ClothSimSettings::retryCarries).

@@ -279,12 +279,12 @@ nlohmann::json DatasetBuildSettings::toJson() const {
     out["simulation"]["static_tolerance"] = m.staticTolerance;
     out["simulation"]["static_iterations"] = m.staticIterations;
   }
-  if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = "translation";  // likewise
-  if (transfer.reskinMinSingularValue > 0.f)                                           // likewise
+  if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = clothCarryName(m.carry);  // likewise
+  if (transfer.reskinMinSingularValue > 0.f)                                                     // likewise
     out["transfer"]["reskin_min_singular_value"] = transfer.reskinMinSingularValue;
-  if (m.retryCarries != std::vector<ClothCarry>{ClothCarry::Skinning}) {  // likewise
+  if (!m.skinningRetriesOnly()) {  // likewise
     nlohmann::json& list = out["simulation"]["retry_carries"] = nlohmann::json::array();
-    for (ClothCarry c : m.retryCarries) list.push_back(c == ClothCarry::Translation ? "translation" : "skinning");
+    for (ClothCarry c : m.retryCarries) list.push_back(clothCarryName(c));
   }
   return out;
 }
