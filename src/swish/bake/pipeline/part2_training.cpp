@@ -87,9 +87,10 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     t = now;
   };
 
-  // Held-out split (seeded shuffle, sorted back so results do not depend on dataset order quirks).
-  // The rest pose part 1 added (part1_dataset.hpp) is always trained on, never held out: it is
-  // there so that the network knows the A-pose, not to be measured.
+  // Held-out split, keyed by pose id (mlp_trainer.hpp, keyedSplit): a re-bake whose part 1 kept a few more
+  // or fewer poses holds out the same poses of the rest, so two bakes' held-out figures compare pose for
+  // pose instead of on two random samples. The rest pose part 1 added (part1_dataset.hpp) is always
+  // trained on, never held out: it is there so that the network knows the A-pose, not to be measured.
   std::vector<uint32_t>& pinned = out.pinnedPoses;
   const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") &&
                        ds.settings["rest_pose_id"].is_number_integer();
@@ -97,8 +98,10 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   for (size_t i = 0; i < poses; ++i)
     if (restId >= 0 && int64_t(ds.poses[i].id) == restId) pinned.push_back(uint32_t(i));
   Rng rng(st.seed);
+  std::vector<uint64_t> poseIds(poses);
+  for (size_t i = 0; i < poses; ++i) poseIds[i] = ds.poses[i].id;
   IndexSplit split =
-      seededSplit(poses, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
+      keyedSplit(poseIds, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
   out.testPoses = std::move(split.held);
   out.trainingPoses = std::move(split.kept);
   const size_t nTrain = out.trainingPoses.size();
@@ -171,7 +174,8 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   if (C) lambda.bottomRows(C) = normalCodes;
   MlpTrainOptions mo = st.mlp;
   mo.seed = st.seed + 5;
-  for (uint32_t p : pinned)  // its column among the training poses
+  for (uint32_t p : out.trainingPoses) mo.sampleKeys.push_back(ds.poses[p].id);  // validation keyed by pose id too
+  for (uint32_t p : pinned)                                                      // its column among the training poses
     mo.alwaysTrain.push_back(
         uint32_t(std::lower_bound(out.trainingPoses.begin(), out.trainingPoses.end(), p) - out.trainingPoses.begin()));
   if (mo.outputWeights.empty()) {

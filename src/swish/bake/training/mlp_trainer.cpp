@@ -67,6 +67,33 @@ IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t
   return s;
 }
 
+IndexSplit keyedSplit(std::span<const uint64_t> keys, size_t held, Rng& rng, std::span<const uint32_t> pinned) {
+  const size_t n = keys.size();
+  std::vector<bool> isPinned(n, false);
+  for (uint32_t i : pinned)
+    if (i < n) isPinned[i] = true;
+  const Rng hashes(rng.next());  // the seed's share of every key's hash
+  struct Keyed {
+    uint64_t hash, key;
+    uint32_t index;
+  };
+  std::vector<Keyed> order;
+  order.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (!isPinned[i]) order.push_back({hashes.split(keys[i]).next(), keys[i], uint32_t(i)});
+  std::sort(order.begin(), order.end(), [](const Keyed& a, const Keyed& b) {
+    return a.hash != b.hash ? a.hash < b.hash : a.key != b.key ? a.key < b.key : a.index < b.index;
+  });
+  held = std::min(held, order.size());
+  IndexSplit s;
+  for (size_t i = 0; i < order.size(); ++i) (i < held ? s.held : s.kept).push_back(order[i].index);
+  for (size_t i = 0; i < n; ++i)
+    if (isPinned[i]) s.kept.push_back(uint32_t(i));
+  std::sort(s.held.begin(), s.held.end());
+  std::sort(s.kept.begin(), s.kept.end());
+  return s;
+}
+
 MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrainOptions& o) {
   const Eigen::Index n = inputs.cols();
   if (n < 2) throw Error("MLP training: needs at least 2 samples, got " + std::to_string(n));
@@ -92,12 +119,17 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
   MlpTrainResult r;
   r.activation = o.activation;
 
-  // Split: a seeded shuffle; validation takes the first share, never an alwaysTrain sample.
+  // Split: a seeded shuffle (or keyed by sampleKeys); validation takes the first share, never an alwaysTrain
+  // sample.
   for (uint32_t i : o.alwaysTrain)
     if (Eigen::Index(i) >= n)
       throw Error("MLP training: always-train sample " + std::to_string(i) + " of " + std::to_string(n));
   const size_t nVal = std::clamp<size_t>(size_t(std::lround(o.validationFraction * double(n))), 1, size_t(n) - 1);
-  IndexSplit split = seededSplit(size_t(n), nVal, rng, o.alwaysTrain);
+  if (!o.sampleKeys.empty() && Eigen::Index(o.sampleKeys.size()) != n)
+    throw Error("MLP training: " + std::to_string(o.sampleKeys.size()) + " sample keys for " + std::to_string(n) +
+                " samples");
+  IndexSplit split = o.sampleKeys.empty() ? seededSplit(size_t(n), nVal, rng, o.alwaysTrain)
+                                          : keyedSplit(o.sampleKeys, nVal, rng, o.alwaysTrain);
   if (split.held.empty()) throw Error("MLP training: every sample is always-train; none left for validation");
   r.validationSamples = std::move(split.held);
   r.trainingSamples = std::move(split.kept);

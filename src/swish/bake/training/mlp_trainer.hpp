@@ -39,6 +39,10 @@ struct MlpTrainOptions {
   // Samples (input columns) never drawn into the validation split: poses the network must fit, such
   // as the rest pose (part1_dataset.hpp, includeRestPose).
   std::vector<uint32_t> alwaysTrain;
+  // One key per sample (the bake passes its pose ids), or empty. With keys the validation split is
+  // keyed (keyedSplit below): a sample's side depends on its key and the seed, not on its column, so a
+  // dataset that gains or loses a few poses keeps the validation poses of the others.
+  std::vector<uint64_t> sampleKeys;
 };
 
 // A seeded split of the indices 0..n-1: `held` of them drawn by a Fisher-Yates shuffle, the rest
@@ -48,6 +52,13 @@ struct IndexSplit {
   std::vector<uint32_t> held, kept;
 };
 IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t> pinned = {});
+
+// A split by key: index i is ordered by a seeded hash of keys[i] (ties by key, then index) and the
+// first `held` unpinned ones are held. Which side a key falls on depends only on the key, the
+// generator's state and how many are held, not on which other keys are there: two datasets of the same
+// recipe that differ by a few poses (a retry kept more) hold out the same poses of the rest, so their
+// held-out figures compare pose for pose. Draws one number from rng.
+IndexSplit keyedSplit(std::span<const uint64_t> keys, size_t held, Rng& rng, std::span<const uint32_t> pinned = {});
 
 struct TrainingEpoch {
   int epoch = 0;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "support/random_model.hpp"
 #include "swish/bake/training/mlp_network.hpp"
@@ -198,6 +199,53 @@ TEST(BakeMlp, SeededSplitNeverHoldsAPinnedIndex) {
   EXPECT_EQ(seededSplit(3, 5, r, std::vector<uint32_t>{0, 1}).held, std::vector<uint32_t>{2});  // at most n - pinned
 }
 
+TEST(BakeMlp, KeyedSplitHoldsTheSamePosesWhenOthersComeAndGo) {
+  // Two bakes of one recipe: the second kept two poses the first lost and lost two it kept (ids as
+  // part 1 numbers its thinned poses). Each key's side depends on the key and the seed alone, so of
+  // the 196 ids both have, the held sets differ at most by what the 4 changed ids displaced at the
+  // boundary.
+  std::vector<uint64_t> a, b;
+  for (uint64_t id = 0; id < 200; ++id) {
+    if (id != 17 && id != 140) a.push_back(id);
+    if (id != 33 && id != 171) b.push_back(id);
+  }
+  const uint64_t seed = test::testSeed(22);
+  Rng ra(seed), rb(seed);
+  const IndexSplit sa = keyedSplit(a, 20, ra), sb = keyedSplit(b, 20, rb);
+  ASSERT_EQ(sa.held.size(), 20u);
+  ASSERT_EQ(sb.held.size(), 20u);
+  EXPECT_EQ(sa.kept.size(), 178u);
+  std::set<uint64_t> heldA, heldB;
+  for (uint32_t i : sa.held) heldA.insert(a[i]);
+  for (uint32_t i : sb.held) heldB.insert(b[i]);
+  const std::set<uint64_t> changed{17, 140, 33, 171};
+  size_t onlyOne = 0;
+  for (uint64_t id = 0; id < 200; ++id)
+    if (!changed.count(id) && heldA.count(id) != heldB.count(id)) ++onlyOne;
+  EXPECT_LE(onlyOne, 4u);
+  // A shuffled index split of the same two lists shares about a tenth of its held poses.
+  Rng qa(seed), qb(seed);
+  const IndexSplit pa = seededSplit(a.size(), 20, qa), pb = seededSplit(b.size(), 20, qb);
+  size_t shuffledOnlyOne = 0;
+  std::set<uint64_t> ha, hb;
+  for (uint32_t i : pa.held) ha.insert(a[i]);
+  for (uint32_t i : pb.held) hb.insert(b[i]);
+  for (uint64_t id = 0; id < 200; ++id)
+    if (!changed.count(id) && ha.count(id) != hb.count(id)) ++shuffledOnlyOne;
+  EXPECT_GT(shuffledOnlyOne, onlyOne);
+
+  // Deterministic for a seed, another seed holds other poses, pins are never held.
+  Rng r1(seed), r2(seed), r3(seed + 1);
+  EXPECT_EQ(keyedSplit(a, 20, r1).held, sa.held);
+  EXPECT_NE(keyedSplit(a, 20, r3).held, sa.held);
+  const std::vector<uint32_t> pins{sa.held.front(), sa.held.back()};
+  const IndexSplit pinnedSplit = keyedSplit(a, 20, r2, pins);
+  ASSERT_EQ(pinnedSplit.held.size(), 20u);
+  for (uint32_t p : pins) EXPECT_FALSE(std::binary_search(pinnedSplit.held.begin(), pinnedSplit.held.end(), p));
+  EXPECT_TRUE(std::is_sorted(pinnedSplit.kept.begin(), pinnedSplit.kept.end()));
+  EXPECT_EQ(pinnedSplit.kept.size(), 178u);
+}
+
 TEST(BakeMlp, AlwaysTrainSamplesAreNeverValidated) {
   Rng rng(test::testSeed(22));
   MatXf x(3, 50), y(2, 50);
@@ -216,6 +264,24 @@ TEST(BakeMlp, AlwaysTrainSamplesAreNeverValidated) {
   }
   o.alwaysTrain = {50};
   EXPECT_THROW(trainMlp(x, y, o), Error);
+}
+
+TEST(BakeMlp, SampleKeysChooseTheValidationSamples) {
+  Rng rng(test::testSeed(23));
+  MatXf x(3, 50), y(2, 50);
+  for (int i = 0; i < 50; ++i) {
+    x.col(i) << float(rng.normal()), float(rng.normal()), float(rng.normal());
+    y.col(i) << x(0, i) + x(1, i), x(2, i) * x(0, i);
+  }
+  MlpTrainOptions o;
+  o.hiddenLayers = 1, o.hiddenWidth = 8, o.maxEpochs = 3, o.validationFraction = 0.2, o.seed = 9;
+  for (uint64_t i = 0; i < 50; ++i) o.sampleKeys.push_back(1000 + 7 * i);  // pose ids, not columns
+  o.alwaysTrain = {4};
+  const MlpTrainResult r = trainMlp(x, y, o);
+  Rng same(o.seed);
+  EXPECT_EQ(r.validationSamples, keyedSplit(o.sampleKeys, 10, same, o.alwaysTrain).held);
+  o.sampleKeys.pop_back();
+  EXPECT_THROW(trainMlp(x, y, o), Error);  // one key per sample
 }
 
 TEST(BakeMlp, ConstantInputsAndOutputsStayFinite) {
