@@ -214,7 +214,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
 }
 
 DatasetBuildSettings parsePart1(const JsonReader& j, const std::filesystem::path& baseDir) {
-  j.requireObject({"character", "clips", "input_joints", "sampling", "thinning", "simulation", "transfer",
+  j.requireObject({"character", "clips", "input_joints", "sampling", "thinning", "synthesis", "simulation", "transfer",
                    "normal_maps", "preview", "holdout"});
   DatasetBuildSettings s;
   if (j.has("character")) parseCharacter(j.child("character"), baseDir, s);
@@ -268,6 +268,24 @@ DatasetBuildSettings parsePart1(const JsonReader& j, const std::filesystem::path
       thin.child("grow_from")
           .fail("is " + std::to_string(s.growFrom) + ", not below target_poses (" + std::to_string(s.targetPoses) +
                 "): nothing to grow");
+  }
+
+  if (j.has("synthesis")) {
+    // Poses between the subjects (pose_synthesis.hpp).
+    const JsonReader syn = j.child("synthesis");
+    syn.requireObject({"joints", "poses", "candidates", "extend", "seed"});
+    PoseSynthesisSettings& ps = s.synthesis;
+    ps.joints = syn.strings("joints", {});
+    if (ps.joints.empty()) syn.child("joints").fail("is required (the joints whose rotations are redrawn)");
+    if (!syn.has("poses")) syn.child("poses").fail("is required (how many synthesized poses to add)");
+    ps.poses = size_t(syn.wholeNumber("poses", 1, 1e6, 0));
+    ps.candidates = size_t(syn.wholeNumber("candidates", 0, 1e8, 0));
+    if (ps.candidates != 0 && ps.candidates < ps.poses)
+      syn.child("candidates")
+          .fail("is " + std::to_string(ps.candidates) + ", fewer than the " + std::to_string(ps.poses) +
+                " poses to add");
+    ps.extend = float(syn.number("extend", 0, 1, ps.extend));
+    ps.seed = uint64_t(syn.wholeNumber("seed", 0, 9.007199254740992e15, double(ps.seed)));
   }
 
   parseShapeSections(j, s);

@@ -27,6 +27,10 @@
 //                   the rest pose joins the kept poses and is always trained on) and "grow_from" (with
 //                   target_poses: keep the poses, ids and simulations of the bake with target_poses
 //                   grow_from, and add poses after them: part1_dataset.hpp),
+//       "synthesis": {"joints": ["LeftShoulder", "RightShoulder"], "poses": 1000, "candidates" (0: 8 x poses),
+//                     "extend" (0.25), "seed"}: poses whose named joints take rotations between and a little
+//                     beyond two recorded samples', thinned against the recorded poses and added after them
+//                     (bake/poses/pose_synthesis.hpp; absent: none),
 //       "simulation": {"preset", "friction" (overrides the preset's, 0-2), "damping" (the preset's
 //                      velocity damping in 1/s, overridden, 0-100), "vertices", "thickness",
 //                      "transition_seconds", "settle_seconds",

@@ -263,6 +263,12 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   if (!holdoutSubjects.empty()) out["holdout"] = {{"subjects", holdoutSubjects}, {"poses", holdoutPoses}};
   if (evenPoses > 0) out["even_poses"] = evenPoses;
   if (growFrom > 0 && evenPoses == 0) out["thinning"]["grow_from"] = growFrom;
+  if (synthesis.enabled() && evenPoses == 0)
+    out["synthesis"] = {{"joints", synthesis.joints},
+                        {"poses", synthesis.poses},
+                        {"candidates", synthesis.candidates},
+                        {"extend", synthesis.extend},
+                        {"seed", synthesis.seed}};
   // Only when overridden, so that the settings (and so the datasets) of other bakes stay as they were.
   const auto& presets = clothMaterialPresets();
   const auto preset =
@@ -298,6 +304,8 @@ nlohmann::json DatasetBuildResult::toJson() const {
           {"samples", samples},
           {"kept_poses", keptPoses},
           {"rest_pose_added", restPoseAdded},
+          {"synthesized_poses", synthesizedPoses},
+          {"synthesis_candidates", synthesisCandidates},
           {"tolerance", tolerance},
           {"poses_corrected", posesCorrected},
           {"max_correction_degrees", maxCorrectionDegrees},
@@ -442,6 +450,39 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
     log(line);
   }
   res.tolerance = thin.tolerance;
+  // Synthesized poses (pose_synthesis.hpp), after every recorded pose so that those keep their ids.
+  if (s.synthesis.enabled() && s.evenPoses == 0) {
+    const auto t2 = Clock::now();
+    const SynthesisResult syn =
+        synthesizePoses(character.skeleton, clips, samples, thin.kept, inputJoints, s.synthesis);
+    auto originJson = [&](const PoseSamples::Origin& o) {
+      return nlohmann::json{{"clip", s.clips[o.clip].file.stem().string()},
+                            {"subject", s.clips[o.clip].subject},
+                            {"frame", o.frame},
+                            {"mirrored", o.mirrored}};
+    };
+    for (const SynthesizedPose& sp : syn.added) {
+      poses.push_back(canonicalPose(character.skeleton, poseOfSynthesized(character.skeleton, clips, sp)));
+      nlohmann::json o = originJson(sp.base), draws = nlohmann::json::array();
+      for (const SynthesizedPose::Draw& d : sp.draws) {
+        nlohmann::json dj = originJson(d.donor);
+        dj["joint"] = character.skeleton.joints[d.joint].name;
+        dj["t"] = d.t;
+        draws.push_back(dj);
+      }
+      o["synthesized"] = draws;
+      res.origins.push_back(o);
+    }
+    res.synthesizedPoses = syn.added.size();
+    res.synthesisCandidates = syn.candidates;
+    char line[240];
+    std::snprintf(line, sizeof line,
+                  "part 1: synthesis: %zu poses of %zu candidates (%zu joints redrawn) added after the recorded ones "
+                  "(tolerance %.4f, %d passes) in %.2f s",
+                  syn.added.size(), syn.candidates, s.synthesis.joints.size(), double(syn.tolerance), syn.passes,
+                  since(t2));
+    log(line);
+  }
   res.keptPoses = poses.size();
   step("sampling + thinning", t);
 

@@ -34,6 +34,7 @@
 #include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/bake/poses/limb_clearance.hpp"
 #include "swish/bake/poses/pose_sampling.hpp"
+#include "swish/bake/poses/pose_synthesis.hpp"
 #include "swish/bake/transfer/pose_transfer.hpp"
 #include "swish/io/joint_map.hpp"
 
@@ -84,6 +85,9 @@ struct DatasetBuildSettings {
   // (pose_thinning.hpp). The result covers the samples as densely as a fresh thinning to targetPoses,
   // with other poses.
   size_t growFrom = 0;
+  // Poses between and around the recorded ones (pose_synthesis.hpp): after the recorded poses (and the rest
+  // pose), so their ids and simulations stay. Off unless joints and a count are given.
+  PoseSynthesisSettings synthesis;
   // The character's rest pose (the A-pose every simulation starts from) joins the kept poses, last,
   // unless a kept pose is within the tolerance of it. Gameplay clips rarely hold the A-pose, and a
   // network that never saw it extrapolates there (arms among the inputs: several cm off); part 2
@@ -144,11 +148,13 @@ struct DatasetBuildStep {
 };
 
 struct DatasetBuildResult {
-  size_t clipFrames = 0;       // frames over all clips
-  size_t samples = 0;          // Theta samples before thinning
-  size_t keptPoses = 0;        // after thinning (the rest pose included when it was added)
-  bool restPoseAdded = false;  // the rest pose was appended to the thinned poses (after the first stage's)
-  size_t posesCorrected = 0;   // poses whose limbs (or one-surface head) were turned out of the body
+  size_t clipFrames = 0;        // frames over all clips
+  size_t samples = 0;           // Theta samples before thinning
+  size_t keptPoses = 0;         // after thinning (the rest pose included when it was added)
+  bool restPoseAdded = false;   // the rest pose was appended to the thinned poses (after the first stage's)
+  size_t synthesizedPoses = 0;  // of keptPoses, drawn by part1.synthesis (the last ones)
+  size_t synthesisCandidates = 0;
+  size_t posesCorrected = 0;  // poses whose limbs (or one-surface head) were turned out of the body
   float maxCorrectionDegrees = 0.f;
   size_t neckRangePoses = 0;  // poses whose neck chain the neck range turned back (limb_clearance.hpp)
   // Per root joint turned (limb clearance): in how many poses, by how much (mean and largest degrees).

@@ -255,6 +255,28 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
                       "recipe.json", "/base")
           .part1->growFrom,
       20u);
+  says(part1Error({{"synthesis", {{"poses", 10}}}}), "part1.synthesis.joints: is required");
+  says(part1Error({{"synthesis", {{"joints", {"LeftShoulder"}}}}}), "part1.synthesis.poses: is required");
+  says(part1Error({{"synthesis", {{"joints", {"LeftShoulder"}}, {"poses", 10}, {"candidates", 5}}}}),
+       "part1.synthesis.candidates: is 5, fewer than the 10 poses");
+  says(part1Error({{"synthesis", {{"joints", {"LeftShoulder"}}, {"poses", 10}, {"extend", 2}}}}),
+       "part1.synthesis.extend: 2 is outside");
+  says(part1Error({{"synthesis", {{"joints", {"LeftShoulder"}}, {"poses", 10}, {"count", 2}}}}), "part1.synthesis");
+  {
+    const DatasetBuildSettings syn =
+        *parseBakeConfig(
+             {{"output", "o"},
+              {"part1", part1({{"synthesis", {{"joints", {"LeftShoulder", "RightShoulder"}}, {"poses", 300}}}})}},
+             "recipe.json", "/base")
+             .part1;
+    EXPECT_EQ(syn.synthesis.joints, (std::vector<std::string>{"LeftShoulder", "RightShoulder"}));
+    EXPECT_EQ(syn.synthesis.poses, 300u);
+    EXPECT_EQ(syn.synthesis.candidates, 0u);  // 8 x poses
+    EXPECT_FLOAT_EQ(syn.synthesis.extend, 0.25f);
+    EXPECT_TRUE(syn.synthesis.enabled());
+    EXPECT_FALSE(
+        parseBakeConfig({{"output", "o"}, {"part1", part1()}}, "recipe.json", "/base").part1->synthesis.enabled());
+  }
   says(part1Error({{"clips", {"/nonexistent/walk.bvh"}}}), "part1.clips[0]: file /nonexistent/walk.bvh does not exist");
   says(part1Error({{"clips", nlohmann::json::array()}}), "part1.clips: must be a non-empty array");
   says(part1Error({{"clips", {{{"file", kThisFile}, {"naming", "cmu"}}}}}), "part1.clips[0].naming");

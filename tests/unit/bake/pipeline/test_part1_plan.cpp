@@ -1,6 +1,7 @@
 // Part 1's pose plan (no simulation): growing a bake's pose list (part1.thinning.grow_from) keeps the
 // smaller bake's poses, rest pose included, with the same ids and the same simulation fingerprints, so
-// a re-run simulates only the poses it adds.
+// a re-run simulates only the poses it adds; synthesized poses (part1.synthesis) likewise come after the
+// recorded ones.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -17,14 +18,15 @@ namespace {
 
 const fs::path kClip = test::debianMocap("01_01.bvh");
 
-DatasetBuildSettings settings(const nlohmann::json& thinning) {
-  const nlohmann::json recipe = {{"name", "grow"},
-                                 {"output", "grow"},
-                                 {"part1",
-                                  {{"character", "default"},
-                                   {"clips", {kClip.string()}},
-                                   {"thinning", thinning},
-                                   {"simulation", {{"vertices", 0}, {"threads", 2}}}}}};
+DatasetBuildSettings settings(const nlohmann::json& thinning, const nlohmann::json& synthesis = nullptr) {
+  nlohmann::json recipe = {{"name", "grow"},
+                           {"output", "grow"},
+                           {"part1",
+                            {{"character", "default"},
+                             {"clips", {kClip.string()}},
+                             {"thinning", thinning},
+                             {"simulation", {{"vertices", 0}, {"threads", 2}}}}}};
+  if (!synthesis.is_null()) recipe["part1"]["synthesis"] = synthesis;
   return *parseBakeConfig(recipe, "recipe.json", fs::current_path()).part1;
 }
 
@@ -81,4 +83,42 @@ TEST(Part1Plan, GrowingAPoseListKeepsItsPosesAndTheirSimulations) {
   const DatasetPosePlan evenPlan = planDatasetPoses(even, {});
   EXPECT_EQ(evenPlan.toSimulate.size(), 30u);
   EXPECT_FALSE(evenPlan.settingsJson["thinning"].contains("grow_from"));
+}
+
+TEST(Part1Plan, SynthesizedPosesComeAfterTheRecordedOnesWhichKeepTheirSimulations) {
+  if (!fs::exists(kClip)) GTEST_SKIP() << kClip << " is missing (Debian package assimp-testmodels)";
+  const nlohmann::json thinning = {{"target_poses", 30}};
+  const DatasetPosePlan plain = planDatasetPoses(settings(thinning), {});
+  const DatasetPosePlan synth = planDatasetPoses(
+      settings(thinning, {{"joints", {"LeftShoulder", "RightShoulder"}}, {"poses", 12}, {"seed", 3}}), {});
+  const size_t n = plain.toSimulate.size();
+  ASSERT_GT(synth.toSimulate.size(), n);
+  EXPECT_EQ(synth.result.synthesizedPoses, synth.toSimulate.size() - n);
+  EXPECT_NEAR(double(synth.result.synthesizedPoses), 12.0, 2.0);
+  EXPECT_EQ(synth.result.synthesisCandidates, 96u);
+  const std::vector<uint64_t> a = plain.poseFingerprints(), b = synth.poseFingerprints();
+  for (size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(a[i], b[i]) << "recorded pose " << i << " simulates again";
+    EXPECT_EQ(synth.result.origins[i], plain.result.origins[i]) << "pose " << i;
+  }
+  // Each added pose names its base and the donors of its two clavicles, and is a new pose.
+  for (size_t i = n; i < b.size(); ++i) {
+    const nlohmann::json& o = synth.result.origins[i];
+    ASSERT_TRUE(o.contains("synthesized")) << o.dump();
+    EXPECT_EQ(o["clip"], "01_01");
+    ASSERT_EQ(o["synthesized"].size(), 2u);
+    EXPECT_EQ(o["synthesized"][0]["joint"], "LeftShoulder");
+    EXPECT_EQ(o["synthesized"][1]["joint"], "RightShoulder");
+    for (const auto& d : o["synthesized"]) EXPECT_TRUE(d["t"].get<double>() >= -0.25 && d["t"].get<double>() <= 1.25);
+    for (size_t j = 0; j < n; ++j) EXPECT_NE(b[i], a[j]) << "pose " << i << " repeats recorded pose " << j;
+  }
+  // The dataset records the synthesis (another pose list: its files are rebuilt, its simulations kept);
+  // without it the settings are as they were, and the held-out subjects' evenly spaced frames get none.
+  EXPECT_EQ(synth.settingsJson["synthesis"]["poses"], 12);
+  EXPECT_FALSE(plain.settingsJson.contains("synthesis"));
+  DatasetBuildSettings even = settings(thinning, {{"joints", {"LeftShoulder"}}, {"poses", 12}});
+  even.evenPoses = 20;
+  const DatasetPosePlan evenPlan = planDatasetPoses(even, {});
+  EXPECT_EQ(evenPlan.toSimulate.size(), 20u);
+  EXPECT_EQ(evenPlan.result.synthesizedPoses, 0u);
 }
