@@ -10,7 +10,7 @@
 namespace swish::bake {
 
 Quatf rotationBetween(const Quatf& a, const Quatf& b, float t) {
-  Quatf r = a.conjugate() * b;  // a^-1 b, unit quaternions
+  Quatf r = a.conjugate() * b;                // a^-1 b, unit quaternions
   if (r.w() < 0.f) r.coeffs() = -r.coeffs();  // the shortest arc
   const Eigen::AngleAxisf arc(r.normalized());
   return (a * Quatf(Eigen::AngleAxisf(t * arc.angle(), arc.axis()))).normalized();

@@ -121,7 +121,8 @@ TEST(PoseSynthesis, ARedrawnJointFillsTheGapBetweenSubjectsAndTheRestStaysRecord
     synthesizePoses(s, clips, samples, recorded.kept, theta, ps);
     ADD_FAILURE() << "an unknown joint was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("part1.synthesis.joints: joint 'LeftClavicle'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("part1.synthesis.joints: joint 'LeftClavicle'"), std::string::npos)
+        << e.what();
   }
   ps.joints = {"LeftShoulder"};
   ps.extend = 2.f;
