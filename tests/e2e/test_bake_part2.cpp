@@ -309,6 +309,29 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("joint '" + j0 + "' is named twice"), std::string::npos);
 }
 
+// Synthesized poses (part1.synthesis, ids from the dataset's synthesized_from_id on) are trained on and
+// never held out: the random held-out poses stay recorded frames, as many as without them, and mostly the
+// same poses (the split is keyed by pose id).
+TEST(BakePart2, SynthesizedPosesAreNeverHeldOut) {
+  const uint64_t seed = test::testSeed(503);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  Dataset ds = syntheticDataset(seed, 160, 32);
+  BakeTrainSettings st = smallTraining();
+  st.normalCodeDims = 0;
+  st.mlp.maxEpochs = 5;
+  Dataset recordedOnly = ds;
+  recordedOnly.poses.resize(120);
+  const BakeTrainOutput plain = trainBake(recordedOnly, st);
+  ds.settings["synthesized_from_id"] = ds.poses[120].id;  // the last 40 stand for synthesized poses
+  const BakeTrainOutput out = trainBake(ds, st);
+  EXPECT_EQ(out.synthesizedPoses, 40u);
+  EXPECT_EQ(out.testPoses.size(), 12u);  // a tenth of the 120 recorded poses
+  EXPECT_EQ(out.testPoses, plain.testPoses);
+  for (uint32_t i : out.testPoses) EXPECT_LT(i, 120u);
+  EXPECT_EQ(out.trainingPoses.size(), 148u);
+  EXPECT_EQ(out.evaluation.poses, 12u);
+}
+
 TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {
   const uint64_t seed = test::testSeed(502);
   const Dataset ds = syntheticDataset(seed, 60, 16);

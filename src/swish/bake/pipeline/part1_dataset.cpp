@@ -585,6 +585,8 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   settingsJson["thinning_tolerance_used"] = thin.tolerance;
   // Part 2 keeps this pose in its training split (part2_training.cpp); -1: none was added.
   settingsJson["rest_pose_id"] = restPoseId;
+  // Part 2 never holds these out: its random held-out poses are recorded frames (part2_training.cpp).
+  if (res.synthesizedPoses > 0) settingsJson["synthesized_from_id"] = poses.size() - res.synthesizedPoses;
   return plan;
 }
 

@@ -95,13 +95,27 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") &&
                        ds.settings["rest_pose_id"].is_number_integer();
   const int64_t restId = hasRest ? ds.settings["rest_pose_id"].get<int64_t>() : int64_t(-1);
-  for (size_t i = 0; i < poses; ++i)
+  // Synthesized poses (part1.synthesis, the ids from synthesized_from_id on) are pinned too: the random
+  // held-out poses stay recorded frames of the training clips, as the report calls them, and as many as a
+  // bake without synthesis holds out.
+  const bool hasSynth = ds.settings.is_object() && ds.settings.contains("synthesized_from_id") &&
+                        ds.settings["synthesized_from_id"].is_number_integer();
+  const int64_t synthFrom = hasSynth ? ds.settings["synthesized_from_id"].get<int64_t>() : int64_t(-1);
+  size_t synthesized = 0;
+  std::vector<uint32_t> neverHeld;  // pinned, and the synthesized poses
+  for (size_t i = 0; i < poses; ++i) {
+    const bool synth = synthFrom >= 0 && int64_t(ds.poses[i].id) >= synthFrom;
+    synthesized += synth;
     if (restId >= 0 && int64_t(ds.poses[i].id) == restId) pinned.push_back(uint32_t(i));
+    if (synth || (restId >= 0 && int64_t(ds.poses[i].id) == restId)) neverHeld.push_back(uint32_t(i));
+  }
+  out.synthesizedPoses = synthesized;
   Rng rng(st.seed);
   std::vector<uint64_t> poseIds(poses);
   for (size_t i = 0; i < poses; ++i) poseIds[i] = ds.poses[i].id;
+  const size_t recorded = poses - synthesized;
   IndexSplit split =
-      keyedSplit(poseIds, std::min(poses - 2, size_t(std::lround(st.testFraction * double(poses)))), rng, pinned);
+      keyedSplit(poseIds, std::min(poses - 2, size_t(std::lround(st.testFraction * double(recorded)))), rng, neverHeld);
   out.testPoses = std::move(split.held);
   out.trainingPoses = std::move(split.kept);
   const size_t nTrain = out.trainingPoses.size();

@@ -83,6 +83,7 @@ struct BakeTrainOutput {
   runtime::QualityLadder ladder;
   std::vector<uint32_t> trainingPoses, testPoses;  // indices into dataset.poses
   std::vector<uint32_t> pinnedPoses;  // indices into dataset.poses always trained on (the rest pose part 1 added)
+  size_t synthesizedPoses = 0;        // part1.synthesis's poses: trained on, never held out
   std::vector<StageTime> stages;
   nlohmann::json metadata;  // what went into Model::metadata
 };

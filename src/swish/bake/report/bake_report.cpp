@@ -48,8 +48,10 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   const auto& ev = out.evaluation;
   nlohmann::json r;
   r["character"] = ds.character.name;
-  r["poses"] = {
-      {"dataset", ds.poses.size()}, {"training", out.trainingPoses.size()}, {"held_out", out.testPoses.size()}};
+  r["poses"] = {{"dataset", ds.poses.size()},
+                {"training", out.trainingPoses.size()},
+                {"held_out", out.testPoses.size()},
+                {"synthesized", out.synthesizedPoses}};
   nlohmann::json pinned = nlohmann::json::array();  // dataset pose ids always trained on (the rest pose)
   for (uint32_t i : out.pinnedPoses) pinned.push_back(ds.poses[i].id);
   r["poses"]["always_trained"] = pinned;
@@ -162,6 +164,11 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   md << ds.poses.size() << " poses: " << out.trainingPoses.size() << " for training, " << out.testPoses.size()
      << " held out (nothing is fitted on them)"
      << (out.pinnedPoses.empty() ? "" : "; the rest pose part 1 added is always among the training poses")
+     << (out.synthesizedPoses == 0
+             ? ""
+             : "; " + std::to_string(out.synthesizedPoses) +
+                   " of the training poses are synthesized (part1.synthesis), so the held-out poses are recorded "
+                   "frames only")
      << ". All errors below are on the held-out poses, through the runtime path "
         "(Theta -> MLP -> PCA -> skinning; nearest code -> VQ decode).\n\n";
   md << "## Mesh\n\n| error (mm) | mean | p95 | max |\n|---|---|---|---|\n";

@@ -115,7 +115,9 @@ TEST(Part1Plan, SynthesizedPosesComeAfterTheRecordedOnesWhichKeepTheirSimulation
   // The dataset records the synthesis (another pose list: its files are rebuilt, its simulations kept);
   // without it the settings are as they were, and the held-out subjects' evenly spaced frames get none.
   EXPECT_EQ(synth.settingsJson["synthesis"]["poses"], 12);
+  EXPECT_EQ(synth.settingsJson["synthesized_from_id"], n);  // part 2 never holds these out
   EXPECT_FALSE(plain.settingsJson.contains("synthesis"));
+  EXPECT_FALSE(plain.settingsJson.contains("synthesized_from_id"));
   DatasetBuildSettings even = settings(thinning, {{"joints", {"LeftShoulder"}}, {"poses", 12}});
   even.evenPoses = 20;
   const DatasetPosePlan evenPlan = planDatasetPoses(even, {});
