@@ -95,9 +95,9 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   const bool hasRest = ds.settings.is_object() && ds.settings.contains("rest_pose_id") &&
                        ds.settings["rest_pose_id"].is_number_integer();
   const int64_t restId = hasRest ? ds.settings["rest_pose_id"].get<int64_t>() : int64_t(-1);
-  // Synthesized poses (part1.synthesis, the ids from synthesized_from_id on) are pinned too: the random
-  // held-out poses stay recorded frames of the training clips, as the report calls them, and as many as a
-  // bake without synthesis holds out.
+  // Synthesized poses (part1.synthesis, the ids from synthesized_from_id on) are never held out either (they
+  // may validate the MLP): the random held-out poses stay recorded frames of the training clips, as the
+  // report calls them, and as many as a bake without synthesis holds out.
   const bool hasSynth = ds.settings.is_object() && ds.settings.contains("synthesized_from_id") &&
                         ds.settings["synthesized_from_id"].is_number_integer();
   const int64_t synthFrom = hasSynth ? ds.settings["synthesized_from_id"].get<int64_t>() : int64_t(-1);
