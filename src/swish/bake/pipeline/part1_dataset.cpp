@@ -400,14 +400,17 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
   }
   std::vector<Pose>& poses = plan.toSimulate;
   res.origins = nlohmann::json::array();
+  auto originJson = [&](const PoseSamples::Origin& o) {  // pose_origins.json's entry for a sample
+    return nlohmann::json{{"clip", s.clips[o.clip].file.stem().string()},
+                          {"subject", s.clips[o.clip].subject},
+                          {"frame", o.frame},
+                          {"mirrored", o.mirrored}};
+  };
   auto addKept = [&](size_t from, size_t to) {
     for (size_t i = from; i < to; ++i) {
       const PoseSamples::Origin& o = samples.origins[thin.kept[i]];
       poses.push_back(canonicalPose(character.skeleton, poseOfSample(character.skeleton, clips, o)));
-      res.origins.push_back({{"clip", s.clips[o.clip].file.stem().string()},
-                             {"subject", s.clips[o.clip].subject},
-                             {"frame", o.frame},
-                             {"mirrored", o.mirrored}});
+      res.origins.push_back(originJson(o));
     }
   };
   addKept(0, thin.kept.size());
@@ -455,12 +458,6 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
     const auto t2 = Clock::now();
     const SynthesisResult syn =
         synthesizePoses(character.skeleton, clips, samples, thin.kept, inputJoints, s.synthesis);
-    auto originJson = [&](const PoseSamples::Origin& o) {
-      return nlohmann::json{{"clip", s.clips[o.clip].file.stem().string()},
-                            {"subject", s.clips[o.clip].subject},
-                            {"frame", o.frame},
-                            {"mirrored", o.mirrored}};
-    };
     for (const SynthesizedPose& sp : syn.added) {
       poses.push_back(canonicalPose(character.skeleton, poseOfSynthesized(character.skeleton, clips, sp)));
       nlohmann::json o = originJson(sp.base), draws = nlohmann::json::array();

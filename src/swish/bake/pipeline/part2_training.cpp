@@ -104,10 +104,11 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   size_t synthesized = 0;
   std::vector<uint32_t> neverHeld;  // pinned, and the synthesized poses
   for (size_t i = 0; i < poses; ++i) {
+    const bool rest = restId >= 0 && int64_t(ds.poses[i].id) == restId;
     const bool synth = synthFrom >= 0 && int64_t(ds.poses[i].id) >= synthFrom;
     synthesized += synth;
-    if (restId >= 0 && int64_t(ds.poses[i].id) == restId) pinned.push_back(uint32_t(i));
-    if (synth || (restId >= 0 && int64_t(ds.poses[i].id) == restId)) neverHeld.push_back(uint32_t(i));
+    if (rest) pinned.push_back(uint32_t(i));
+    if (rest || synth) neverHeld.push_back(uint32_t(i));
   }
   out.synthesizedPoses = synthesized;
   Rng rng(st.seed);

@@ -47,51 +47,59 @@ Mlp toModelMlp(const MlpNetwork<float>& net) {
 
 }  // namespace
 
-IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t> pinned) {
+namespace {
+
+std::vector<bool> pinnedMask(size_t n, std::span<const uint32_t> pinned) {
   std::vector<bool> isPinned(n, false);
   for (uint32_t i : pinned)
     if (i < n) isPinned[i] = true;
-  std::vector<uint32_t> order;
-  order.reserve(n);
-  for (size_t i = 0; i < n; ++i)
-    if (!isPinned[i]) order.push_back(uint32_t(i));
-  for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+  return isPinned;
+}
+
+// The first `held` of `order` (the unpinned indices in the split's order) held, the rest and the pinned
+// kept; both ascending.
+IndexSplit takeFirst(const std::vector<uint32_t>& order, size_t held, const std::vector<bool>& isPinned) {
   held = std::min(held, order.size());
   IndexSplit s;
   s.held.assign(order.begin(), order.begin() + long(held));
   s.kept.assign(order.begin() + long(held), order.end());
-  for (size_t i = 0; i < n; ++i)
+  for (size_t i = 0; i < isPinned.size(); ++i)
     if (isPinned[i]) s.kept.push_back(uint32_t(i));
   std::sort(s.held.begin(), s.held.end());
   std::sort(s.kept.begin(), s.kept.end());
   return s;
 }
 
+}  // namespace
+
+IndexSplit seededSplit(size_t n, size_t held, Rng& rng, std::span<const uint32_t> pinned) {
+  const std::vector<bool> isPinned = pinnedMask(n, pinned);
+  std::vector<uint32_t> order;
+  order.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (!isPinned[i]) order.push_back(uint32_t(i));
+  for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+  return takeFirst(order, held, isPinned);
+}
+
 IndexSplit keyedSplit(std::span<const uint64_t> keys, size_t held, Rng& rng, std::span<const uint32_t> pinned) {
-  const size_t n = keys.size();
-  std::vector<bool> isPinned(n, false);
-  for (uint32_t i : pinned)
-    if (i < n) isPinned[i] = true;
+  const std::vector<bool> isPinned = pinnedMask(keys.size(), pinned);
   const Rng hashes(rng.next());  // the seed's share of every key's hash
   struct Keyed {
     uint64_t hash, key;
     uint32_t index;
   };
-  std::vector<Keyed> order;
-  order.reserve(n);
-  for (size_t i = 0; i < n; ++i)
-    if (!isPinned[i]) order.push_back({hashes.split(keys[i]).next(), keys[i], uint32_t(i)});
-  std::sort(order.begin(), order.end(), [](const Keyed& a, const Keyed& b) {
+  std::vector<Keyed> keyed;
+  keyed.reserve(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (!isPinned[i]) keyed.push_back({hashes.split(keys[i]).next(), keys[i], uint32_t(i)});
+  std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
     return a.hash != b.hash ? a.hash < b.hash : a.key != b.key ? a.key < b.key : a.index < b.index;
   });
-  held = std::min(held, order.size());
-  IndexSplit s;
-  for (size_t i = 0; i < order.size(); ++i) (i < held ? s.held : s.kept).push_back(order[i].index);
-  for (size_t i = 0; i < n; ++i)
-    if (isPinned[i]) s.kept.push_back(uint32_t(i));
-  std::sort(s.held.begin(), s.held.end());
-  std::sort(s.kept.begin(), s.kept.end());
-  return s;
+  std::vector<uint32_t> order;
+  order.reserve(keyed.size());
+  for (const Keyed& k : keyed) order.push_back(k.index);
+  return takeFirst(order, held, isPinned);
 }
 
 MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrainOptions& o) {

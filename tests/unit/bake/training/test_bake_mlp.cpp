@@ -246,13 +246,23 @@ TEST(BakeMlp, KeyedSplitHoldsTheSamePosesWhenOthersComeAndGo) {
   EXPECT_EQ(pinnedSplit.kept.size(), 178u);
 }
 
-TEST(BakeMlp, AlwaysTrainSamplesAreNeverValidated) {
-  Rng rng(test::testSeed(22));
-  MatXf x(3, 50), y(2, 50);
+namespace {
+
+// 50 samples of a small smooth map (3 inputs, 2 outputs) for the split tests.
+void smallRegression(uint64_t seed, MatXf& x, MatXf& y) {
+  Rng rng(seed);
+  x.resize(3, 50), y.resize(2, 50);
   for (int i = 0; i < 50; ++i) {
     x.col(i) << float(rng.normal()), float(rng.normal()), float(rng.normal());
     y.col(i) << x(0, i) + x(1, i), x(2, i) * x(0, i);
   }
+}
+
+}  // namespace
+
+TEST(BakeMlp, AlwaysTrainSamplesAreNeverValidated) {
+  MatXf x, y;
+  smallRegression(test::testSeed(22), x, y);
   MlpTrainOptions o;
   o.hiddenLayers = 1, o.hiddenWidth = 8, o.maxEpochs = 5, o.validationFraction = 0.3;
   o.alwaysTrain = {0, 17, 49};
@@ -267,12 +277,8 @@ TEST(BakeMlp, AlwaysTrainSamplesAreNeverValidated) {
 }
 
 TEST(BakeMlp, SampleKeysChooseTheValidationSamples) {
-  Rng rng(test::testSeed(23));
-  MatXf x(3, 50), y(2, 50);
-  for (int i = 0; i < 50; ++i) {
-    x.col(i) << float(rng.normal()), float(rng.normal()), float(rng.normal());
-    y.col(i) << x(0, i) + x(1, i), x(2, i) * x(0, i);
-  }
+  MatXf x, y;
+  smallRegression(test::testSeed(23), x, y);
   MlpTrainOptions o;
   o.hiddenLayers = 1, o.hiddenWidth = 8, o.maxEpochs = 3, o.validationFraction = 0.2, o.seed = 9;
   for (uint64_t i = 0; i < 50; ++i) o.sampleKeys.push_back(1000 + 7 * i);  // pose ids, not columns
