@@ -19,9 +19,15 @@ namespace swish::replay {
 
 namespace {
 
-// The coverage ray starts this far above the body triangle (m), so that a garment vertex lying on the
-// skin still counts and the triangle itself is never the hit.
-constexpr float kLift = 1e-4f;
+// The coverage ray starts this far below the body triangle (m): a garment that lies on the skin, or is
+// already sunk a little under it at rest, covers it. The default jersey's rest game mesh cuts up to 8 mm
+// under the shoulder tops (its long triangles there are chords of the rounded shoulder), and those
+// shoulder caps are what a player sees first; a ray from the skin outwards missed them.
+constexpr float kSunk = 0.015f;
+// A body triangle buried in another part at rest is covered when the garment lies over it within this (m).
+constexpr float kBuriedReach = 0.08f;
+// Rays from a body triangle start this far off it (m), so that it is never its own hit.
+constexpr float kLiftOff = 1e-4f;
 
 }  // namespace
 
@@ -62,10 +68,25 @@ BodyThroughGarmentMeter::BodyThroughGarmentMeter(const Points3f& restBody, const
     for (int k = 0; k < 3; ++k) nearOpening_[size_t(t)] |= char(nearOpening(restGarment.row(garmentTriangles(t, k))));
   covered_.assign(size_t(bodyTriangles.rows()), 0);
   for (Eigen::Index t = 0; t < bodyTriangles.rows(); ++t) {
-    const std::optional<bake::SurfacePoint> hit =
-        bake::garmentAlongNormal(restBody.row(bodyTriangles(t, 0)), restBody.row(bodyTriangles(t, 1)),
-                                 restBody.row(bodyTriangles(t, 2)), garment, kLift, reach);
-    covered_[size_t(t)] = hit && hit->found && !nearOpening(hit->point);  // degenerate: no outward direction
+    const Vec3f a = restBody.row(bodyTriangles(t, 0)), b = restBody.row(bodyTriangles(t, 1)),
+                c = restBody.row(bodyTriangles(t, 2));
+    const std::optional<bake::SurfacePoint> hit = bake::garmentAlongNormal(a, b, c, garment, -kSunk, kSunk + reach);
+    if (!hit) continue;  // degenerate: no outward direction
+    if (hit->found && !nearOpening(hit->point)) {
+      covered_[size_t(t)] = 1;
+      continue;
+    }
+    // Buried in another part at rest (the top of an arm tube inside the trunk's shoulder): hidden then, and
+    // under the garment when a pose brings it out, if the garment lies over it within kBuriedReach. Inside
+    // when the first body surface the outward line meets faces the same way (the line leaves a part there).
+    const Vec3f dir = (b - a).cross(c - a).normalized(), centroid = (a + b + c) / 3.f;
+    const bake::SurfacePoint exit = body.intersect(centroid + kLiftOff * dir, dir, 0.f, kBuriedReach);
+    if (!exit.found) continue;
+    const Vec3f ea = restBody.row(bodyTriangles(exit.triangle, 0)), eb = restBody.row(bodyTriangles(exit.triangle, 1)),
+                ec = restBody.row(bodyTriangles(exit.triangle, 2));
+    if (!((eb - ea).cross(ec - ea).dot(dir) > 0.f)) continue;
+    const std::optional<bake::SurfacePoint> over = bake::garmentAlongNormal(a, b, c, garment, 0.f, kBuriedReach);
+    covered_[size_t(t)] = over && over->found && !nearOpening(over->point);
   }
 }
 
@@ -74,8 +95,8 @@ size_t BodyThroughGarmentMeter::coveredTriangles() const {
 }
 
 BodyThroughGarment BodyThroughGarmentMeter::measure(const Points3f& body, const Points3f& garment,
-                                                    const api::Mat4& viewProjection, uint32_t width,
-                                                    uint32_t height) const {
+                                                    const api::Mat4& viewProjection, uint32_t width, uint32_t height,
+                                                    std::vector<int32_t>* where) const {
   if (body.rows() != bodyVertices_ || garment.rows() != garmentVertices_)
     throw Error("body through the garment: the posed body has " + std::to_string(body.rows()) +
                 " vertices and the garment " + std::to_string(garment.rows()) + ", at rest " +
@@ -92,6 +113,7 @@ BodyThroughGarment BodyThroughGarmentMeter::measure(const Points3f& body, const 
     const Eigen::Vector4f h = inv * Eigen::Vector4f(x, y, z, 1.f);
     return Vec3f(h.head<3>() / h.w());
   };
+  if (where) where->assign(size_t(width) * height, -1);
   auto pixel = [&](uint32_t px, uint32_t py, BodyThroughGarment& out) {
     const float x = (float(px) + 0.5f) / float(width) * 2.f - 1.f;
     const float y = (float(py) + 0.5f) / float(height) * 2.f - 1.f;
@@ -108,7 +130,10 @@ BodyThroughGarment BodyThroughGarmentMeter::measure(const Points3f& body, const 
       // there (sunk beneath the skin, or just behind it), not when its edge has moved off (a hem that
       // rode up when the arms rose, a sleeve that slid).
       const bake::SurfacePoint c = garmentScene.closestPoint(b.point, reach_);
-      if (c.found && !nearOpening_[c.triangle]) ++out.pixels;
+      if (c.found && !nearOpening_[c.triangle]) {
+        ++out.pixels;
+        if (where) (*where)[size_t(py) * width + px] = int32_t(b.triangle);
+      }
     }
   };
   return tbb::parallel_reduce(

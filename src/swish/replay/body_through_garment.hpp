@@ -3,9 +3,11 @@
 // garment covers. Vertex counts of penetration (bake/report/penetration.hpp) say how much cloth is inside
 // the body; this says what a player sees of it (the grey shoulder patches of the contact sheet).
 //
-// Which skin the garment covers is decided once, in the rest pose: a body triangle is covered when a ray
-// from its centroid along its outward normal meets the rest garment within `reach`, at least
-// `edgeMargin` from the garment's openings (hem, collar, sleeve ends). The forearms, the neck above the
+// Which skin the garment covers is decided once, in the rest pose: a body triangle is covered when the
+// line along its outward normal through its centroid meets the rest garment between 1.5 cm under the skin
+// and `reach` above it, at least `edgeMargin` from the garment's openings (hem, collar, sleeve ends); or
+// when it is buried inside another part of the body at rest (the top of an arm tube inside the trunk's
+// shoulder, which a hanging arm brings out) with the garment over it within 8 cm. The forearms, the neck above the
 // collar and the legs are not covered; the shoulders, chest and back are.
 //
 // Per picture, each pixel's ray (the camera's view-projection inverted, through the pixel centre) is
@@ -46,8 +48,10 @@ class BodyThroughGarmentMeter {
   // column-major as render::viewProjection), with the body and the garment posed in that world (same
   // vertex counts as at rest). Throws Error for a singular view-projection, other vertex counts or
   // non-finite positions.
+  // `where` (optional): resized to width * height (row-major, y down) and set, per pixel that counts, to
+  // the body triangle the camera sees there; -1 elsewhere.
   BodyThroughGarment measure(const Points3f& body, const Points3f& garment, const api::Mat4& viewProjection,
-                             uint32_t width, uint32_t height) const;
+                             uint32_t width, uint32_t height, std::vector<int32_t>* where = nullptr) const;
 
  private:
   Triangles bodyTriangles_, garmentTriangles_;

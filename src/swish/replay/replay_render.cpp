@@ -1,5 +1,6 @@
 #include "swish/replay/replay_render.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <optional>
@@ -110,13 +111,15 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
     uint32_t frame;
     Pose pose;
     Points3f model;
+    Points3f body;  // as drawn (empty without a body), for the truth's body-through measure
+    api::Mat4 viewProjection;
   };
   std::vector<HeatJob> heatJobs;
 
   const uint32_t frames = scene.frameCount;
   const uint32_t shown = std::max<uint32_t>(1, std::min(o.maxFrames, frames));
   std::vector<PoseIssue> issues;
-  std::vector<render::PreviewImage> images;
+  std::vector<render::PreviewImage> images, marked;  // marked: the frames with body through, marked
   std::vector<api::Quat> rotations(skeleton.size());
   for (uint32_t i = 0; i < shown; ++i) {
     uint32_t index = uint32_t(uint64_t(i) * frames / shown);
@@ -134,16 +137,32 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
     images.push_back(render::renderFramePng(preview, cp, dir / name));
     result.frames.push_back(dir / name);
     result.frameNumbers.push_back(f);
+    Points3f drawnBody;
     if (meter) {
       const std::vector<float> body = preview.lastBody();
       const api::DeformedMesh jersey = preview.lastJersey();
+      drawnBody = Eigen::Map<const Points3f>(body.data(), Eigen::Index(body.size() / 3), 3);
+      std::vector<int32_t> where;
       result.bodyThrough.push_back(meter->measure(
-          Eigen::Map<const Points3f>(body.data(), Eigen::Index(body.size() / 3), 3),
-          Eigen::Map<const Points3f>(jersey.positions.data(), Eigen::Index(jersey.positions.size() / 3), 3),
-          preview.viewProjection(), o.width, o.height));
+          drawnBody, Eigen::Map<const Points3f>(jersey.positions.data(), Eigen::Index(jersey.positions.size() / 3), 3),
+          preview.viewProjection(), o.width, o.height, &where));
+      if (result.bodyThrough.back().pixels > 0) {
+        // The frame again with the pixels that count painted magenta: where to look.
+        render::PreviewImage image = images.back();
+        for (size_t p = 0; p < where.size(); ++p)
+          if (where[p] >= 0) {
+            uint8_t* px = &image.rgba[p * 4];
+            px[0] = 255, px[1] = 0, px[2] = 255, px[3] = 255;
+          }
+        std::snprintf(name, sizeof name, "through_%04u.png", f);
+        render::writePreviewPng((dir / name).string(), image, preview.options().background);
+        result.throughFrames.push_back(dir / name);
+        marked.push_back(std::move(image));
+      }
     }
+    result.truthBodyThrough.emplace_back();
     if (truth) {
-      HeatJob job{f, pose, Points3f()};
+      HeatJob job{f, pose, Points3f(), std::move(drawnBody), preview.viewProjection()};
       job.pose.rootTranslation = skeleton.restPose().rootTranslation;  // drawn in place, as the preview
       const api::DeformedMesh mesh = preview.lastJersey();
       job.model = Eigen::Map<const Points3f>(mesh.positions.data(), Eigen::Index(mesh.positions.size() / 3), 3);
@@ -171,6 +190,11 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
       fig.truth = &measured[k].truthPositions;
       fig.triangles = &entry.model.gameMesh.triangles;
       fig.scaleMm = 10.0;  // one scale for every frame, so that colours compare across the sheet
+      if (meter) {
+        const auto drawn = std::find(result.frameNumbers.begin(), result.frameNumbers.end(), heatJobs[k].frame);
+        result.truthBodyThrough[size_t(drawn - result.frameNumbers.begin())] =
+            meter->measure(heatJobs[k].body, measured[k].truthPositions, heatJobs[k].viewProjection, o.width, o.height);
+      }
       const io::PngImage png = io::heatMapFigure(fig);
       char name[32];
       std::snprintf(name, sizeof name, "heat_%04u.png", heatJobs[k].frame);
@@ -195,6 +219,10 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   }
   result.contactSheet = dir / "contact_sheet.png";
   render::writeContactSheet(images, result.contactSheet);
+  if (!marked.empty()) {
+    result.throughSheet = dir / "through_sheet.png";
+    render::writeContactSheet(marked, result.throughSheet);
+  }
   return result;
 }
 
@@ -231,14 +259,42 @@ std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderO
                     r.bodyThrough[most].pixels, r.frameNumbers[most], 100.0 * r.bodyThrough[most].share());
       s += line;
     }
-    s += ".\n\n| frame | pixels | share of the garment's |\n|---|---|---|\n";
+    s += ".";
+    // The truth's garment in the same pictures (frames with truth only): is the body through the model's doing?
+    size_t truthFrames = 0, truthShowing = 0;
+    uint32_t truthMost = 0;
+    for (const auto& t : r.truthBodyThrough)
+      if (t) {
+        ++truthFrames;
+        if (t->pixels > 0) ++truthShowing;
+        truthMost = std::max(truthMost, t->pixels);
+      }
+    if (truthFrames > 0) {
+      std::snprintf(line, sizeof line,
+                    " The truth (the source simulation's garment, skinned as the run time skins it, posed and seen "
+                    "as the model's) shows it in **%zu of %zu frames**, at most %u pixels.",
+                    truthShowing, truthFrames, truthMost);
+      s += line;
+    }
+    s += truthFrames > 0 ? "\n\n| frame | pixels | share of the garment's | truth pixels |\n|---|---|---|---|\n"
+                         : "\n\n| frame | pixels | share of the garment's |\n|---|---|---|\n";
     for (size_t i = 0; i < r.bodyThrough.size(); ++i) {
-      std::snprintf(line, sizeof line, "| %u | %u | %.2f %% |\n", r.frameNumbers[i], r.bodyThrough[i].pixels,
+      std::snprintf(line, sizeof line, "| %u | %u | %.2f %% |", r.frameNumbers[i], r.bodyThrough[i].pixels,
                     100.0 * r.bodyThrough[i].share());
       s += line;
+      if (truthFrames > 0) {
+        const auto& t = i < r.truthBodyThrough.size() ? r.truthBodyThrough[i] : std::nullopt;
+        if (t) std::snprintf(line, sizeof line, " %u |", t->pixels);
+        s += t ? line : " - |";
+      }
+      s += "\n";
     }
   }
   s += "\n\n![contact sheet](" + rel(r.contactSheet) + ")\n";
+  if (!r.throughSheet.empty())
+    s += "\nThe frames that show the body through the garment, the pixels counted painted magenta:\n\n![body through "
+         "the garment](" +
+         rel(r.throughSheet) + ")\n";
   if (!r.heatSheet.empty())
     s += "\nModel | truth | per-vertex error (mm, one scale for all frames):\n\n![error heat maps](" +
          rel(r.heatSheet) + ")\n";

@@ -6,6 +6,7 @@
 // garment and the upper body around it (arms included), not the whole figure on a large canvas.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,8 +40,14 @@ struct ReplayRenderResult {
   // Per drawn frame: the pixels where skin the garment covers at rest is drawn (body_through_garment.hpp);
   // empty when no body is drawn. `coveredTriangles`: how many body triangles the garment covers at rest.
   std::vector<BodyThroughGarment> bodyThrough;
+  std::vector<std::filesystem::path> throughFrames;  // per frame that shows any: through_NNNN.png, those pixels marked
   size_t coveredTriangles = 0;
+  // With truth and a body: per drawn frame, the same measure on the truth's garment posed and seen as the
+  // model's was (nullopt where the frame has no truth or its simulation failed), so the report tells whether
+  // the model or its source simulation puts the body through the cloth.
+  std::vector<std::optional<BodyThroughGarment>> truthBodyThrough;
   std::filesystem::path contactSheet;
+  std::filesystem::path throughSheet;           // the through_NNNN.png frames on one sheet; empty when none
   std::vector<std::filesystem::path> heatMaps;  // per frame with truth
   std::filesystem::path heatSheet;              // empty without truth
   std::string note;                             // e.g. why no body was drawn, or why there are no heat maps

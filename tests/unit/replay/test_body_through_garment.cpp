@@ -80,6 +80,34 @@ TEST(BodyThroughGarment, NothingAtRestClothSunkIntoTheBodyShowsSlidClothDoesNot)
   EXPECT_EQ(meter.measure(body.positions, sunk, vp, kWidth, kHeight).pixels, through.pixels);
 }
 
+// The default jersey's rest game mesh already cuts a few millimetres under the shoulder tops (its long
+// triangles there are chords of the rounded shoulder). That skin is under the garment all the same, and
+// when it shows the measure counts it: a shirt whose band is sunk 5 mm under the skin at rest.
+TEST(BodyThroughGarment, SkinTheRestGarmentCutsUnderIsCoveredAndCounts) {
+  const test::CapsuleSpec spec;
+  const Mesh body = test::capsuleBody(spec);
+  Mesh shirt = test::tubeGarment(spec);
+  auto sinkBand = [&](Points3f p, float depth) {
+    for (Eigen::Index v = 0; v < p.rows(); ++v)
+      if (p(v, 1) > 0.3f && p(v, 1) < 0.4f) {
+        const Vec2f in = Vec2f(p(v, 0), p(v, 2)).normalized() * (spec.radius - depth);
+        p(v, 0) = in.x(), p(v, 2) = in.y();
+      }
+    return p;
+  };
+  const BodyThroughGarmentMeter plain(body.positions, body.triangles, shirt.positions, shirt.triangles);
+  shirt.positions = sinkBand(shirt.positions, 0.005f);
+  const BodyThroughGarmentMeter sunkAtRest(body.positions, body.triangles, shirt.positions, shirt.triangles);
+  // The band's skin is covered as where the shirt lies outside the body.
+  EXPECT_EQ(sunkAtRest.coveredTriangles(), plain.coveredTriangles());
+  const BodyThroughGarment shows = sunkAtRest.measure(body.positions, shirt.positions, frontCamera(), kWidth, kHeight);
+  EXPECT_GT(shows.pixels, 100u);
+  // Cloth 2 cm under the skin at rest is not taken for covering (a limb under a hem, say): beyond 1.5 cm.
+  const Points3f deep = sinkBand(test::tubeGarment(spec).positions, 0.02f);
+  const BodyThroughGarmentMeter deepAtRest(body.positions, body.triangles, deep, shirt.triangles);
+  EXPECT_LT(deepAtRest.coveredTriangles(), plain.coveredTriangles());
+}
+
 TEST(BodyThroughGarment, BadInputIsAClearError) {
   const test::CapsuleSpec spec;
   const Mesh body = test::capsuleBody(spec), shirt = test::tubeGarment(spec);

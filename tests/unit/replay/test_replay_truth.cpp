@@ -242,12 +242,45 @@ TEST_F(ReplayTruth, RenderMeasuresTheBodyThroughTheGarmentPerFrame) {
     EXPECT_GT(b.garmentPixels, 500u);  // the jersey fills the framed picture
     EXPECT_LT(b.pixels, 96u * 128u - b.garmentPixels);
   }
+  // Each frame that shows any has its copy with those pixels marked, and they share a sheet.
+  size_t showing = 0;
+  for (const replay::BodyThroughGarment& b : r.bodyThrough) showing += b.pixels > 0;
+  EXPECT_EQ(r.throughFrames.size(), showing);
+  for (const fs::path& f : r.throughFrames) EXPECT_TRUE(fs::exists(f)) << f;
+  EXPECT_EQ(r.throughSheet.empty(), showing == 0);
+  // No truth asked: no truth column.
+  ASSERT_EQ(r.truthBodyThrough.size(), 2u);
+  EXPECT_FALSE(r.truthBodyThrough[0] || r.truthBodyThrough[1]);
   const std::string md = replay::renderReportSection(r, ro, *tmp_ / "out");
   EXPECT_NE(md.find("Body through the garment"), std::string::npos) << md;
-  EXPECT_NE(md.find("| frame | pixels | share of the garment's |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| frame | pixels | share of the garment's |\n"), std::string::npos) << md;
   EXPECT_NE(md.find("| " + std::to_string(r.frameNumbers[1]) + " | " + std::to_string(r.bodyThrough[1].pixels) + " |"),
             std::string::npos)
       << md;
+}
+
+// With truth, the same measure on the truth's garment in the same pictures, beside the model's: whether the
+// model or its source simulation puts the body through the cloth.
+TEST_F(ReplayTruth, RenderMeasuresTheTruthsBodyThroughBesideTheModels) {
+  const runtime::Scene s = scene(3, json::array({character("walker", true)}));
+  replay::ModelLibrary models(s);
+  replay::ReplayRenderOptions ro;
+  ro.maxFrames = 1;
+  ro.width = 96;
+  ro.height = 128;
+  ro.truth = cheaperTruth(2);
+  ro.truth.normalMaps = false;
+  const replay::ReplayRenderResult r = replay::renderReplayFrames(s, models, *tmp_ / "out/render_truth", ro);
+  ASSERT_EQ(r.frames.size(), 1u);
+  ASSERT_EQ(r.truthBodyThrough.size(), 1u);
+  ASSERT_TRUE(r.truthBodyThrough[0].has_value()) << r.note;
+  // The truth's jersey is drawn where the model's is: about as many garment pixels.
+  EXPECT_NEAR(double(r.truthBodyThrough[0]->garmentPixels), double(r.bodyThrough[0].garmentPixels),
+              0.2 * double(r.bodyThrough[0].garmentPixels));
+  const std::string md = replay::renderReportSection(r, ro, *tmp_ / "out");
+  EXPECT_NE(md.find("| frame | pixels | share of the garment's | truth pixels |"), std::string::npos) << md;
+  EXPECT_NE(md.find("The truth (the source simulation's garment"), std::string::npos) << md;
+  EXPECT_NE(md.find(" " + std::to_string(r.truthBodyThrough[0]->pixels) + " |\n"), std::string::npos) << md;
 }
 
 TEST_F(ReplayTruth, SameFiguresTwiceAndFarFromTheOrigin) {
@@ -395,6 +428,7 @@ TEST(ReplayTruthSettings, MetadataGivesBackTheBakeSettings) {
   EXPECT_EQ(a.transfer.normalMap.height, b.transfer.normalMap.height);
   EXPECT_EQ(a.transfer.normalMap.maxDistance, b.transfer.normalMap.maxDistance);
   EXPECT_EQ(a.transfer.normalMap.dilationRings, b.transfer.normalMap.dilationRings);
+  EXPECT_EQ(a.transfer.cover.margin, b.transfer.cover.margin);
 
   EXPECT_NE(test::errorOf([] {
               bake::poseShapeSettingsFromJson(json::parse(R"({"simulation": {"substeps": "8"}})"), "meta");
