@@ -75,6 +75,19 @@ Triangles trianglesWeldedByPosition(const Points3f& positions, const Triangles& 
   return out;
 }
 
+std::vector<std::pair<uint32_t, uint32_t>> openEdges(const Triangles& triangles) {
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t i = triangles(t, k), j = triangles(t, (k + 1) % 3);
+      ++uses[{std::min(i, j), std::max(i, j)}];
+    }
+  std::vector<std::pair<uint32_t, uint32_t>> open;
+  for (const auto& [edge, n] : uses)
+    if (n == 1) open.push_back(edge);
+  return open;
+}
+
 std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, size_t n,
                                                          const std::vector<uint32_t>* weld) {
   auto rep = [&](uint32_t v) { return weld ? (*weld)[v] : v; };

@@ -49,6 +49,10 @@ std::vector<uint32_t> weldByPosition(const Points3f& positions);
 // seam copies joined (closed where only UV seams split it), over the same vertex array.
 Triangles trianglesWeldedByPosition(const Points3f& positions, const Triangles& triangles);
 
+// The edges (lower index first, ascending) that exactly one triangle uses: a surface's openings. Weld first
+// (trianglesWeldedByPosition) for a mesh whose UV seams split it, or every seam is an opening too.
+std::vector<std::pair<uint32_t, uint32_t>> openEdges(const Triangles& triangles);
+
 // Vertex -> incident triangles, in compressed sparse rows. Gathered (never scattered), so that the
 // GPU pass needs no float atomics and the CPU reference sums in the same order.
 struct VertexTriangleAdjacency {

@@ -47,17 +47,9 @@ BodyThroughGarmentMeter::BodyThroughGarmentMeter(const Points3f& restBody, const
   const bake::TriangleRayScene body(restBody, bodyTriangles, "body through the garment: rest body");
   const bake::TriangleRayScene garment(restGarment, garmentTriangles, "body through the garment: rest garment");
   // The garment's open edges (hem, collar, sleeve ends; UV seams welded first, they are not openings).
-  const Triangles welded = trianglesWeldedByPosition(restGarment, garmentTriangles);
-  std::map<std::pair<uint32_t, uint32_t>, int> edgeUses;
-  for (Eigen::Index t = 0; t < welded.rows(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t i = welded(t, k), j = welded(t, (k + 1) % 3);
-      ++edgeUses[{std::min(i, j), std::max(i, j)}];
-    }
   std::vector<Vec3f> openEdgePoints;
-  for (const auto& [edge, uses] : edgeUses)
-    if (uses == 1)
-      openEdgePoints.push_back(0.5f * (restGarment.row(edge.first) + restGarment.row(edge.second)).transpose());
+  for (const auto& [a, b] : openEdges(trianglesWeldedByPosition(restGarment, garmentTriangles)))
+    openEdgePoints.push_back(0.5f * (restGarment.row(a) + restGarment.row(b)).transpose());
   auto nearOpening = [&](const Vec3f& p) {
     for (const Vec3f& q : openEdgePoints)
       if ((q - p).squaredNorm() < edgeMargin * edgeMargin) return true;

@@ -6,6 +6,7 @@
 
 #include "support/random_model.hpp"
 #include "swish/core/error.hpp"
+#include "swish/core/mesh.hpp"
 #include "swish/core/mesh_frames.hpp"
 #include "swish/core/rng.hpp"
 #include "swish/core/rotation.hpp"
@@ -161,6 +162,31 @@ TEST(MeshFrames, SeamCopiesShareTheirNormal) {
   EXPECT_LT((n.row(0) - n.row(3)).norm(), 1e-6f);
   EXPECT_LT((n.row(2) - n.row(4)).norm(), 1e-6f);
   EXPECT_GT((n.row(1) - n.row(5)).norm(), 0.5f);  // unshared corners keep their own face normal
+}
+
+// A quad strip closed into a tube by a UV seam (its first column repeated): welded, only the two rims are
+// openings; unwelded, the seam is too.
+TEST(Mesh, OpenEdgesAreTheRimsOnceTheSeamIsWelded) {
+  const int around = 6;
+  Points3f p((around + 1) * 2, 3);
+  for (int row = 0; row < 2; ++row)
+    for (int k = 0; k <= around; ++k) {
+      const float a = 2.f * float(M_PI) * float(k % around) / float(around);
+      p.row(row * (around + 1) + k) << std::cos(a), float(row), std::sin(a);
+    }
+  Triangles t(2 * around, 3);
+  for (int k = 0; k < around; ++k) {
+    const uint32_t a = uint32_t(k), b = a + 1, d = a + uint32_t(around + 1), e = d + 1;
+    t.row(2 * k) << a, b, e;
+    t.row(2 * k + 1) << a, e, d;
+  }
+  EXPECT_EQ(openEdges(t).size(), size_t(2 * around + 2));  // the rims and the seam's two sides
+  const auto rims = openEdges(trianglesWeldedByPosition(p, t));
+  ASSERT_EQ(rims.size(), size_t(2 * around));
+  for (const auto& [a, b] : rims) {
+    EXPECT_LT(a, b);
+    EXPECT_EQ(p(a, 1), p(b, 1));  // along a rim, not across the strip
+  }
 }
 
 TEST(Rng, SameSeedSameStreamAndUniformInRange) {

@@ -183,9 +183,9 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
     sim.fail(e.what());
   }
 
-  const JsonReader tr =
-      j.section("transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights",
-                             "unskin_min_singular_value", "max_edge_strain", "reskin_min_singular_value"});
+  const JsonReader tr = j.section(
+      "transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights", "unskin_min_singular_value",
+                   "max_edge_strain", "reskin_min_singular_value", "cover_body_mm"});
   LaplacianSmoothingSettings& ls = s.transfer.smoothing;
   ls.strength = float(tr.number("smoothing_strength", 0, 1, ls.strength));
   ls.iterations = int(tr.wholeNumber("smoothing_iterations", 0, 1000, ls.iterations));
@@ -202,6 +202,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   // Where a corrected pose's vertex moves with its skinned rest position (pose_transfer.hpp; 0: nowhere).
   s.transfer.reskinMinSingularValue =
       float(tr.number("reskin_min_singular_value", 0, 0.5, s.transfer.reskinMinSingularValue));
+  // How far outside the body the game mesh passes where the simulation covered it (body_cover.hpp; 0: off).
+  s.transfer.cover.margin = float(tr.number("cover_body_mm", 0, 20, 1000.0 * s.transfer.cover.margin) / 1000.0);
 
   const JsonReader nm = j.section("normal_maps", {"size", "max_distance", "dilation_rings", "bit_depth"});
   NormalMapBakeSettings& nb = s.transfer.normalMap;
@@ -329,6 +331,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   // Settings recorded before it carried every corrected vertex through pre-skin space.
   const nlohmann::json tr = datasetSettings.value("transfer", nlohmann::json::object());
   if (tr.is_object() && !tr.contains("reskin_min_singular_value")) s.transfer.reskinMinSingularValue = 0.f;
+  // Settings recorded before the game mesh was kept over the body stored it as transferred.
+  if (tr.is_object() && !tr.contains("cover_body_mm")) s.transfer.cover.margin = 0.f;
   return s.poseShape();
 }
 

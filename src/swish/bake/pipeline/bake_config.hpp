@@ -58,7 +58,9 @@
 //                    "max_edge_strain" (0.5-1000, default 4: a game-mesh edge stretched more fails
 //                    the pose as torn; transfer/pose_transfer.hpp),
 //                    "reskin_min_singular_value" (0-0.5, default 0.4: where a corrected pose's vertex
-//                    moves with its skinned rest position; pose_transfer.hpp)},
+//                    moves with its skinned rest position; pose_transfer.hpp),
+//                    "cover_body_mm" (0-20, default 2: the game mesh kept this far outside the body
+//                    where the simulation's cloth covers it; 0: off; transfer/body_cover.hpp)},
 //       "normal_maps": {"size", "max_distance", "dilation_rings", "bit_depth"},
 //       "preview": {"poses", "size"}
 //     },

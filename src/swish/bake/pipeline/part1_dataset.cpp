@@ -288,7 +288,8 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = clothCarryName(m.carry);  // likewise
   if (transfer.reskinMinSingularValue > 0.f)                                                     // likewise
     out["transfer"]["reskin_min_singular_value"] = transfer.reskinMinSingularValue;
-  if (!m.skinningRetriesOnly()) {  // likewise
+  if (transfer.cover.enabled()) out["transfer"]["cover_body_mm"] = 1000.f * transfer.cover.margin;  // likewise
+  if (!m.skinningRetriesOnly()) {                                                                   // likewise
     nlohmann::json& list = out["simulation"]["retry_carries"] = nlohmann::json::array();
     for (ClothCarry c : m.retryCarries) list.push_back(clothCarryName(c));
   }
@@ -327,6 +328,12 @@ nlohmann::json DatasetBuildResult::toJson() const {
            {{"poses", unskinDampedPoses},
             {"max_vertices", unskinDampedMaxVertices},
             {"smallest_singular_value", unskinSmallestSingularValue}}},
+          {"body_cover",
+           {{"poses", bodyCover.poses},
+            {"vertices_moved", bodyCover.vertices},
+            {"largest_shift_mm", 1000.0 * bodyCover.largestShift},
+            {"deepest_before_mm", 1000.0 * bodyCover.deepest},
+            {"poses_left_through", bodyCover.posesLeftThrough}}},
           {"failed", f},
           {"rebuilt", rebuilt},
           {"simulation", simulationReport},
@@ -716,6 +723,16 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
   ProgressThrottle transferThrottle;
   const auto transferStart = Clock::now();
   const size_t total = todo.size();
+  auto counted = [&](const TransferredPose& tp) {
+    if (tp.cover.verticesMoved == 0 && tp.cover.samplesLeft == 0) return;
+    std::lock_guard<std::mutex> lock(mutex);
+    DatasetBuildResult::BodyCoverSummary& c = res.bodyCover;
+    c.poses += tp.cover.verticesMoved > 0;
+    c.vertices += tp.cover.verticesMoved;
+    c.posesLeftThrough += tp.cover.samplesLeft > 0;
+    c.largestShift = std::max(c.largestShift, tp.cover.largestShift);
+    c.deepest = std::max(c.deepest, tp.cover.deepest);
+  };
   auto one = [&](size_t k) {
     const uint32_t id = todo[k];
     std::string failure;
@@ -730,6 +747,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         }
         if (failure.empty()) {
           TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], positions);
+          counted(tp);
           DatasetPose dp;
           dp.id = id;
           dp.pose = recorded[id];
@@ -754,6 +772,7 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
         // The pre-skin shape from the corrected simulation, the world shape skinned with the
         // recorded pose (pose_shape.hpp); the dataset keeps the recorded pose.
         TransferredPose tp = shapes.gameMeshShape(poses[id], recorded[id], rec->result.positions);
+        counted(tp);
         DatasetPose dp;
         dp.id = id;
         dp.pose = recorded[id];
@@ -809,6 +828,17 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
                     double(res.unskinSmallestSingularValue));
       log(line);
     }
+  }
+  if (res.bodyCover.poses > 0) {
+    const auto& c = res.bodyCover;
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "part 1: the game mesh kept over the body (cover_body_mm) in %zu of %zu poses transferred: %.0f "
+                  "vertices moved per such pose, at most %.1f mm; the body was up to %.1f mm through its chords; %zu "
+                  "poses still have some of it through",
+                  c.poses, res.transferred, double(c.vertices) / double(c.poses), 1000.0 * c.largestShift,
+                  1000.0 * c.deepest, c.posesLeftThrough);
+    log(line);
   }
   nlohmann::json source = {{"tool", "swish bake (part 1)"},
                            {"samples", res.samples},

@@ -36,6 +36,8 @@ PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, 
       if (b > a) edges_.emplace_back(a, b);
   edgeRest_.reserve(edges_.size());
   for (const auto& [a, b] : edges_) edgeRest_.push_back((p.row(a) - p.row(b)).norm());
+  if (settings.cover.enabled() && character.body.triangleCount() > 0)
+    cover_.emplace(character.garment.positions, character.garment.triangles, character.body.triangles, settings.cover);
   if (!edgeRest_.empty()) {
     std::vector<float> sorted = edgeRest_;
     std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
@@ -65,6 +67,11 @@ TransferredPose PoseTransfer::transfer(const Pose& pose, const Points3f& simPose
   TransferredPose out;
   out.gameMeshWorld = smoother_.smoothDisplacement(followed, skinned);
   out.maxSmoothingShift = (out.gameMeshWorld - followed).rowwise().norm().maxCoeff();
+  if (cover_) {
+    const Mesh& body = character_->body;
+    out.cover =
+        cover_->apply(out.gameMeshWorld, skinPositions(body.positions, body.skin, mats), simPosed, simTriangles_);
+  }
   out.gameMeshPreSkin = unskinPositions(out.gameMeshWorld, g.positions, g.skin, mats, unskin_);
   out.normalMap = baker_.bake(out.gameMeshWorld, simPosed, simTriangles_, simTopology_, &out.bakeStats);
   return out;

@@ -5,11 +5,13 @@
 // and the normal map of the detail the smoothed game mesh lacks (normal_map_baker.hpp). Built once per
 // character and simulation mesh; transfer() is const and may run for several poses at once.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "swish/bake/dataset/dataset.hpp"
+#include "swish/bake/transfer/body_cover.hpp"
 #include "swish/bake/transfer/laplacian_smoothing.hpp"
 #include "swish/bake/transfer/mesh_transfer.hpp"
 #include "swish/bake/transfer/normal_map_baker.hpp"
@@ -37,6 +39,10 @@ struct PoseTransferSettings {
   // before it was a setting). Measured on the default bake's 3929 poses (docs/baking.md): 0.4 keeps
   // all 15 poses that tore, and moves the others' shapes 0.15 mm on average.
   float reskinMinSingularValue = 0.4f;
+  // The game mesh kept `cover.margin` outside the body where the simulation's cloth covers it
+  // (body_cover.hpp): its coarse triangles are chords that cut under sharp shoulders. margin 0: off
+  // (models baked before it was a setting).
+  BodyCoverSettings cover;
 };
 
 // The game mesh's worst edge in a shape: its strain (length / max(rest length, half the median rest
@@ -52,6 +58,7 @@ struct TransferredPose {
   NormalMapImage normalMap;
   NormalMapBakeStats bakeStats;
   float maxSmoothingShift = 0.f;  // largest distance smoothing moved a vertex (metres)
+  BodyCoverStats cover;           // what keeping the game mesh over the body did (nothing when off)
 };
 
 class PoseTransfer {
@@ -76,6 +83,7 @@ class PoseTransfer {
   MeshFrameTopology simTopology_;
   MeshTransfer transfer_;
   LaplacianSmoother smoother_;
+  std::optional<BodyCover> cover_;  // when on and the character has a body
   NormalMapBaker baker_;
 };
 

@@ -1,0 +1,173 @@
+#include "swish/bake/transfer/body_cover.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "swish/bake/transfer/triangle_ray_scene.hpp"
+#include "swish/core/error.hpp"
+#include "swish/core/mesh.hpp"
+
+namespace swish::bake {
+
+namespace {
+
+// Barycentric share below which a closest point counts as on the triangle's edge.
+constexpr float kInside = 0.02f;
+// A body sample less than this (m) through the game mesh is left alone: rounding where the cloth lies on
+// the skin, and nothing a player sees.
+constexpr float kThrough = 0.0005f;
+// A moved vertex's neighbours move at least this share of its move, over this many rings.
+constexpr float kFalloff = 0.5f;
+constexpr int kFalloffRings = 3;
+// The cosine between the skin's normal and the game triangle's at which a sample counts half; its share goes
+// from 0 to 1 over kFacingBlend around it.
+constexpr float kFacing = 0.7f, kFacingBlend = 0.2f;
+
+Vec3f faceNormal(const Points3f& p, const Triangles& t, Eigen::Index k) {
+  const Vec3f a = p.row(t(k, 0)), b = p.row(t(k, 1)), c = p.row(t(k, 2));
+  const Vec3f n = (b - a).cross(c - a);
+  const float len = n.norm();
+  return len > 0.f ? Vec3f(n / len) : Vec3f::Zero();
+}
+
+}  // namespace
+
+BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, const Triangles& bodyTriangles,
+                     const BodyCoverSettings& settings)
+    : settings_(settings), gameVertices_(gameRest.rows()), bodyTriangles_(bodyTriangles) {
+  if (!(settings.margin >= 0.f && settings.margin <= 0.02f))
+    throw Error("body cover: the margin must be in [0, 20] mm");
+  if (!(settings.maxShift > 0.f && settings.maxShift <= 0.1f) || !(settings.reach > 0.f && settings.reach <= 0.2f) ||
+      settings.rounds < 1)
+    throw Error("body cover: the largest shift, the reach and the rounds must be positive");
+  if (gameTriangles.size() > 0 && Eigen::Index(gameTriangles.maxCoeff()) >= gameRest.rows())
+    throw Error("body cover: a game-mesh triangle names a vertex out of range");
+  weld_ = weldByPosition(gameRest);
+  welded_ = trianglesWeldedByPosition(gameRest, gameTriangles);
+  opening_.assign(size_t(gameRest.rows()), 0);
+  for (const auto& [a, b] : openEdges(welded_)) opening_[a] = opening_[b] = 1;
+  for (Eigen::Index v = 0; v < gameRest.rows(); ++v) opening_[size_t(v)] = opening_[weld_[size_t(v)]];
+  neighbours_ = buildVertexNeighbours(welded_, size_t(gameRest.rows()));
+}
+
+BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const Points3f& simulation,
+                                const Triangles& simulationTriangles) const {
+  BodyCoverStats stats;
+  if (!settings_.enabled()) return stats;
+  if (game.rows() != gameVertices_)
+    throw Error("body cover: the game mesh has " + std::to_string(game.rows()) + " vertices, at rest " +
+                std::to_string(gameVertices_));
+  if (bodyTriangles_.size() > 0 && Eigen::Index(bodyTriangles_.maxCoeff()) >= body.rows())
+    throw Error("body cover: the posed body has fewer vertices than its triangles name");
+  // The body's surface samples, with their outward normals: its vertices (area-weighted normals) and its
+  // triangles' centroids.
+  Points3f samples(body.rows() + bodyTriangles_.rows(), 3), sampleNormals = Points3f::Zero(samples.rows(), 3);
+  samples.topRows(body.rows()) = body;
+  for (Eigen::Index k = 0; k < bodyTriangles_.rows(); ++k) {
+    const Vec3f a = body.row(bodyTriangles_(k, 0)), b = body.row(bodyTriangles_(k, 1)),
+                c = body.row(bodyTriangles_(k, 2));
+    const Vec3f n = (b - a).cross(c - a);
+    samples.row(body.rows() + k) = ((a + b + c) / 3.f).transpose();
+    sampleNormals.row(body.rows() + k) = n.normalized().transpose();
+    for (int e = 0; e < 3; ++e) sampleNormals.row(bodyTriangles_(k, e)) += n.transpose();
+  }
+  for (Eigen::Index i = 0; i < body.rows(); ++i) sampleNormals.row(i).normalize();
+  const TriangleRayScene cloth(simulation, simulationTriangles, "body cover: simulated cloth");
+  // Which samples the simulation covers: the nearest simulated surface is outside them (or less than
+  // kThrough inside). Decided once: the simulation does not move.
+  std::vector<char> covered(size_t(samples.rows()), 0);  // by the simulation
+  for (Eigen::Index i = 0; i < samples.rows(); ++i) {
+    const Vec3f b = samples.row(i);
+    const SurfacePoint s = cloth.closestPoint(b, settings_.reach);
+    if (s.found)
+      covered[size_t(i)] = (b - s.point).dot(faceNormal(simulation, simulationTriangles, s.triangle)) <= kThrough;
+  }
+  // One pass over the covered samples against the game mesh as it is: how many are through it, and (when
+  // `ask` is given) how far each representative is asked to move out, and the deepest. A sample that the
+  // last round's moves did not take at least halfway out is given up (moving along the vertex normals does
+  // not reach it: a crease), so that no vertex is pushed round after round into a tear.
+  std::vector<float> lastDepth(size_t(samples.rows()), std::numeric_limits<float>::infinity());
+  std::vector<char> asking = covered;
+  auto pass = [&](std::vector<float>* ask, float* deepest) {
+    const TriangleRayScene mesh(game, welded_, "body cover: game mesh");
+    size_t through = 0;
+    for (Eigen::Index i = 0; i < samples.rows(); ++i) {
+      if (!covered[size_t(i)]) continue;
+      const Vec3f b = samples.row(i);
+      const SurfacePoint g = mesh.closestPoint(b, settings_.reach);
+      if (!g.found) continue;
+      const Eigen::Index t = g.triangle;
+      if (opening_[size_t(welded_(t, 0))] || opening_[size_t(welded_(t, 1))] || opening_[size_t(welded_(t, 2))])
+        continue;
+      // Over the triangle's inside only: at an edge or a corner the nearest triangle's side says little (a
+      // crease such as the armpit), and a chord's cut lies inside it.
+      if (!(g.u > kInside && g.v > kInside && 1.f - g.u - g.v > kInside)) continue;
+      const Vec3f n = faceNormal(game, welded_, t);
+      const float depth = (b - g.point).dot(n);
+      if (!(depth > kThrough)) continue;
+      // The skin faces the way the cloth over it does (a shoulder under the yoke), not across it (the trunk's
+      // side under a sleeve in the armpit's crease, where moving the sleeve out tears it).
+      const float facing = std::clamp((n.dot(sampleNormals.row(i)) - kFacing) / kFacingBlend + 0.5f, 0.f, 1.f);
+      if (!(facing > 0.f)) continue;
+      ++through;
+      if (!ask || !asking[size_t(i)]) continue;
+      if (!(depth < 0.5f * lastDepth[size_t(i)])) {
+        asking[size_t(i)] = 0;
+        continue;
+      }
+      lastDepth[size_t(i)] = depth;
+      if (deepest) *deepest = std::max(*deepest, depth);
+      // The ask grows from 0 at kThrough: continuous in the pose, so that a sample crossing the threshold
+      // does not add a bump to the stored shape at once (the model learns a smooth function of the pose).
+      const float over = depth - kThrough;
+      const float d = facing * (over + settings_.margin * std::min(1.f, over / kThrough));
+      const float w[3] = {1.f - g.u - g.v, g.u, g.v};
+      const float norm = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+      for (int e = 0; e < 3; ++e) {  // a vertex keeps its largest ask
+        float& a = (*ask)[size_t(welded_(t, e))];
+        a = std::max(a, w[e] * d / norm);
+      }
+    }
+    return through;
+  };
+  std::vector<float> shifted(size_t(game.rows()), 0.f), ask(size_t(game.rows()));
+  for (int round = 0; round < settings_.rounds; ++round) {
+    std::fill(ask.begin(), ask.end(), 0.f);
+    const size_t through = pass(&ask, round == 0 ? &stats.deepest : nullptr);
+    if (round == 0) stats.samplesThrough = through;
+    if (through == 0) break;
+    // A smooth bump, not a spike: each vertex moves at least half as far as its farthest-moving neighbour
+    // (three rings), so that no edge between a moved vertex and a still one tears.
+    for (int ring = 0; ring < kFalloffRings; ++ring) {
+      const std::vector<float> before = ask;
+      for (size_t v = 0; v < neighbours_.size(); ++v)
+        for (uint32_t u : neighbours_[v]) ask[v] = std::max(ask[v], kFalloff * before[u]);
+    }
+    // Out along the representatives' area-weighted normals.
+    Points3f normals = Points3f::Zero(game.rows(), 3);
+    for (Eigen::Index k = 0; k < welded_.rows(); ++k) {
+      const Vec3f a = game.row(welded_(k, 0)), b = game.row(welded_(k, 1)), c = game.row(welded_(k, 2));
+      const Vec3f n = (b - a).cross(c - a);
+      for (int e = 0; e < 3; ++e) normals.row(welded_(k, e)) += n.transpose();
+    }
+    for (Eigen::Index v = 0; v < game.rows(); ++v) {
+      const float len = normals.row(v).norm();
+      const float step = std::min(ask[size_t(v)], settings_.maxShift - shifted[size_t(v)]);
+      if (!(step > 0.f) || !(len > 0.f) || weld_[size_t(v)] != uint32_t(v)) continue;
+      game.row(v) += normals.row(v) * (step / len);
+      shifted[size_t(v)] += step;
+    }
+    for (Eigen::Index v = 0; v < game.rows(); ++v) game.row(v) = game.row(weld_[size_t(v)]);  // seam copies follow
+  }
+  stats.samplesLeft = stats.samplesThrough > 0 ? pass(nullptr, nullptr) : 0;
+  for (Eigen::Index v = 0; v < game.rows(); ++v)
+    if (shifted[size_t(weld_[size_t(v)])] > 0.f) {
+      ++stats.verticesMoved;
+      stats.largestShift = std::max(stats.largestShift, shifted[size_t(weld_[size_t(v)])]);
+    }
+  return stats;
+}
+
+}  // namespace swish::bake
