@@ -49,6 +49,16 @@ replay::TruthOptions cheaperTruth(uint32_t every) {
   return t;
 }
 
+// `swish replay --render` at thumbnail size with the validation layers on.
+replay::ReplayRenderOptions smallPictures(uint32_t frames) {
+  replay::ReplayRenderOptions ro;
+  ro.maxFrames = frames;
+  ro.width = 96;
+  ro.height = 128;
+  ro.validation = true;
+  return ro;
+}
+
 class ReplayTruth : public test::GpuTest {
  protected:
   void SetUp() override {
@@ -227,11 +237,7 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
 TEST_F(ReplayTruth, RenderMeasuresTheBodyThroughTheGarmentPerFrame) {
   const runtime::Scene s = scene(6, json::array({character("walker", true)}));
   replay::ModelLibrary models(s);
-  replay::ReplayRenderOptions ro;
-  ro.maxFrames = 2;
-  ro.width = 96;
-  ro.height = 128;
-  ro.validation = true;
+  const replay::ReplayRenderOptions ro = smallPictures(2);
   const fs::path dir = *tmp_ / "out/render";
   const replay::ReplayRenderResult r = replay::renderReplayFrames(s, models, dir, ro);
   ASSERT_EQ(r.frames.size(), 2u);
@@ -264,10 +270,7 @@ TEST_F(ReplayTruth, RenderMeasuresTheBodyThroughTheGarmentPerFrame) {
 TEST_F(ReplayTruth, RenderMeasuresTheTruthsBodyThroughBesideTheModels) {
   const runtime::Scene s = scene(3, json::array({character("walker", true)}));
   replay::ModelLibrary models(s);
-  replay::ReplayRenderOptions ro;
-  ro.maxFrames = 1;
-  ro.width = 96;
-  ro.height = 128;
+  replay::ReplayRenderOptions ro = smallPictures(1);
   ro.truth = cheaperTruth(2);
   ro.truth.normalMaps = false;
   const replay::ReplayRenderResult r = replay::renderReplayFrames(s, models, *tmp_ / "out/render_truth", ro);
