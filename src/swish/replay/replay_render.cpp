@@ -109,6 +109,7 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   }
   struct HeatJob {
     uint32_t frame;
+    size_t drawn;  // its index among the drawn frames
     Pose pose;
     Points3f model;
     Points3f body;  // as drawn (empty without a body), for the truth's body-through measure
@@ -162,7 +163,7 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
     }
     result.truthBodyThrough.emplace_back();
     if (truth) {
-      HeatJob job{f, pose, Points3f(), std::move(drawnBody), preview.viewProjection()};
+      HeatJob job{f, result.frames.size() - 1, pose, Points3f(), std::move(drawnBody), preview.viewProjection()};
       job.pose.rootTranslation = skeleton.restPose().rootTranslation;  // drawn in place, as the preview
       const api::DeformedMesh mesh = preview.lastJersey();
       job.model = Eigen::Map<const Points3f>(mesh.positions.data(), Eigen::Index(mesh.positions.size() / 3), 3);
@@ -190,11 +191,9 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
       fig.truth = &measured[k].truthPositions;
       fig.triangles = &entry.model.gameMesh.triangles;
       fig.scaleMm = 10.0;  // one scale for every frame, so that colours compare across the sheet
-      if (meter) {
-        const auto drawn = std::find(result.frameNumbers.begin(), result.frameNumbers.end(), heatJobs[k].frame);
-        result.truthBodyThrough[size_t(drawn - result.frameNumbers.begin())] =
+      if (meter)
+        result.truthBodyThrough[heatJobs[k].drawn] =
             meter->measure(heatJobs[k].body, measured[k].truthPositions, heatJobs[k].viewProjection, o.width, o.height);
-      }
       const io::PngImage png = io::heatMapFigure(fig);
       char name[32];
       std::snprintf(name, sizeof name, "heat_%04u.png", heatJobs[k].frame);

@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "swish/bake/transfer/mesh_transfer.hpp"
 #include "swish/bake/transfer/triangle_ray_scene.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/mesh.hpp"
@@ -34,9 +35,9 @@ Vec3f faceNormal(const Points3f& p, const Triangles& t, Eigen::Index k) {
 
 }  // namespace
 
-BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, const Triangles& bodyTriangles,
-                     const BodyCoverSettings& settings)
-    : settings_(settings), gameVertices_(gameRest.rows()), bodyTriangles_(bodyTriangles) {
+BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, const Points3f& bodyRest,
+                     const Triangles& bodyTriangles, const BodyCoverSettings& settings)
+    : settings_(settings), bodyTriangles_(bodyTriangles) {
   if (!(settings.margin >= 0.f && settings.margin <= 0.02f))
     throw Error("body cover: the margin must be in [0, 20] mm");
   if (!(settings.maxShift > 0.f && settings.maxShift <= 0.1f) || !(settings.reach > 0.f && settings.reach <= 0.2f) ||
@@ -49,31 +50,33 @@ BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, c
   opening_.assign(size_t(gameRest.rows()), 0);
   for (const auto& [a, b] : openEdges(welded_)) opening_[a] = opening_[b] = 1;
   for (Eigen::Index v = 0; v < gameRest.rows(); ++v) opening_[size_t(v)] = opening_[weld_[size_t(v)]];
+  if (bodyTriangles.size() > 0 && Eigen::Index(bodyTriangles.maxCoeff()) >= bodyRest.rows())
+    throw Error("body cover: a body triangle names a vertex out of range");
   neighbours_ = buildVertexNeighbours(welded_, size_t(gameRest.rows()));
+  gameTopology_ = buildFrameTopology(gameTriangles, gameRest);
+  bodyTopology_ = buildFrameTopology(bodyTriangles, bodyRest);
 }
 
 BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const Points3f& simulation,
                                 const Triangles& simulationTriangles) const {
   BodyCoverStats stats;
   if (!settings_.enabled()) return stats;
-  if (game.rows() != gameVertices_)
+  if (size_t(game.rows()) != weld_.size())
     throw Error("body cover: the game mesh has " + std::to_string(game.rows()) + " vertices, at rest " +
-                std::to_string(gameVertices_));
-  if (bodyTriangles_.size() > 0 && Eigen::Index(bodyTriangles_.maxCoeff()) >= body.rows())
-    throw Error("body cover: the posed body has fewer vertices than its triangles name");
+                std::to_string(weld_.size()));
+  if (size_t(body.rows()) != bodyTopology_.normalAdjacency.offsets.size() - 1)
+    throw Error("body cover: the posed body has " + std::to_string(body.rows()) + " vertices, at rest " +
+                std::to_string(bodyTopology_.normalAdjacency.offsets.size() - 1));
   // The body's surface samples, with their outward normals: its vertices (area-weighted normals) and its
   // triangles' centroids.
-  Points3f samples(body.rows() + bodyTriangles_.rows(), 3), sampleNormals = Points3f::Zero(samples.rows(), 3);
+  Points3f samples(body.rows() + bodyTriangles_.rows(), 3), sampleNormals(samples.rows(), 3);
   samples.topRows(body.rows()) = body;
+  sampleNormals.topRows(body.rows()) = surfaceVertexNormals(body, bodyTriangles_, bodyTopology_);
   for (Eigen::Index k = 0; k < bodyTriangles_.rows(); ++k) {
-    const Vec3f a = body.row(bodyTriangles_(k, 0)), b = body.row(bodyTriangles_(k, 1)),
-                c = body.row(bodyTriangles_(k, 2));
-    const Vec3f n = (b - a).cross(c - a);
-    samples.row(body.rows() + k) = ((a + b + c) / 3.f).transpose();
-    sampleNormals.row(body.rows() + k) = n.normalized().transpose();
-    for (int e = 0; e < 3; ++e) sampleNormals.row(bodyTriangles_(k, e)) += n.transpose();
+    samples.row(body.rows() + k) =
+        (body.row(bodyTriangles_(k, 0)) + body.row(bodyTriangles_(k, 1)) + body.row(bodyTriangles_(k, 2))) / 3.f;
+    sampleNormals.row(body.rows() + k) = faceNormal(body, bodyTriangles_, k).transpose();
   }
-  for (Eigen::Index i = 0; i < body.rows(); ++i) sampleNormals.row(i).normalize();
   const TriangleRayScene cloth(simulation, simulationTriangles, "body cover: simulated cloth");
   // Which samples the simulation covers: the nearest simulated surface is outside them (or less than
   // kThrough inside). Decided once: the simulation does not move.
@@ -112,13 +115,13 @@ BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const Poin
       const float facing = std::clamp((n.dot(sampleNormals.row(i)) - kFacing) / kFacingBlend + 0.5f, 0.f, 1.f);
       if (!(facing > 0.f)) continue;
       ++through;
+      if (deepest) *deepest = std::max(*deepest, depth);
       if (!ask || !asking[size_t(i)]) continue;
       if (!(depth < 0.5f * lastDepth[size_t(i)])) {
         asking[size_t(i)] = 0;
         continue;
       }
       lastDepth[size_t(i)] = depth;
-      if (deepest) *deepest = std::max(*deepest, depth);
       // The ask grows from 0 at kThrough: continuous in the pose, so that a sample crossing the threshold
       // does not add a bump to the stored shape at once (the model learns a smooth function of the pose).
       const float over = depth - kThrough;
@@ -145,18 +148,12 @@ BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const Poin
       for (size_t v = 0; v < neighbours_.size(); ++v)
         for (uint32_t u : neighbours_[v]) ask[v] = std::max(ask[v], kFalloff * before[u]);
     }
-    // Out along the representatives' area-weighted normals.
-    Points3f normals = Points3f::Zero(game.rows(), 3);
-    for (Eigen::Index k = 0; k < welded_.rows(); ++k) {
-      const Vec3f a = game.row(welded_(k, 0)), b = game.row(welded_(k, 1)), c = game.row(welded_(k, 2));
-      const Vec3f n = (b - a).cross(c - a);
-      for (int e = 0; e < 3; ++e) normals.row(welded_(k, e)) += n.transpose();
-    }
+    // Out along the area-weighted vertex normals (seam copies share theirs).
+    const Points3f normals = surfaceVertexNormals(game, welded_, gameTopology_);
     for (Eigen::Index v = 0; v < game.rows(); ++v) {
-      const float len = normals.row(v).norm();
       const float step = std::min(ask[size_t(v)], settings_.maxShift - shifted[size_t(v)]);
-      if (!(step > 0.f) || !(len > 0.f) || weld_[size_t(v)] != uint32_t(v)) continue;
-      game.row(v) += normals.row(v) * (step / len);
+      if (!(step > 0.f) || weld_[size_t(v)] != uint32_t(v)) continue;
+      game.row(v) += normals.row(v) * step;
       shifted[size_t(v)] += step;
     }
     for (Eigen::Index v = 0; v < game.rows(); ++v) game.row(v) = game.row(weld_[size_t(v)]);  // seam copies follow

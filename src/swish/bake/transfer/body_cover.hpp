@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "swish/core/mesh_frames.hpp"
 #include "swish/core/types.hpp"
 
 namespace swish::bake {
@@ -48,10 +49,10 @@ struct BodyCoverStats {
 // on its openings (edges of one triangle once welded).
 class BodyCover {
  public:
-  // `gameRest`/`gameTriangles`: the game mesh at rest, triangles winding outwards; `bodyTriangles`: the
-  // body's. Throws Error for indices out of range or a bad setting.
-  BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, const Triangles& bodyTriangles,
-            const BodyCoverSettings& settings);
+  // `gameRest`/`gameTriangles`: the game mesh at rest, triangles winding outwards; `bodyRest`/`bodyTriangles`:
+  // the body's. Throws Error for indices out of range or a bad setting.
+  BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, const Points3f& bodyRest,
+            const Triangles& bodyTriangles, const BodyCoverSettings& settings);
 
   // Moves `game` (the posed game mesh) in place; `body`: the body posed as simulated; `simulation` with
   // `simulationTriangles`: the simulated cloth the game mesh was transferred from. Deterministic. Throws
@@ -59,16 +60,13 @@ class BodyCover {
   BodyCoverStats apply(Points3f& game, const Points3f& body, const Points3f& simulation,
                        const Triangles& simulationTriangles) const;
 
-  const BodyCoverSettings& settings() const { return settings_; }
-  const std::vector<char>& opening() const { return opening_; }  // per game vertex
-
  private:
   BodyCoverSettings settings_;
-  Eigen::Index gameVertices_ = 0;
   std::vector<uint32_t> weld_;  // game vertex -> its welded representative (the first at its rest position)
   Triangles welded_;            // game triangles on the representatives
-  std::vector<char> opening_;
+  std::vector<char> opening_;   // per game vertex
   std::vector<std::vector<uint32_t>> neighbours_;  // of each representative, over the welded triangles
+  MeshFrameTopology gameTopology_, bodyTopology_;  // for their area-weighted vertex normals, seams welded
   Triangles bodyTriangles_;
 };
 

@@ -37,7 +37,8 @@ PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, 
   edgeRest_.reserve(edges_.size());
   for (const auto& [a, b] : edges_) edgeRest_.push_back((p.row(a) - p.row(b)).norm());
   if (settings.cover.enabled() && character.body.triangleCount() > 0)
-    cover_.emplace(character.garment.positions, character.garment.triangles, character.body.triangles, settings.cover);
+    cover_.emplace(character.garment.positions, character.garment.triangles, character.body.positions,
+                   character.body.triangles, settings.cover);
   if (!edgeRest_.empty()) {
     std::vector<float> sorted = edgeRest_;
     std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());

@@ -59,7 +59,7 @@ TEST(BodyCover, ACoarseGameMeshIsMovedOverTheBodyTheSimulationCovered) {
   EXPECT_NEAR(deepBefore, 0.0094f - 0.003f, 0.0015f);  // the chord's depth less the cloth's gap
 
   BodyCoverSettings settings;  // 2 mm margin
-  const BodyCover cover(s.game.positions, s.game.triangles, s.body.triangles, settings);
+  const BodyCover cover(s.game.positions, s.game.triangles, s.body.positions, s.body.triangles, settings);
   Points3f game = s.game.positions;
   const BodyCoverStats stats = cover.apply(game, s.body.positions, s.cloth.positions, s.cloth.triangles);
   EXPECT_GT(stats.samplesThrough, 100u);
@@ -91,7 +91,8 @@ TEST(BodyCover, ACoarseGameMeshIsMovedOverTheBodyTheSimulationCovered) {
 TEST(BodyCover, NothingMovesWhereTheSimulationLeftTheBodyThroughOrWhenOff) {
   // The simulated cloth itself 5 mm inside the body: the transfer is not what put the body through.
   const Scene sunk = coarseTubeOnRoundBody(-0.005f);
-  const BodyCover cover(sunk.game.positions, sunk.game.triangles, sunk.body.triangles, BodyCoverSettings{});
+  const BodyCover cover(sunk.game.positions, sunk.game.triangles, sunk.body.positions, sunk.body.triangles,
+                        BodyCoverSettings{});
   Points3f game = sunk.game.positions;
   const BodyCoverStats stats = cover.apply(game, sunk.body.positions, sunk.cloth.positions, sunk.cloth.triangles);
   EXPECT_EQ(stats.verticesMoved, 0u);
@@ -101,7 +102,7 @@ TEST(BodyCover, NothingMovesWhereTheSimulationLeftTheBodyThroughOrWhenOff) {
   BodyCoverSettings off;
   off.margin = 0.f;
   EXPECT_FALSE(off.enabled());
-  const BodyCover none(s.game.positions, s.game.triangles, s.body.triangles, off);
+  const BodyCover none(s.game.positions, s.game.triangles, s.body.positions, s.body.triangles, off);
   game = s.game.positions;
   EXPECT_EQ(none.apply(game, s.body.positions, s.cloth.positions, s.cloth.triangles).verticesMoved, 0u);
   EXPECT_EQ(game, s.game.positions);
@@ -112,10 +113,10 @@ TEST(BodyCover, BadInputIsAClearError) {
   BodyCoverSettings bad;
   bad.margin = 0.5f;
   EXPECT_NE(test::errorOf([&] {
-              BodyCover(s.game.positions, s.game.triangles, s.body.triangles, bad);
+              BodyCover(s.game.positions, s.game.triangles, s.body.positions, s.body.triangles, bad);
             }).find("margin must be in"),
             std::string::npos);
-  const BodyCover cover(s.game.positions, s.game.triangles, s.body.triangles, BodyCoverSettings{});
+  const BodyCover cover(s.game.positions, s.game.triangles, s.body.positions, s.body.triangles, BodyCoverSettings{});
   Points3f fewer = s.game.positions.topRows(10);
   EXPECT_NE(test::errorOf([&] {
               cover.apply(fewer, s.body.positions, s.cloth.positions, s.cloth.triangles);
