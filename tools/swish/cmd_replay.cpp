@@ -48,6 +48,7 @@ struct ReplayCliOptions {
   bool pushOut = false, noPushOut = false, noGuard = false, hideCoveredBody = false, showCoveredBody = false;
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
+  std::optional<float> truthCoverMm;
   std::optional<double> frameBudgetMs, tolerancePixels;
   std::string level;
 };
@@ -150,6 +151,7 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.truth.every = o.truthEvery;
   jo.engine.truth.simulationVertices = o.truthVertices;
   jo.engine.truth.substeps = o.truthSubsteps;
+  jo.engine.truth.coverBodyMm = o.truthCoverMm;
   jo.engine.penetrationEvery = o.penetrationEvery;
   jo.engine.pushOut = scene.body.pushOut;
   jo.engine.noveltyGuard = !o.noGuard;
@@ -270,6 +272,11 @@ swish::cli::CommandRegistration reg{
                      "further from the bake's truth; the report says so)");
       app.add_option("--truth-substeps", o->truthSubsteps, "truth simulation substeps instead of the bake's")
           ->check(CLI::Range(1, 1000));
+      app.add_option("--truth-cover-mm", o->truthCoverMm,
+                     "the truth's game mesh kept this far over the body where the simulation covered it, instead of "
+                     "the bake's part1.transfer.cover_body_mm (0: off; with --render the report counts the truth's "
+                     "body-through pixels: what the cover does to the pictures before any re-bake)")
+          ->check(CLI::Range(0.0, 20.0));
       app.add_option(
           "--penetration-every", o->penetrationEvery,
           "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "

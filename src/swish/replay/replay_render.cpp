@@ -121,6 +121,23 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   const uint32_t shown = std::max<uint32_t>(1, std::min(o.maxFrames, frames));
   std::vector<PoseIssue> issues;
   std::vector<render::PreviewImage> images, marked;  // marked: the frames with body through, marked
+  std::vector<render::PreviewImage> truthMarked;     // the same frames with the truth's body-through pixels marked
+  // A drawn frame again with the pixels that count painted magenta (where to look), written as PREFIX_NNNN.png;
+  // the picture is kept in lastMarked for the sheet.
+  render::PreviewImage lastMarked;
+  auto writeMarked = [&](const render::PreviewImage& drawn, const std::vector<int32_t>& where, const char* prefix,
+                         uint32_t frame) {
+    lastMarked = drawn;
+    for (size_t p = 0; p < where.size(); ++p)
+      if (where[p] >= 0) {
+        uint8_t* px = &lastMarked.rgba[p * 4];
+        px[0] = 255, px[1] = 0, px[2] = 255, px[3] = 255;
+      }
+    char name[48];
+    std::snprintf(name, sizeof name, "%s_%04u.png", prefix, frame);
+    render::writePreviewPng((dir / name).string(), lastMarked, preview.options().background);
+    return dir / name;
+  };
   std::vector<api::Quat> rotations(skeleton.size());
   for (uint32_t i = 0; i < shown; ++i) {
     uint32_t index = uint32_t(uint64_t(i) * frames / shown);
@@ -148,17 +165,8 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
           drawnBody, Eigen::Map<const Points3f>(jersey.positions.data(), Eigen::Index(jersey.positions.size() / 3), 3),
           preview.viewProjection(), o.width, o.height, &where));
       if (result.bodyThrough.back().pixels > 0) {
-        // The frame again with the pixels that count painted magenta: where to look.
-        render::PreviewImage image = images.back();
-        for (size_t p = 0; p < where.size(); ++p)
-          if (where[p] >= 0) {
-            uint8_t* px = &image.rgba[p * 4];
-            px[0] = 255, px[1] = 0, px[2] = 255, px[3] = 255;
-          }
-        std::snprintf(name, sizeof name, "through_%04u.png", f);
-        render::writePreviewPng((dir / name).string(), image, preview.options().background);
-        result.throughFrames.push_back(dir / name);
-        marked.push_back(std::move(image));
+        result.throughFrames.push_back(writeMarked(images.back(), where, "through", f));
+        marked.push_back(std::move(lastMarked));
       }
     }
     result.truthBodyThrough.emplace_back();
@@ -191,9 +199,17 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
       fig.truth = &measured[k].truthPositions;
       fig.triangles = &entry.model.gameMesh.triangles;
       fig.scaleMm = 10.0;  // one scale for every frame, so that colours compare across the sheet
-      if (meter)
-        result.truthBodyThrough[heatJobs[k].drawn] =
-            meter->measure(heatJobs[k].body, measured[k].truthPositions, heatJobs[k].viewProjection, o.width, o.height);
+      if (meter) {
+        std::vector<int32_t> where;
+        const BodyThroughGarment through = meter->measure(heatJobs[k].body, measured[k].truthPositions,
+                                                          heatJobs[k].viewProjection, o.width, o.height, &where);
+        result.truthBodyThrough[heatJobs[k].drawn] = through;
+        if (through.pixels > 0) {  // marked on the model's frame: where the truth's garment lets the body through
+          result.truthThroughFrames.push_back(
+              writeMarked(images[heatJobs[k].drawn], where, "truth_through", heatJobs[k].frame));
+          truthMarked.push_back(std::move(lastMarked));
+        }
+      }
       const io::PngImage png = io::heatMapFigure(fig);
       char name[32];
       std::snprintf(name, sizeof name, "heat_%04u.png", heatJobs[k].frame);
@@ -221,6 +237,10 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   if (!marked.empty()) {
     result.throughSheet = dir / "through_sheet.png";
     render::writeContactSheet(marked, result.throughSheet);
+  }
+  if (!truthMarked.empty()) {
+    result.truthThroughSheet = dir / "truth_through_sheet.png";
+    render::writeContactSheet(truthMarked, result.truthThroughSheet);
   }
   return result;
 }
@@ -294,6 +314,11 @@ std::string renderReportSection(const ReplayRenderResult& r, const ReplayRenderO
     s += "\nThe frames that show the body through the garment, the pixels counted painted magenta:\n\n![body through "
          "the garment](" +
          rel(r.throughSheet) + ")\n";
+  if (!r.truthThroughSheet.empty())
+    s += "\nThe truth's body-through pixels in the same frames, painted magenta over the model's picture (where the "
+         "source simulation's garment, as the run time skins it, lets the body through):\n\n![the truth's body "
+         "through the garment](" +
+         rel(r.truthThroughSheet) + ")\n";
   if (!r.heatSheet.empty())
     s += "\nModel | truth | per-vertex error (mm, one scale for all frames):\n\n![error heat maps](" +
          rel(r.heatSheet) + ")\n";

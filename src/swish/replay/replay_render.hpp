@@ -47,7 +47,11 @@ struct ReplayRenderResult {
   // the model or its source simulation puts the body through the cloth.
   std::vector<std::optional<BodyThroughGarment>> truthBodyThrough;
   std::filesystem::path contactSheet;
-  std::filesystem::path throughSheet;           // the through_NNNN.png frames on one sheet; empty when none
+  std::filesystem::path throughSheet;  // the through_NNNN.png frames on one sheet; empty when none
+  // With truth: per frame whose truth shows any, truth_through_NNNN.png (the truth's counted pixels painted on
+  // the model's frame), and those on one sheet.
+  std::vector<std::filesystem::path> truthThroughFrames;
+  std::filesystem::path truthThroughSheet;
   std::vector<std::filesystem::path> heatMaps;  // per frame with truth
   std::filesystem::path heatSheet;              // empty without truth
   std::string note;                             // e.g. why no body was drawn, or why there are no heat maps

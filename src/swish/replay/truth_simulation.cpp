@@ -155,6 +155,10 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     ps.simulation.substeps = *options.substeps;
     overridden += " substeps";
   }
+  if (options.coverBodyMm) {
+    ps.transfer.cover.margin = 0.001f * *options.coverBodyMm;
+    overridden += " cover_body_mm " + fmtNum("%g", *options.coverBodyMm);
+  }
   try {
     simulator_ = std::make_unique<bake::PoseShapeSimulator>(*character_, ps);
   } catch (const Error& e) {

@@ -34,7 +34,10 @@ struct TruthOptions {
   uint32_t every = 0;                        // 0: none; N: frames whose index in the scene is a multiple of N
   std::optional<size_t> simulationVertices;  // instead of the bake's (tests and quick looks: coarser, faster)
   std::optional<int> substeps;               // instead of the bake's
-  bool normalMaps = true;                    // also bake the truth normal map and measure the run time's
+  // part1.transfer.cover_body_mm instead of the bake's (0: off): what keeping the game mesh over the body does
+  // to the truth, measured on a model baked without it (or the reverse).
+  std::optional<float> coverBodyMm;
+  bool normalMaps = true;  // also bake the truth normal map and measure the run time's
 };
 
 // One character on one truth frame.

@@ -284,6 +284,17 @@ TEST_F(ReplayTruth, RenderMeasuresTheTruthsBodyThroughBesideTheModels) {
   EXPECT_NE(md.find("| frame | pixels | share of the garment's | truth pixels |"), std::string::npos) << md;
   EXPECT_NE(md.find("The truth (the source simulation's garment"), std::string::npos) << md;
   EXPECT_NE(md.find(" " + std::to_string(r.truthBodyThrough[0]->pixels) + " |\n"), std::string::npos) << md;
+  // Where the truth shows the body, its pixels are painted on a copy of the frame, and the report shows the sheet.
+  const bool truthShows = r.truthBodyThrough[0]->pixels > 0;
+  ASSERT_EQ(r.truthThroughFrames.size(), truthShows ? 1u : 0u);
+  EXPECT_EQ(r.truthThroughSheet.empty(), !truthShows);
+  if (truthShows) {
+    char name[48];
+    std::snprintf(name, sizeof name, "truth_through_%04u.png", r.frameNumbers[0]);
+    EXPECT_EQ(r.truthThroughFrames[0].filename(), name);
+    EXPECT_TRUE(fs::exists(r.truthThroughFrames[0]));
+    EXPECT_NE(md.find("truth_through_sheet.png"), std::string::npos) << md;
+  }
 }
 
 TEST_F(ReplayTruth, SameFiguresTwiceAndFarFromTheOrigin) {
