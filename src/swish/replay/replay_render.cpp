@@ -122,21 +122,21 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   std::vector<PoseIssue> issues;
   std::vector<render::PreviewImage> images, marked;  // marked: the frames with body through, marked
   std::vector<render::PreviewImage> truthMarked;     // the same frames with the truth's body-through pixels marked
-  // A drawn frame again with the pixels that count painted magenta (where to look), written as PREFIX_NNNN.png;
-  // the picture is kept in lastMarked for the sheet.
-  render::PreviewImage lastMarked;
+  // A drawn frame again with the pixels that count painted magenta (where to look), written as PREFIX_NNNN.png
+  // (its path appended to `paths`); returned for the sheet.
   auto writeMarked = [&](const render::PreviewImage& drawn, const std::vector<int32_t>& where, const char* prefix,
-                         uint32_t frame) {
-    lastMarked = drawn;
+                         uint32_t frame, std::vector<fs::path>& paths) {
+    render::PreviewImage image = drawn;
     for (size_t p = 0; p < where.size(); ++p)
       if (where[p] >= 0) {
-        uint8_t* px = &lastMarked.rgba[p * 4];
+        uint8_t* px = &image.rgba[p * 4];
         px[0] = 255, px[1] = 0, px[2] = 255, px[3] = 255;
       }
     char name[48];
     std::snprintf(name, sizeof name, "%s_%04u.png", prefix, frame);
-    render::writePreviewPng((dir / name).string(), lastMarked, preview.options().background);
-    return dir / name;
+    render::writePreviewPng((dir / name).string(), image, preview.options().background);
+    paths.push_back(dir / name);
+    return image;
   };
   std::vector<api::Quat> rotations(skeleton.size());
   for (uint32_t i = 0; i < shown; ++i) {
@@ -165,8 +165,7 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
           drawnBody, Eigen::Map<const Points3f>(jersey.positions.data(), Eigen::Index(jersey.positions.size() / 3), 3),
           preview.viewProjection(), o.width, o.height, &where));
       if (result.bodyThrough.back().pixels > 0) {
-        result.throughFrames.push_back(writeMarked(images.back(), where, "through", f));
-        marked.push_back(std::move(lastMarked));
+        marked.push_back(writeMarked(images.back(), where, "through", f, result.throughFrames));
       }
     }
     result.truthBodyThrough.emplace_back();
@@ -205,9 +204,8 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
                                                           heatJobs[k].viewProjection, o.width, o.height, &where);
         result.truthBodyThrough[heatJobs[k].drawn] = through;
         if (through.pixels > 0) {  // marked on the model's frame: where the truth's garment lets the body through
-          result.truthThroughFrames.push_back(
-              writeMarked(images[heatJobs[k].drawn], where, "truth_through", heatJobs[k].frame));
-          truthMarked.push_back(std::move(lastMarked));
+          truthMarked.push_back(writeMarked(images[heatJobs[k].drawn], where, "truth_through", heatJobs[k].frame,
+                                            result.truthThroughFrames));
         }
       }
       const io::PngImage png = io::heatMapFigure(fig);
