@@ -49,6 +49,7 @@ struct ReplayCliOptions {
   std::optional<size_t> truthVertices;
   std::optional<int> truthSubsteps;
   std::optional<float> truthCoverMm;
+  std::optional<float> truthLimbClearanceMm;
   std::optional<double> frameBudgetMs, tolerancePixels;
   std::string level;
 };
@@ -152,6 +153,7 @@ int runReplay(const ReplayCliOptions& o) {
   jo.engine.truth.simulationVertices = o.truthVertices;
   jo.engine.truth.substeps = o.truthSubsteps;
   jo.engine.truth.coverBodyMm = o.truthCoverMm;
+  jo.engine.truth.limbClearanceMm = o.truthLimbClearanceMm;
   jo.engine.penetrationEvery = o.penetrationEvery;
   jo.engine.pushOut = scene.body.pushOut;
   jo.engine.noveltyGuard = !o.noGuard;
@@ -277,6 +279,10 @@ swish::cli::CommandRegistration reg{
                      "the bake's part1.transfer.cover_body_mm (0: off; with --render the report counts the truth's "
                      "body-through pixels: what the cover does to the pictures before any re-bake)")
           ->check(CLI::Range(0.0, 20.0));
+      app.add_option("--truth-limb-clearance-mm", o->truthLimbClearanceMm,
+                     "the truth simulated with limbs turned this far out of the trunk instead of the bake's "
+                     "part1.simulation.limb_clearance, in mm (0: each pose simulated as recorded)")
+          ->check(CLI::Range(0.0, 100.0));
       app.add_option(
           "--penetration-every", o->penetrationEvery,
           "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "

@@ -159,6 +159,10 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     ps.transfer.cover.margin = 0.001f * *options.coverBodyMm;
     overridden += " cover_body_mm " + fmtNum("%g", *options.coverBodyMm);
   }
+  if (options.limbClearanceMm) {
+    ps.limbClearance.clearance = 0.001f * *options.limbClearanceMm;
+    overridden += " limb clearance " + fmtNum("%g", *options.limbClearanceMm) + " mm";
+  }
   try {
     simulator_ = std::make_unique<bake::PoseShapeSimulator>(*character_, ps);
   } catch (const Error& e) {

@@ -37,6 +37,9 @@ struct TruthOptions {
   // part1.transfer.cover_body_mm instead of the bake's (0: off): what keeping the game mesh over the body does
   // to the truth, measured on a model baked without it (or the reverse).
   std::optional<float> coverBodyMm;
+  // part1.simulation.limb_clearance (mm here) instead of the bake's (0: poses simulated as recorded): what turning
+  // limbs out of the trunk before simulating does to the truth.
+  std::optional<float> limbClearanceMm;
   bool normalMaps = true;  // also bake the truth normal map and measure the run time's
 };
 

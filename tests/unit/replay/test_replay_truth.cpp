@@ -297,6 +297,27 @@ TEST_F(ReplayTruth, RenderMeasuresTheTruthsBodyThroughBesideTheModels) {
   }
 }
 
+// `--truth-cover-mm` and `--truth-limb-clearance-mm`: the truth is set up with them instead of the bake's, and
+// its note says that it is overridden and how.
+TEST_F(ReplayTruth, CoverAndLimbClearanceOverridesReachTheTruthAndAreSaid) {
+  const runtime::Scene s = scene(1, json::array({character("walker", true)}));
+  replay::ModelLibrary models(s);
+  ASSERT_FALSE(models.entries().empty());
+  replay::TruthOptions o = cheaperTruth(1);
+  {
+    const replay::ModelTruth t(*models.entries()[0], o);
+    ASSERT_TRUE(t.available()) << t.note();
+    EXPECT_EQ(t.note().find("cover_body_mm"), std::string::npos) << t.note();
+  }
+  o.coverBodyMm = 2.5f;
+  o.limbClearanceMm = 0.f;
+  const replay::ModelTruth t(*models.entries()[0], o);
+  ASSERT_TRUE(t.available()) << t.note();
+  EXPECT_NE(t.note().find("overridden for this run (not the bake's): substeps cover_body_mm 2.5 limb clearance 0 mm"),
+            std::string::npos)
+      << t.note();
+}
+
 TEST_F(ReplayTruth, SameFiguresTwiceAndFarFromTheOrigin) {
   auto figures = [&](std::array<double, 3> at) {
     const replay::ReplayResult r = run(scene(3, json::array({character("walker", true, at)})), cheaperTruth(2));
