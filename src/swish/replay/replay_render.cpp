@@ -121,7 +121,7 @@ ReplayRenderResult renderInto(const runtime::Scene& scene, ModelLibrary& models,
   const uint32_t shown = std::max<uint32_t>(1, std::min(o.maxFrames, frames));
   std::vector<PoseIssue> issues;
   std::vector<render::PreviewImage> images, marked;  // marked: the frames with body through, marked
-  std::vector<render::PreviewImage> truthMarked;     // the same frames with the truth's body-through pixels marked
+  std::vector<render::PreviewImage> truthMarked;     // the truth frames whose truth shows any, its pixels marked
   // A drawn frame again with the pixels that count painted magenta (where to look), written as PREFIX_NNNN.png
   // (its path appended to `paths`); returned for the sheet.
   auto writeMarked = [&](const render::PreviewImage& drawn, const std::vector<int32_t>& where, const char* prefix,
