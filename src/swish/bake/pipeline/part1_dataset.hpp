@@ -176,11 +176,16 @@ struct DatasetBuildResult {
   float unskinSmallestSingularValue = 1.f;
   // part1.transfer.cover_body_mm (transfer/body_cover.hpp), over the poses transferred in this run: those
   // whose game mesh it moved, the vertices moved (all such poses), the largest move, the deepest body sample
-  // through the game mesh before, and the poses where some sample stayed through it.
+  // through the game mesh before, and the poses where some sample stayed through it. bodyCover: in the
+  // simulated pose; bodyCoverRecorded: again in the recorded pose, for poses that limb clearance changed
+  // (pose_shape.hpp step 4: the skin the cloth covered round the turned-out arm stays covered).
   struct BodyCoverSummary {
     size_t poses = 0, vertices = 0, posesLeftThrough = 0;
     float largestShift = 0.f, deepest = 0.f;
-  } bodyCover;
+    void add(const BodyCoverStats& s);
+    nlohmann::json toJson() const;
+  };
+  BodyCoverSummary bodyCover, bodyCoverRecorded;
   std::vector<FailedPose> failed;  // left out of the dataset, with the reason
   // The simulation's report (cloth/simulation_quality.hpp): failures per reason, retried poses, seconds
   // per pose per core, equilibrium residuals, and "quality" (convergence, noise) when measured.

@@ -108,6 +108,30 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
       const Points3f drawn = skinPositions(tp.gameMeshPreSkin, skin, recordedMatrices);
       for (Eigen::Index v : carried) tp.gameMeshWorld.row(v) = drawn.row(v);
     }
+    // The cover again, in the recorded pose (body_cover.hpp). The sleeve was simulated round an arm that
+    // limb clearance turned out of the trunk; skinned back with the recorded arm, the arm's skin (on its
+    // own weights) passes through the sleeve's inner side by the armpit, which the cover of step 3, in the
+    // simulated pose, cannot see (measured: docs/baking.md, "The cover on the truth"). The skin the
+    // simulation covered in its pose is kept covered in the recorded one: the same body samples, posed as
+    // recorded. Stored is again what the run time draws.
+    if (const BodyCover* cover = transfer_.cover()) {
+      const Mesh& body = character_->body;
+      const std::vector<char> covered =
+          cover->coveredSamples(skinPositions(body.positions, body.skin, simulatedMatrices), simulationPositions,
+                                transfer_.simulationTriangles());
+      Points3f world = tp.gameMeshWorld;
+      tp.coverRecorded = cover->apply(world, skinPositions(body.positions, body.skin, recordedMatrices), covered);
+      if (tp.coverRecorded.verticesMoved > 0) {
+        std::vector<Eigen::Index> shifted;
+        for (Eigen::Index v = 0; v < world.rows(); ++v)
+          if (world.row(v) != tp.gameMeshWorld.row(v)) shifted.push_back(v);
+        const Points3f preSkin =
+            unskinPositions(world, garment.positions, skin, recordedMatrices, settings_.transfer.unskin);
+        for (Eigen::Index v : shifted) tp.gameMeshPreSkin.row(v) = preSkin.row(v);
+        const Points3f drawn = skinPositions(tp.gameMeshPreSkin, skin, recordedMatrices);
+        for (Eigen::Index v : shifted) tp.gameMeshWorld.row(v) = drawn.row(v);
+      }
+    }
   }
   const EdgeStretch worst = transfer_.worstEdge(tp.gameMeshWorld);
   if (!(worst.strain <= settings_.transfer.maxEdgeStrain)) {

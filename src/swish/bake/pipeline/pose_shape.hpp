@@ -10,7 +10,8 @@
 //      (Laplacian), un-skins it to pre-skinning space and bakes the normal map;
 //   4. when the simulated pose differs from the recorded one (step 1 changed it), the world shape is
 //      the pre-skin shape skinned with the RECORDED pose, as the run time will skin it, at the vertices
-//      whose skinning the change moved (the others keep the simulated shape).
+//      whose skinning the change moved (the others keep the simulated shape); with the cover on
+//      (body_cover.hpp), the skin the simulated cloth covered is then kept covered in the recorded pose too.
 //
 // The bake keeps steps 1-3 apart (clearance over all poses first, then resumable per-pose simulation
 // files), so each step is its own call; simulate() runs them all for one pose. Everything is const and

@@ -57,36 +57,66 @@ BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, c
   bodyTopology_ = buildFrameTopology(bodyTriangles, bodyRest);
 }
 
-BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const Points3f& simulation,
-                                const Triangles& simulationTriangles) const {
-  BodyCoverStats stats;
-  if (!settings_.enabled()) return stats;
-  if (size_t(game.rows()) != weld_.size())
-    throw Error("body cover: the game mesh has " + std::to_string(game.rows()) + " vertices, at rest " +
-                std::to_string(weld_.size()));
+namespace {
+
+// The body's surface samples, with their outward normals: its vertices (area-weighted normals) and its
+// triangles' centroids.
+void bodySamples(const Points3f& body, const Triangles& triangles, const MeshFrameTopology& topology, Points3f& samples,
+                 Points3f& normals) {
+  samples.resize(body.rows() + triangles.rows(), 3);
+  normals.resize(samples.rows(), 3);
+  samples.topRows(body.rows()) = body;
+  normals.topRows(body.rows()) = surfaceVertexNormals(body, triangles, topology);
+  for (Eigen::Index k = 0; k < triangles.rows(); ++k) {
+    samples.row(body.rows() + k) =
+        (body.row(triangles(k, 0)) + body.row(triangles(k, 1)) + body.row(triangles(k, 2))) / 3.f;
+    normals.row(body.rows() + k) = faceNormal(body, triangles, k).transpose();
+  }
+}
+
+}  // namespace
+
+void BodyCover::checkBody(const Points3f& body) const {
   if (size_t(body.rows()) != bodyTopology_.normalAdjacency.offsets.size() - 1)
     throw Error("body cover: the posed body has " + std::to_string(body.rows()) + " vertices, at rest " +
                 std::to_string(bodyTopology_.normalAdjacency.offsets.size() - 1));
-  // The body's surface samples, with their outward normals: its vertices (area-weighted normals) and its
-  // triangles' centroids.
-  Points3f samples(body.rows() + bodyTriangles_.rows(), 3), sampleNormals(samples.rows(), 3);
-  samples.topRows(body.rows()) = body;
-  sampleNormals.topRows(body.rows()) = surfaceVertexNormals(body, bodyTriangles_, bodyTopology_);
-  for (Eigen::Index k = 0; k < bodyTriangles_.rows(); ++k) {
-    samples.row(body.rows() + k) =
-        (body.row(bodyTriangles_(k, 0)) + body.row(bodyTriangles_(k, 1)) + body.row(bodyTriangles_(k, 2))) / 3.f;
-    sampleNormals.row(body.rows() + k) = faceNormal(body, bodyTriangles_, k).transpose();
-  }
+}
+
+std::vector<char> BodyCover::coveredSamples(const Points3f& body, const Points3f& simulation,
+                                            const Triangles& simulationTriangles) const {
+  checkBody(body);
+  Points3f samples, sampleNormals;
+  bodySamples(body, bodyTriangles_, bodyTopology_, samples, sampleNormals);
   const TriangleRayScene cloth(simulation, simulationTriangles, "body cover: simulated cloth");
   // Which samples the simulation covers: the nearest simulated surface is outside them (or less than
-  // kThrough inside). Decided once: the simulation does not move.
-  std::vector<char> covered(size_t(samples.rows()), 0);  // by the simulation
+  // kThrough inside).
+  std::vector<char> covered(size_t(samples.rows()), 0);
   for (Eigen::Index i = 0; i < samples.rows(); ++i) {
     const Vec3f b = samples.row(i);
     const SurfacePoint s = cloth.closestPoint(b, settings_.reach);
     if (s.found)
       covered[size_t(i)] = (b - s.point).dot(faceNormal(simulation, simulationTriangles, s.triangle)) <= kThrough;
   }
+  return covered;
+}
+
+BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const Points3f& simulation,
+                                const Triangles& simulationTriangles) const {
+  if (!settings_.enabled()) return {};
+  return apply(game, body, coveredSamples(body, simulation, simulationTriangles));
+}
+
+BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const std::vector<char>& covered) const {
+  BodyCoverStats stats;
+  if (!settings_.enabled()) return stats;
+  if (size_t(game.rows()) != weld_.size())
+    throw Error("body cover: the game mesh has " + std::to_string(game.rows()) + " vertices, at rest " +
+                std::to_string(weld_.size()));
+  checkBody(body);
+  Points3f samples, sampleNormals;
+  bodySamples(body, bodyTriangles_, bodyTopology_, samples, sampleNormals);
+  if (covered.size() != size_t(samples.rows()))
+    throw Error("body cover: the covered samples do not belong to this body");
   // One pass over the covered samples against the game mesh as it is: how many are through it, and (when
   // `ask` is given) how far each representative is asked to move out, and the deepest. A sample that the
   // last round's moves did not take at least halfway out is given up (moving along the vertex normals does

@@ -60,7 +60,19 @@ class BodyCover {
   BodyCoverStats apply(Points3f& game, const Points3f& body, const Points3f& simulation,
                        const Triangles& simulationTriangles) const;
 
+  // The two halves of apply(). coveredSamples: which of the body's samples (its vertices, then its
+  // triangles' centroids) the simulated cloth covers, with `body` posed as simulated. apply with that mask:
+  // moves `game` off `body` where a covered sample is through it. The body and the game mesh may be in
+  // another pose than the simulation's, as long as the samples keep their meaning: after limb clearance
+  // (pose_shape.hpp step 4) a sample the cloth covered round the turned-out arm is still the skin the
+  // sleeve must cover once the arm is back where it was recorded.
+  std::vector<char> coveredSamples(const Points3f& body, const Points3f& simulation,
+                                   const Triangles& simulationTriangles) const;
+  BodyCoverStats apply(Points3f& game, const Points3f& body, const std::vector<char>& covered) const;
+
  private:
+  void checkBody(const Points3f& body) const;  // throws for a body of another vertex count
+
   BodyCoverSettings settings_;
   std::vector<uint32_t> weld_;  // game vertex -> its welded representative (the first at its rest position)
   Triangles welded_;            // game triangles on the representatives

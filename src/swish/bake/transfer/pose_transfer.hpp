@@ -59,6 +59,7 @@ struct TransferredPose {
   NormalMapBakeStats bakeStats;
   float maxSmoothingShift = 0.f;  // largest distance smoothing moved a vertex (metres)
   BodyCoverStats cover;           // what keeping the game mesh over the body did (nothing when off)
+  BodyCoverStats coverRecorded;   // the same again in the recorded pose, after limb clearance (pose_shape.hpp)
 };
 
 class PoseTransfer {
@@ -71,6 +72,8 @@ class PoseTransfer {
   TransferredPose transfer(const Pose& pose, const Points3f& simPosed) const;
 
   const MeshTransfer& meshTransfer() const { return transfer_; }
+  const BodyCover* cover() const { return cover_ ? &*cover_ : nullptr; }  // null when off
+  const Triangles& simulationTriangles() const { return simTriangles_; }
   // The worst edge of a game-mesh shape (world or pre-skin), against the game mesh's rest edges.
   EdgeStretch worstEdge(const Points3f& gameMeshShape) const;
 

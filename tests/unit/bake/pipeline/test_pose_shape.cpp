@@ -9,6 +9,9 @@
 
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
+#include "swish/bake/transfer/mesh_transfer.hpp"
+#include "swish/bake/transfer/triangle_ray_scene.hpp"
+#include "swish/core/mesh.hpp"
 #include "swish/core/skinning.hpp"
 
 using namespace swish;
@@ -31,6 +34,7 @@ TEST(PoseShape, ACorrectionReSkinsOnlyTheVerticesItsJointsMove) {
   s.simulationVertices = 0;         // the welded game mesh: no refinement, quick to build
   s.limbClearance.clearance = 0.f;  // the test sets the recorded pose itself
   s.transfer.maxEdgeStrain = 1e6f;  // the skinned arm overhead is no cloth; only step 4 is tested
+  s.transfer.cover.margin = 0.f;    // the round trip alone (the cover has its own test below)
   const PoseShapeSimulator shapes(ch, s);
 
   // Simulated: the left arm turned 166 degrees from rest, so that the armpit's skinning collapses (115
@@ -96,6 +100,7 @@ TEST(PoseShape, ACollapsedBlendMovesWithItsSkinnedRestPosition) {
   s.simulationVertices = 0;
   s.limbClearance.clearance = 0.f;
   s.transfer.maxEdgeStrain = 1e6f;
+  s.transfer.cover.margin = 0.f;  // the round trip alone
   PoseShapeSettings off = s;
   off.transfer.reskinMinSingularValue = 0.f;  // the round trip everywhere, as before the setting
   const PoseShapeSimulator shapes(ch, s), roundTrip(ch, off);
@@ -149,4 +154,104 @@ TEST(PoseShape, ACollapsedBlendMovesWithItsSkinnedRestPosition) {
   std::printf("%zu arm vertices kept, %zu moved with their rest position; worst edge %.0f%% -> %.0f%%\n", kept, moved,
               100.0 * tornBefore, 100.0 * tornAfter);
   EXPECT_LT(tornAfter, tornBefore);
+}
+
+namespace {
+
+// Body vertices the cloth covers in `clothPose` (the nearest cloth surface is outside them) that are more
+// than 0.5 mm through `game` in `bodyPose`: in front of the outward side of the nearest game triangle,
+// over its inside. An independent count of what body_cover.hpp removes.
+size_t coveredSkinThrough(const Character& ch, const Pose& clothPose, const Points3f& cloth, const Triangles& clothTris,
+                          const Pose& bodyPose, const Points3f& game) {
+  const Mesh& body = ch.body;
+  const Points3f inCloth = skinPositions(body.positions, body.skin, ch.skeleton.skinningMatrices(clothPose));
+  const Points3f posed = skinPositions(body.positions, body.skin, ch.skeleton.skinningMatrices(bodyPose));
+  const Points3f skinNormals =
+      surfaceVertexNormals(posed, body.triangles, buildFrameTopology(body.triangles, body.positions));
+  const TriangleRayScene clothScene(cloth, clothTris, "cloth"), gameScene(game, ch.garment.triangles, "game");
+  auto normal = [](const Points3f& p, const Triangles& t, uint32_t k) {
+    const Vec3f a = p.row(t(k, 0)), b = p.row(t(k, 1)), c = p.row(t(k, 2));
+    return Vec3f((b - a).cross(c - a).normalized());
+  };
+  // Skin beyond an opening (a sleeve's end, the hem) is not under the cloth: the game triangles on the
+  // openings (edges of one triangle once seam copies are welded) are not asked to cover it.
+  const Triangles welded = trianglesWeldedByPosition(ch.garment.positions, ch.garment.triangles);
+  std::vector<char> opening(size_t(ch.garment.positions.rows()), 0);
+  for (const auto& [a, b] : openEdges(welded)) opening[a] = opening[b] = 1;
+  const std::vector<uint32_t> weld = weldByPosition(ch.garment.positions);
+  size_t through = 0;
+  for (Eigen::Index v = 0; v < body.positions.rows(); ++v) {
+    const Vec3f b0 = inCloth.row(v), b = posed.row(v);
+    const SurfacePoint c = clothScene.closestPoint(b0, 0.03f);
+    if (!c.found || (b0 - c.point).dot(normal(cloth, clothTris, c.triangle)) > 0.f) continue;  // not covered
+    const SurfacePoint g = gameScene.closestPoint(b, 0.03f);
+    if (!g.found || !(g.u > 0.05f && g.v > 0.05f && g.u + g.v < 0.95f)) continue;
+    bool open = false;
+    for (int e = 0; e < 3; ++e) open = open || opening[weld[ch.garment.triangles(g.triangle, e)]];
+    if (open) continue;
+    // Skin facing across the cloth (the trunk's side against a sleeve's inner side, in the armpit's crease)
+    // is where two parts of the garment meet, not skin under one.
+    const Vec3f n = normal(game, ch.garment.triangles, g.triangle);
+    if (n.dot(skinNormals.row(v).transpose()) < 0.5f) continue;
+    through += (b - g.point).dot(n) > 0.0005f;
+  }
+  return through;
+}
+
+}  // namespace
+
+// Limb clearance simulates the sleeve round an arm turned out of the trunk; step 4 skins it back with the
+// recorded arm, and the arm's skin, on its own weights, comes through the sleeve's inner side by the armpit
+// (the truth of the default scene's training clip showed it in 14 of 15 frames, docs/baking.md). With the
+// cover on, the skin the cloth covered in the simulated pose stays covered in the recorded one.
+TEST(PoseShape, TheCoverKeepsTheSkinTheClothCoveredCoveredInTheRecordedPose) {
+  const Character ch = makeDefaultCharacter();
+  const Skeleton& sk = ch.skeleton;
+  PoseShapeSettings s;
+  s.simulationVertices = 0;
+  ASSERT_GT(s.transfer.cover.margin, 0.f);  // on by default
+  ASSERT_GT(s.limbClearance.clearance, 0.f);
+  const PoseShapeSimulator shapes(ch, s);
+
+  // Recorded: both upper arms hanging 0.2 rad into the trunk (as in the CMU clips); simulated: what limb
+  // clearance makes of it. The cloth: the simulation mesh skinned to the simulated pose and lifted 4 mm off
+  // it along its normals (a tight jersey; no solve is needed for the transfer).
+  Pose recorded = sk.restPose();
+  const float down = 40.f * float(M_PI) / 180.f + 0.2f;
+  recorded.local[size_t(sk.find("LeftArm"))] = Quatf(Eigen::AngleAxisf(-down, Vec3f::UnitZ()));
+  recorded.local[size_t(sk.find("RightArm"))] = Quatf(Eigen::AngleAxisf(down, Vec3f::UnitZ()));
+  std::vector<LimbCorrection> corrections;
+  const Pose simulated = shapes.poseToSimulate(recorded, &corrections);
+  ASSERT_FALSE(corrections.empty());
+  const SimulationMesh& mesh = shapes.solver().mesh();
+  Points3f cloth = skinPositions(mesh.restPositions, mesh.skin, sk.skinningMatrices(simulated));
+  cloth += 0.004f * surfaceVertexNormals(cloth, mesh.triangles, buildFrameTopology(mesh.triangles, mesh.restPositions));
+
+  const TransferredPose tp = shapes.gameMeshShape(simulated, recorded, cloth);
+  // Without the cover in the recorded pose: the shape as simulated, skinned back with the recorded pose.
+  const TransferredPose asSimulated = shapes.gameMeshShape(simulated, simulated, cloth);
+  const Points3f roundTrip = skinPositions(asSimulated.gameMeshPreSkin, ch.garment.skin, sk.skinningMatrices(recorded));
+
+  const size_t inSimulated =
+      coveredSkinThrough(ch, simulated, cloth, mesh.triangles, simulated, asSimulated.gameMeshWorld);
+  const size_t before = coveredSkinThrough(ch, simulated, cloth, mesh.triangles, recorded, roundTrip);
+  const size_t after = coveredSkinThrough(ch, simulated, cloth, mesh.triangles, recorded, tp.gameMeshWorld);
+  std::printf(
+      "covered body vertices through the game mesh: %zu as simulated, %zu skinned back to the recorded arms, "
+      "%zu with the cover there (%zu game vertices moved, up to %.1f mm)\n",
+      inSimulated, before, after, tp.coverRecorded.verticesMoved, 1000.0 * tp.coverRecorded.largestShift);
+  // The round trip brings the skin through (43 body vertices; none as simulated): the case this is for.
+  EXPECT_LE(inSimulated, 2u);
+  EXPECT_GE(before, 20u);
+  // The cover takes most of it out (10 left: this arm hangs 11 degrees into the trunk, and where a vertex
+  // has moved its largest shift, 3 cm, the rest stays; the default scene's truth kept 1 to 21 of 76 to 116
+  // body samples a pose, docs/baking.md).
+  EXPECT_LE(after, before / 3);
+  EXPECT_GT(tp.coverRecorded.verticesMoved, 0u);
+  EXPECT_LE(tp.coverRecorded.largestShift, s.transfer.cover.maxShift + 1e-6f);
+  // Stored is what the run time draws: the recorded pose's skinning of the pre-skin shape.
+  const Points3f drawn = skinPositions(tp.gameMeshPreSkin, ch.garment.skin, sk.skinningMatrices(recorded));
+  EXPECT_LT((drawn - tp.gameMeshWorld).rowwise().norm().maxCoeff(), 1e-4f);
+  // Nothing torn.
+  EXPECT_LE(shapes.transfer().worstEdge(tp.gameMeshWorld).strain, s.transfer.maxEdgeStrain);
 }
