@@ -52,7 +52,9 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   const CommandResult r =
       swishCmd({"levels", defaultModel().string(), "--clips", test::debianMocap("01_01.bvh").string(),
                 test::debianMocap("01_03.bvh").string(), "--frames", "2", "--threads", "2", "--out", out.string(),
-                "--report", report.string()});
+                "--report", report.string(),
+                // The truth overrides are `swish replay`'s (truth_options.hpp); the bake's own clearance, said.
+                "--truth-limb-clearance-mm", "15"});
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("truth 2/2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("s left"), std::string::npos) << r.out;
@@ -69,6 +71,8 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   EXPECT_GE(l.poses, 1u);
   EXPECT_LE(l.poses, 2u);
   EXPECT_NE(l.measuredOn.find("the clips 01_01.bvh, 01_03.bvh"), std::string::npos) << l.measuredOn;
+  EXPECT_NE(l.measuredOn.find("overridden for this run (not the bake's): limb clearance 15 mm"), std::string::npos)
+      << l.measuredOn;
   EXPECT_FALSE(l.timedOn.empty());
   const runtime::QualityLevel &full = l.levels.front(), &skinned = l.levels.back();
   // The default model's held-out error is 14.8 mm mean, 33 mm p95 on random held-out frames of its
@@ -101,6 +105,11 @@ TEST(LevelsCli, ErrorsNameTheFile) {
   EXPECT_EQ(clip.exitCode, 1);
   EXPECT_NE(clip.err.find("gone.bvh does not exist"), std::string::npos) << clip.err;
   EXPECT_FALSE(fs::exists(out));  // nothing written
+  const CommandResult range =
+      swishCmd({"levels", defaultModel().string(), "--truth-cover-mm", "50", "--out", out.string()});
+  EXPECT_NE(range.exitCode, 0);
+  EXPECT_NE((range.out + range.err).find("--truth-cover-mm"), std::string::npos) << range.out << range.err;
+  EXPECT_FALSE(fs::exists(out));
   // A model with no bake behind it (no metadata naming the character): no truth, and it says why.
   const fs::path bare = tmp / "bare.swish";
   Model m = loadModel(defaultModel());

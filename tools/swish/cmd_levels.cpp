@@ -29,6 +29,7 @@
 #include "swish/model/model_file.hpp"
 #include "swish/replay/truth_simulation.hpp"
 #include "swish/runtime/quality_levels.hpp"
+#include "swish/truth_options.hpp"
 
 namespace {
 
@@ -41,8 +42,7 @@ struct LevelsCliOptions {
   std::vector<std::string> clips;
   size_t frames = 40;
   size_t every = 0;
-  std::optional<size_t> truthVertices;
-  std::optional<int> truthSubsteps;
+  swish::replay::TruthOptions truth;  // the overrides (truth_options.hpp)
   int threads = 0;
 };
 
@@ -85,10 +85,7 @@ int runLevels(const LevelsCliOptions& o) {
   const json ds = meta.is_object() && meta.contains("dataset_settings") && meta["dataset_settings"].is_object()
                       ? meta["dataset_settings"]
                       : json::object();
-  replay::TruthOptions to;
-  to.simulationVertices = o.truthVertices;
-  to.substeps = o.truthSubsteps;
-  const replay::ModelTruth simulator(entry, to);
+  const replay::ModelTruth simulator(entry, o.truth);
   if (!simulator.available()) throw Error(o.model + ": no truth to measure the levels against: " + simulator.note());
   const std::string& truth = simulator.note();
 
@@ -265,11 +262,7 @@ swish::cli::CommandRegistration reg{
       app.add_option("--report", o->report,
                      "also write levels.md, levels.json and quality_levels.svg (error against CPU time) into this "
                      "folder");
-      app.add_option("--truth-vertices", o->truthVertices,
-                     "truth simulation vertices instead of the bake's (0: the welded game mesh; coarser is faster and "
-                     "further from the bake's truth; the ladder's 'measured_on' says so)");
-      app.add_option("--truth-substeps", o->truthSubsteps, "truth simulation substeps instead of the bake's")
-          ->check(CLI::Range(1, 1000));
+      swish::cli::addTruthOverrideOptions(app, o->truth, "the ladder's 'measured_on'");
       app.add_option("--threads", o->threads, "threads for the truth simulations (default 0: all cores)")
           ->check(CLI::Range(0, 1024));
       app.footer(

@@ -34,6 +34,7 @@
 #include "swish/runtime/level_planner.hpp"
 #include "swish/runtime/quality_levels.hpp"
 #include "swish/runtime/scene_file.hpp"
+#include "swish/truth_options.hpp"
 
 namespace {
 
@@ -46,10 +47,7 @@ struct ReplayCliOptions {
   std::vector<uint32_t> renderSize = {swish::replay::ReplayRenderOptions{}.width,
                                       swish::replay::ReplayRenderOptions{}.height};
   bool pushOut = false, noPushOut = false, noGuard = false, hideCoveredBody = false, showCoveredBody = false;
-  std::optional<size_t> truthVertices;
-  std::optional<int> truthSubsteps;
-  std::optional<float> truthCoverMm;
-  std::optional<float> truthLimbClearanceMm;
+  swish::replay::TruthOptions truth;  // the overrides (truth_options.hpp); `every` comes from truthEvery
   std::optional<double> frameBudgetMs, tolerancePixels;
   std::string level;
 };
@@ -149,11 +147,8 @@ int runReplay(const ReplayCliOptions& o) {
   jo.models = &models;
   jo.engine.device.device = o.device;
   if (o.validation) jo.engine.device.validation = true;
+  jo.engine.truth = o.truth;
   jo.engine.truth.every = o.truthEvery;
-  jo.engine.truth.simulationVertices = o.truthVertices;
-  jo.engine.truth.substeps = o.truthSubsteps;
-  jo.engine.truth.coverBodyMm = o.truthCoverMm;
-  jo.engine.truth.limbClearanceMm = o.truthLimbClearanceMm;
   jo.engine.penetrationEvery = o.penetrationEvery;
   jo.engine.pushOut = scene.body.pushOut;
   jo.engine.noveltyGuard = !o.noGuard;
@@ -269,20 +264,8 @@ swish::cli::CommandRegistration reg{
           "(mm) and normal-map (deg) error of the run time against it (about 2 s of CPU per character and truth frame "
           "with "
           "the default model, in parallel)");
-      app.add_option("--truth-vertices", o->truthVertices,
-                     "truth simulation vertices instead of the bake's (0: the welded game mesh; coarser is faster, and "
-                     "further from the bake's truth; the report says so)");
-      app.add_option("--truth-substeps", o->truthSubsteps, "truth simulation substeps instead of the bake's")
-          ->check(CLI::Range(1, 1000));
-      app.add_option("--truth-cover-mm", o->truthCoverMm,
-                     "the truth's game mesh kept this far over the body where the simulation covered it, instead of "
-                     "the bake's part1.transfer.cover_body_mm (0: off; with --render the report counts the truth's "
-                     "body-through pixels: what the cover does to the pictures before any re-bake)")
-          ->check(CLI::Range(0.0, 20.0));
-      app.add_option("--truth-limb-clearance-mm", o->truthLimbClearanceMm,
-                     "the truth simulated with limbs turned this far out of the trunk instead of the bake's "
-                     "part1.simulation.limb_clearance, in mm (0: each pose simulated as recorded)")
-          ->check(CLI::Range(0.0, 100.0));
+      // --truth-cover-mm with --render: the report counts the truth's body-through pixels too.
+      swish::cli::addTruthOverrideOptions(app, o->truth, "the report");
       app.add_option(
           "--penetration-every", o->penetrationEvery,
           "measure the garment inside the body it was baked on (CPU reference, before and after the push-out) "
