@@ -134,6 +134,15 @@ TEST(BakeWhole, DefaultCharacterAndMocapToLoadableModel) {
     EXPECT_NE(q["edge_strain_mean_percent"].get<double>(), q["reference_edge_strain_mean_percent"].get<double>());
   }
   EXPECT_TRUE(fs::exists(w.config.previewDir() / "preview.json"));
+  // The cover (transfer/body_cover.hpp), in the simulated pose and again in the recorded one: the second
+  // runs only on poses that limb clearance changed, and the walk's hanging arms are turned out in most.
+  const nlohmann::json &cover = p1["body_cover"], &coverRecorded = p1["body_cover_recorded_pose"];
+  ASSERT_TRUE(cover.is_object() && coverRecorded.is_object()) << p1.dump();
+  EXPECT_LE(cover["poses"].get<size_t>(), inDataset);
+  EXPECT_LE(coverRecorded["poses"].get<size_t>(), p1["poses_corrected"].get<size_t>());
+  EXPECT_LE(coverRecorded["largest_shift_mm"].get<double>(), 30.0 + 1e-3);  // BodyCoverSettings::maxShift
+  std::printf("cover: %zu poses; again in the recorded pose: %zu of the %zu corrected\n", cover["poses"].get<size_t>(),
+              coverRecorded["poses"].get<size_t>(), p1["poses_corrected"].get<size_t>());
 
   // Progress lines with the time left for the long steps.
   bool simLeft = false, transferLeft = false;

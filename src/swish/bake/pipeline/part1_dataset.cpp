@@ -837,26 +837,17 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
       log(line);
     }
   }
-  if (res.bodyCover.poses > 0) {
-    const auto& c = res.bodyCover;
-    char line[320];
+  // What the cover did (transfer/body_cover.hpp): in the simulated pose, then again in the recorded one.
+  for (const auto& [c, what] :
+       {std::pair{&res.bodyCover, "the game mesh kept over the body (cover_body_mm)"},
+        std::pair{&res.bodyCoverRecorded, "and again in the recorded pose, where limb clearance had turned a limb,"}}) {
+    if (c->poses == 0) continue;
+    char line[360];
     std::snprintf(line, sizeof line,
-                  "part 1: the game mesh kept over the body (cover_body_mm) in %zu of %zu poses transferred: %.0f "
-                  "vertices moved per such pose, at most %.1f mm; the body was up to %.1f mm through its chords; %zu "
-                  "poses still have some of it through",
-                  c.poses, res.transferred, double(c.vertices) / double(c.poses), 1000.0 * c.largestShift,
-                  1000.0 * c.deepest, c.posesLeftThrough);
-    log(line);
-  }
-  if (res.bodyCoverRecorded.poses > 0) {
-    const auto& c = res.bodyCoverRecorded;
-    char line[320];
-    std::snprintf(line, sizeof line,
-                  "part 1: and again in the recorded pose where limb clearance had turned a limb out: %zu poses, %.0f "
-                  "vertices moved per such pose, at most %.1f mm; the skin was up to %.1f mm through; %zu poses still "
-                  "have some of it through",
-                  c.poses, double(c.vertices) / double(c.poses), 1000.0 * c.largestShift, 1000.0 * c.deepest,
-                  c.posesLeftThrough);
+                  "part 1: %s in %zu of %zu poses transferred: %.0f vertices moved per such pose, at most %.1f mm; the "
+                  "body was up to %.1f mm through; %zu poses still have some of it through",
+                  what, c->poses, res.transferred, double(c->vertices) / double(c->poses), 1000.0 * c->largestShift,
+                  1000.0 * c->deepest, c->posesLeftThrough);
     log(line);
   }
   nlohmann::json source = {{"tool", "swish bake (part 1)"},
