@@ -185,7 +185,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
 
   const JsonReader tr = j.section(
       "transfer", {"smoothing_strength", "smoothing_iterations", "smoothing_weights", "unskin_min_singular_value",
-                   "max_edge_strain", "reskin_min_singular_value", "cover_body_mm"});
+                   "max_edge_strain", "reskin_min_singular_value", "cover_body_mm", "cover_recorded_pose"});
   LaplacianSmoothingSettings& ls = s.transfer.smoothing;
   ls.strength = float(tr.number("smoothing_strength", 0, 1, ls.strength));
   ls.iterations = int(tr.wholeNumber("smoothing_iterations", 0, 1000, ls.iterations));
@@ -204,6 +204,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
       float(tr.number("reskin_min_singular_value", 0, 0.5, s.transfer.reskinMinSingularValue));
   // How far outside the body the game mesh passes where the simulation covered it (body_cover.hpp; 0: off).
   s.transfer.cover.margin = float(tr.number("cover_body_mm", 0, 20, 1000.0 * s.transfer.cover.margin) / 1000.0);
+  // And again in the recorded pose after limb clearance (pose_shape.hpp step 4).
+  s.transfer.cover.recordedPose = tr.boolean("cover_recorded_pose", s.transfer.cover.recordedPose);
 
   const JsonReader nm = j.section("normal_maps", {"size", "max_distance", "dilation_rings", "bit_depth"});
   NormalMapBakeSettings& nb = s.transfer.normalMap;
@@ -333,6 +335,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (tr.is_object() && !tr.contains("reskin_min_singular_value")) s.transfer.reskinMinSingularValue = 0.f;
   // Settings recorded before the game mesh was kept over the body stored it as transferred.
   if (tr.is_object() && !tr.contains("cover_body_mm")) s.transfer.cover.margin = 0.f;
+  // Settings recorded before the cover ran in the recorded pose too kept it to the simulated one.
+  if (tr.is_object() && !tr.contains("cover_recorded_pose")) s.transfer.cover.recordedPose = false;
   return s.poseShape();
 }
 

@@ -288,8 +288,11 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = clothCarryName(m.carry);  // likewise
   if (transfer.reskinMinSingularValue > 0.f)                                                     // likewise
     out["transfer"]["reskin_min_singular_value"] = transfer.reskinMinSingularValue;
-  if (transfer.cover.enabled()) out["transfer"]["cover_body_mm"] = 1000.f * transfer.cover.margin;  // likewise
-  if (!m.skinningRetriesOnly()) {                                                                   // likewise
+  if (transfer.cover.enabled()) {  // likewise
+    out["transfer"]["cover_body_mm"] = 1000.f * transfer.cover.margin;
+    out["transfer"]["cover_recorded_pose"] = transfer.cover.recordedPose;
+  }
+  if (!m.skinningRetriesOnly()) {  // likewise
     nlohmann::json& list = out["simulation"]["retry_carries"] = nlohmann::json::array();
     for (ClothCarry c : m.retryCarries) list.push_back(clothCarryName(c));
   }

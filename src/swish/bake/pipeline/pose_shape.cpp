@@ -114,7 +114,7 @@ TransferredPose PoseShapeSimulator::gameMeshShape(const Pose& simulated, const P
     // simulated pose, cannot see (measured: docs/baking.md, "The cover on the truth"). The skin the
     // simulation covered in its pose is kept covered in the recorded one: the same body samples, posed as
     // recorded. Stored is again what the run time draws.
-    if (const BodyCover* cover = transfer_.cover()) {
+    if (const BodyCover* cover = settings_.transfer.cover.recordedPose ? transfer_.cover() : nullptr) {
       const Mesh& body = character_->body;
       const std::vector<char> covered =
           cover->coveredSamples(skinPositions(body.positions, body.skin, simulatedMatrices), simulationPositions,

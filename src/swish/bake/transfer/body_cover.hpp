@@ -34,6 +34,9 @@ struct BodyCoverSettings {
   float maxShift = 0.03f;  // m: no vertex moves further (the chord error of a coarse game mesh is below this)
   float reach = 0.03f;     // m: body samples farther from the game mesh are not under it
   int rounds = 4;          // moving a vertex can uncover a neighbouring triangle's sample
+  // Also in the recorded pose, where limb clearance changed the simulated one (pose_shape.hpp step 4). Datasets
+  // and models from before it was a setting (session 28) did not (their settings lack the key).
+  bool recordedPose = true;
   bool enabled() const { return margin > 0.f; }
 };
 

@@ -127,28 +127,31 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   const BakeConfig c = parseBakeConfig(
       {{"output", "o"},
        {"work", "/tmp/w"},
-       {"part1",
-        part1({{"character", {{"file", kThisFile}, {"garment_mesh", {"shirt"}}}},
-               {"clips", {{{"file", kThisFile}, {"naming", "mixamo"}, {"joint_map", {{"Hips", "Hips"}}}}}},
-               {"input_joints", {"Spine", "Spine1"}},
-               {"thinning", {{"tolerance", 0.25}, {"include_rest_pose", false}}},
-               {"simulation",
-                {{"preset", "stiff"},
-                 {"vertices", 4000},
-                 {"threads", 2},
-                 {"substeps", 4},
-                 {"gravity", 0},
-                 {"attach_band", 0.03},
-                 {"damping", 1.5},
-                 {"limb_garment_reach", 0.1},
-                 {"limb_neck_range", 45},
-                 {"static_solve", true},
-                 {"static_tolerance", 0.002},
-                 {"static_iterations", 25},
-                 {"carry", "translation"},
-                 {"retry_carries", {"translation"}}}},
-               {"transfer", {{"smoothing_strength", 0.3}, {"smoothing_weights", "uniform"}, {"cover_body_mm", 5}}},
-               {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
+       {"part1", part1({{"character", {{"file", kThisFile}, {"garment_mesh", {"shirt"}}}},
+                        {"clips", {{{"file", kThisFile}, {"naming", "mixamo"}, {"joint_map", {{"Hips", "Hips"}}}}}},
+                        {"input_joints", {"Spine", "Spine1"}},
+                        {"thinning", {{"tolerance", 0.25}, {"include_rest_pose", false}}},
+                        {"simulation",
+                         {{"preset", "stiff"},
+                          {"vertices", 4000},
+                          {"threads", 2},
+                          {"substeps", 4},
+                          {"gravity", 0},
+                          {"attach_band", 0.03},
+                          {"damping", 1.5},
+                          {"limb_garment_reach", 0.1},
+                          {"limb_neck_range", 45},
+                          {"static_solve", true},
+                          {"static_tolerance", 0.002},
+                          {"static_iterations", 25},
+                          {"carry", "translation"},
+                          {"retry_carries", {"translation"}}}},
+                        {"transfer",
+                         {{"smoothing_strength", 0.3},
+                          {"smoothing_weights", "uniform"},
+                          {"cover_body_mm", 5},
+                          {"cover_recorded_pose", false}}},
+                        {"normal_maps", {{"size", 128}, {"bit_depth", 8}}}})}},
       "recipe.json", "/base");
   EXPECT_EQ(c.work, std::filesystem::path("/tmp/w"));  // absolute paths stay as they are
   EXPECT_EQ(c.dataset, std::filesystem::path("/tmp/w/dataset"));
@@ -217,8 +220,18 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_FLOAT_EQ(d.part1->transfer.cover.margin, 0.002f);
   EXPECT_FLOAT_EQ(s.transfer.cover.margin, 0.005f);
   EXPECT_FLOAT_EQ(back.transfer.cover.margin, 0.005f);
+  EXPECT_FALSE(s.transfer.cover.recordedPose);
+  EXPECT_FALSE(back.transfer.cover.recordedPose);
   EXPECT_EQ(d.part1->toJson()["transfer"]["cover_body_mm"], 2.f);
   EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").transfer.cover.margin, 0.005f);
+  // And again in the recorded pose (pose_shape.hpp step 4): on by default, recorded; settings from before it
+  // was a setting (no key) did not.
+  EXPECT_TRUE(d.part1->transfer.cover.recordedPose);
+  EXPECT_EQ(d.part1->toJson()["transfer"]["cover_recorded_pose"], true);
+  nlohmann::json defaults = d.part1->toJson();
+  EXPECT_TRUE(poseShapeSettingsFromJson(defaults, "dataset settings").transfer.cover.recordedPose);
+  defaults["transfer"].erase("cover_recorded_pose");
+  EXPECT_FALSE(poseShapeSettingsFromJson(defaults, "dataset settings").transfer.cover.recordedPose);
   withoutCarry["transfer"].erase("cover_body_mm");
   EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").transfer.cover.margin, 0.f);
   EXPECT_FLOAT_EQ(d.part1->simulation.attachTopFraction, ClothSimSettings{}.attachTopFraction);
@@ -242,6 +255,8 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"simulation", {{"limb_neck_range", 800}}}}), "part1.simulation.limb_neck_range: 800 is outside");
   says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
   says(part1Error({{"transfer", {{"cover_body_mm", 30}}}}), "part1.transfer.cover_body_mm: 30 is outside");
+  says(part1Error({{"transfer", {{"cover_recorded_pose", 1}}}}),
+       "part1.transfer.cover_recorded_pose: must be true or false");
   says(part1Error({{"simulation", {{"carry", "rigid"}}}}),
        "part1.simulation.carry: 'rigid' is not \"skinning\" or \"translation\"");
   says(part1Error({{"simulation", {{"retry_carries", "translation"}}}}),
