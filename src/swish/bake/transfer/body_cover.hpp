@@ -20,6 +20,10 @@
 // garment's openings (hem, collar, sleeve ends) ask nothing: a body beyond a hem is not under the cloth. Where the
 // simulation itself has the body through its cloth nothing is asked either: that is the simulation's fault (issue 18),
 // not the transfer's.
+//
+// Where limb clearance simulated another pose than the recorded one, the same runs again once the game mesh is
+// skinned back to the recorded pose (pose_shape.hpp step 4): the samples the cloth covered in the simulated
+// pose, posed as recorded, against the re-skinned game mesh (coveredSamples, then apply with that mask).
 #include <cstddef>
 #include <cstdint>
 #include <vector>

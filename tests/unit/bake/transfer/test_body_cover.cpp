@@ -122,4 +122,13 @@ TEST(BodyCover, BadInputIsAClearError) {
               cover.apply(fewer, s.body.positions, s.cloth.positions, s.cloth.triangles);
             }).find("the game mesh has 10 vertices"),
             std::string::npos);
+  // A mask of covered samples (coveredSamples) made for another body.
+  Points3f game = s.game.positions;
+  const std::vector<char> mask(5, 1);
+  EXPECT_NE(test::errorOf([&] { cover.apply(game, s.body.positions, mask); }).find("do not belong to this body"),
+            std::string::npos);
+  EXPECT_NE(test::errorOf([&] {
+              cover.coveredSamples(s.body.positions.topRows(10), s.cloth.positions, s.cloth.triangles);
+            }).find("the posed body has 10 vertices"),
+            std::string::npos);
 }
