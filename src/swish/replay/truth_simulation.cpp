@@ -155,9 +155,11 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     ps.simulation.substeps = *options.substeps;
     overridden += " substeps";
   }
-  if (options.coverBodyMm) {
+  if (options.coverBodyMm) {  // the cover as bakes run it today: in the simulated pose and the recorded one
     ps.transfer.cover.margin = 0.001f * *options.coverBodyMm;
     overridden += " cover_body_mm " + fmtNum("%g", *options.coverBodyMm);
+    if (!ps.transfer.cover.recordedPose && ps.transfer.cover.enabled()) overridden += " (in the recorded pose too)";
+    ps.transfer.cover.recordedPose = true;
   }
   if (options.limbClearanceMm) {
     ps.limbClearance.clearance = 0.001f * *options.limbClearanceMm;
