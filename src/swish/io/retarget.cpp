@@ -12,7 +12,11 @@ namespace {
 Quatd shortestArc(const Vec3d& a, const Vec3d& b) { return Quatd::FromTwoVectors(a, b).normalized(); }
 
 // Rotation R minimising sum |R a_i - b_i|^2 (Kabsch), or nullopt when the a_i are (nearly) collinear.
-std::optional<Quatd> kabsch(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+// `ambiguous` is set when the answer is not one rotation: the directions fit best mirrored (a reflection)
+// and the two smallest singular values nearly tie, so that the SVD may return either of two rotations far
+// apart. The shared T-shirt's chest (collar bones ahead of the neck) against the Daz rig's (behind it):
+// singular values 2.79, 0.0612, 0.0611, and the chest came out turned 180 degrees about the spine.
+std::optional<Quatd> kabsch(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, bool& ambiguous) {
   Mat3d h = Mat3d::Zero();
   for (size_t i = 0; i < a.size(); ++i) h += a[i] * b[i].transpose();
   Eigen::JacobiSVD<Mat3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -20,7 +24,49 @@ std::optional<Quatd> kabsch(const std::vector<Vec3d>& a, const std::vector<Vec3d
   if (s[1] < 1e-3 * std::max(s[0], 1e-12)) return std::nullopt;
   Mat3d d = Mat3d::Identity();
   d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  ambiguous = d(2, 2) < 0 && s[2] > 0.5 * s[1];
   return Quatd(svd.matrixV() * d * svd.matrixU().transpose()).normalized();
+}
+
+// The alignment where Kabsch is ambiguous (a chest whose collar bones lie ahead of its neck, as the
+// shared T-shirt's, against one whose collar bones lie behind it, as the Daz rig's: no rotation fits both,
+// and the best fits are a tilt or a half turn about the spine). What both skeletons agree on is used
+// instead: each mirrored pair of children (names that differ by left / right) gives the direction from the
+// right one to the left one, the other children their own directions, and Kabsch fits those. Without a
+// pair (or if that fit is ambiguous too) the smallest turn of the directions' mean onto the clip's after
+// the parent's alignment `inherited`, so that the twist follows the parent as for a joint with one child.
+Quatd agreedAlignment(const std::vector<int>& child, const std::vector<Vec3d>& a, const std::vector<Vec3d>& b,
+                      const std::vector<Vec3d>& aOffset, const std::vector<Vec3d>& bOffset, const Skeleton& character,
+                      const Quatd& inherited) {
+  std::vector<Vec3d> da, db;
+  std::vector<char> paired(child.size(), 0);
+  for (size_t i = 0; i < child.size(); ++i) {
+    const std::string name = normaliseJointName(character.joints[size_t(child[i])].name);
+    const size_t at = name.find("left");
+    if (at == std::string::npos) continue;
+    const std::string mirror = name.substr(0, at) + "right" + name.substr(at + 4);
+    for (size_t k = 0; k < child.size(); ++k)
+      if (k != i && !paired[k] && normaliseJointName(character.joints[size_t(child[k])].name) == mirror) {
+        const Vec3d sa = aOffset[i] - aOffset[k], sb = bOffset[i] - bOffset[k];
+        if (sa.norm() > 1e-9 && sb.norm() > 1e-9) {
+          da.push_back(sa.normalized());
+          db.push_back(sb.normalized());
+          paired[i] = paired[k] = 1;
+        }
+        break;
+      }
+  }
+  if (!da.empty()) {
+    for (size_t i = 0; i < child.size(); ++i)
+      if (!paired[i]) da.push_back(a[i]), db.push_back(b[i]);
+    bool ambiguous = false;
+    if (da.size() >= 2)
+      if (const std::optional<Quatd> k = kabsch(da, db, ambiguous); k && !ambiguous) return *k;
+  }
+  Vec3d ma = Vec3d::Zero(), mb = Vec3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) ma += a[i], mb += b[i];
+  if (!(ma.norm() > 1e-9) || !(mb.norm() > 1e-9)) ma = a[0], mb = b[0];
+  return (shortestArc((inherited * ma).normalized(), mb.normalized()) * inherited).normalized();
 }
 
 // A chain of character joints driven together (JointChain): indices, parent first, and per joint its
@@ -130,7 +176,8 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
       align[h] = inherited;
       continue;
     }
-    std::vector<Vec3d> dh, ds;
+    std::vector<Vec3d> dh, ds, oh, os;  // directions to the mapped children, and the offsets themselves
+    std::vector<int> used;              // the character child each came from
     for (int c0 : children[h]) {
       // Zero-length bones (CMU's LHipJoint) say nothing: walk down to the first real bone.
       int c = c0;
@@ -140,6 +187,9 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
           if (b.norm() > 0) {
             dh.push_back(a.normalized());
             ds.push_back(b.normalized());
+            oh.push_back(a);
+            os.push_back(b);
+            used.push_back(c0);
             if (c == c0) {  // a direct bone: its length calibrates the root translation
               charLength += a.norm();
               clipLength += b.norm();
@@ -151,7 +201,9 @@ AnimationClip retarget(const SourceAnimation& clip, const Skeleton& character, c
       }
     }
     std::optional<Quatd> k;
-    if (dh.size() >= 2) k = kabsch(dh, ds);
+    bool ambiguous = false;
+    if (dh.size() >= 2) k = kabsch(dh, ds, ambiguous);
+    if (ambiguous) k = agreedAlignment(used, dh, ds, oh, os, character, inherited);
     if (k)
       align[h] = *k;
     else if (!dh.empty())

@@ -6,7 +6,9 @@
 // joint h driven by clip joint s, a rest alignment A_h (a world rotation) takes the character's rest
 // bone directions (to its mapped children) onto the clip's rest bone directions: for one child the
 // smallest rotation after the parent's alignment (so the twist follows the parent), for several the
-// least-squares rotation (Kabsch) of all of them. Then, per frame,
+// least-squares rotation (Kabsch) of all of them, or, where that is ambiguous (the directions fit best
+// mirrored and two singular values nearly tie: two rotations up to 180 degrees apart fit alike), the
+// smallest turn of their mean onto the clip's after the parent's alignment. Then, per frame,
 //     R_h(t) = R_s(t) * R_s(rest)^-1 * A_h * R_h(rest)          (global rotations)
 // so each character bone points where the clip's bone points. Unmapped joints keep their rest local
 // rotation, except along a joint map chain (joint_map.hpp): there the rotation D the chain adds to its
