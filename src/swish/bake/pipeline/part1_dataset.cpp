@@ -246,6 +246,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
         {"limb_clearance", limbClearance.clearance},
         {"limb_garment_reach", limbClearance.garmentReach},
         {"limb_neck_range", limbClearance.neckRangeDegrees},
+        {"limb_one_surface", limbClearance.oneSurfaceLimbs},
         {"attach_band", m.attachTopFraction}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength},
@@ -556,9 +557,10 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
       std::snprintf(
           line, sizeof line,
           "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk where the garment is (%zu "
-          "limbs of the body checked, %zu of the trunk's %zu triangles within %.0f mm of the garment); "
+          "limbs of the body checked%s, %zu of the trunk's %zu triangles within %.0f mm of the garment); "
           "turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
           1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
+          clearance.limbsAreRegions() ? ": skin regions of a body that is one surface" : "",
           clearance.guardedTriangles(), clearance.trunkTriangles(), 1000.0 * s.limbClearance.garmentReach,
           double(res.maxCorrectionDegrees), stillInside, since(t));
     if (clearance.limbCount() > 0) log(line);
@@ -573,19 +575,27 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
       log(neck);
     }
     if (clearance.checksHead()) {
-      for (const auto& c : corrections)
+      size_t headPoses = 0, headInside = 0;
+      float headDegrees = 0.f;
+      for (const auto& c : corrections) {
+        headPoses += std::any_of(c.begin(), c.end(), [](const LimbCorrection& x) { return x.head; });
         for (const LimbCorrection& x : c)
-          if (!x.neckRange) res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);
+          if (x.head) {
+            res.maxTowardsRest = std::max(res.maxTowardsRest, x.towardsRest);
+            headDegrees = std::max(headDegrees, x.degrees);
+            headInside += x.depthAfter > 0.f;
+          }
+      }
       std::snprintf(line, sizeof line,
                     "part 1: head clearance (one-surface body, %zu head vertices checked): %zu of %zu poses had the "
                     "head inside the body; neck turned back towards rest by up to %.0f %% (%.0f degrees), %zu still "
                     "inside, in %.2f s",
-                    clearance.headVertexCount(), res.posesCorrected, poses.size(), 100.0 * res.maxTowardsRest,
-                    double(res.maxCorrectionDegrees), stillInside, since(t));
+                    clearance.headVertexCount(), headPoses, poses.size(), 100.0 * res.maxTowardsRest,
+                    double(headDegrees), headInside, since(t));
       log(line);
       for (size_t i = 0; i < corrections.size(); ++i)
         for (const LimbCorrection& x : corrections[i]) {
-          if (x.neckRange) continue;  // counted on the neck range's line
+          if (!x.head) continue;  // the neck range and the limbs have their own lines
           std::snprintf(line, sizeof line,
                         "part 1: head clearance: pose %zu: head %.1f mm inside, neck turned %.0f %% back to rest "
                         "(%s %.1f degrees), %.1f mm after",

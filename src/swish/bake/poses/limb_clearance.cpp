@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_set>
 
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/core/error.hpp"
@@ -19,6 +20,8 @@ constexpr float kSearch = 0.25f;
 constexpr float kCell = 0.05f;
 // A limb this little inside its clearance is left alone (m).
 constexpr float kTolerance = 0.001f;
+// Spacing of the checked vertices of a one-surface body's limb regions (m): a little below the clearance.
+constexpr float kRegionSpacing = 0.01f;
 
 // The smallest whole number of steps in [1, most] after which depthAt(steps) <= kTolerance, `before`
 // being the depth at 0: 5-step strides, then bisection; `most` when none clears. `after` gets the depth
@@ -102,6 +105,21 @@ float angleDegrees(const Quatf& a, const Quatf& b) {
 
 }  // namespace
 
+void LimbClearance::addLimb(Limb limb, const std::vector<uint32_t>& vertices, const BodyCollider& trunk,
+                            const std::vector<RigidTransform>& restGlobal) {
+  const Vec3f head = restGlobal[size_t(limb.rootJoint)].translation;
+  for (const uint32_t v : vertices) {
+    const Vec3f x = body_.positions.row(v);
+    if ((x - head).norm() <= settings_.rootRadius) continue;
+    const BodyCollider::Hit hit = trunk.closest(x, kSearch);
+    const float d = hit.found ? hit.signedDistance : std::numeric_limits<float>::infinity();
+    if (!(d > 0.f)) continue;  // inside the trunk at rest: the part's root, meant to overlap
+    limb.vertices.push_back(v);
+    limb.restDistance.push_back(d);
+  }
+  if (!limb.vertices.empty()) limbs_.push_back(std::move(limb));
+}
+
 LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings)
     : skeleton_(ch.skeleton), body_(ch.body), settings_(settings) {
   const std::string what = "body of character '" + ch.name + "'";
@@ -138,6 +156,7 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
   for (size_t i = 0; i < keep.size(); ++i) trunkMesh.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
   if (keep.size() == size_t(body_.triangles.rows())) {
     skipped_ = "the body is one connected mesh: no limbs to keep apart";
+    if (settings_.oneSurfaceLimbs) setUpLimbRegions(ch);
     setUpHead();
     return;
   }
@@ -179,18 +198,10 @@ LimbClearance::LimbClearance(const Character& ch, LimbClearanceSettings settings
         limb.rootJoint = j;
     // A part that moves with the root of the skeleton cannot be rotated away from anything.
     if (limb.rootJoint <= 0) continue;
-    const Vec3f head = g[size_t(limb.rootJoint)].translation;
-    for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
-      if (part[v] != p) continue;
-      const Vec3f x = body_.positions.row(v);
-      if ((x - head).norm() <= settings_.rootRadius) continue;
-      const BodyCollider::Hit hit = trunkCollider.closest(x, kSearch);
-      const float d = hit.found ? hit.signedDistance : std::numeric_limits<float>::infinity();
-      if (!(d > 0.f)) continue;  // inside the trunk at rest: the part's root, meant to overlap
-      limb.vertices.push_back(v);
-      limb.restDistance.push_back(d);
-    }
-    if (!limb.vertices.empty()) limbs_.push_back(std::move(limb));
+    std::vector<uint32_t> vertices;
+    for (uint32_t v = 0; v < body_.vertexCount(); ++v)
+      if (part[v] == p) vertices.push_back(v);
+    addLimb(std::move(limb), vertices, trunkCollider, g);
   }
 }
 
@@ -208,13 +219,17 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
   Pose p = pose;
   p.local[0] = skeleton_.joints[0].rest.rotation;
   p.rootTranslation = skeleton_.joints[0].rest.translation;
-  if (head_) {
-    if (std::optional<LimbCorrection> c = applyHead(pose, std::move(p))) out.push_back(*c);
-    return out;
-  }
+  if (!limbs_.empty()) applyLimbs(pose, p, out);
+  if (head_)
+    if (std::optional<LimbCorrection> c = applyHead(pose, p)) out.push_back(*c);
+  return out;
+}
 
-  // The trunk is posed once: turning a limb moves only the few trunk vertices its blends reach, near
-  // its root, where nothing is checked.
+void LimbClearance::applyLimbs(Pose& pose, Pose& p, std::vector<LimbCorrection>& out) const {
+  // The trunk of a body of parts is posed once: turning a limb moves only the few trunk vertices its
+  // blends reach, near its root, where nothing is checked. A one-surface body's trunk blends into its
+  // limbs (a MakeHuman side under the armpit is partly skinned to the arm), so it is posed again with the
+  // limb at every turn tried: posed once, the arms it cleared were 2.5 mm inside again when checked anew.
   BodyCollider trunk = *trunk_;
   trunk.pose(skeleton_.skinningMatrices(p));
   for (const Limb& limb : limbs_) {
@@ -223,6 +238,7 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
     Vec3f push = Vec3f::Zero(), centre = Vec3f::Zero();
     auto measure = [&] {
       const std::vector<Mat4f> m = skeleton_.skinningMatrices(p);
+      if (limbRegions_) trunk.pose(m);
       float worst = 0.f, total = 0.f;
       push.setZero();
       centre.setZero();
@@ -269,7 +285,6 @@ std::vector<LimbCorrection> LimbClearance::apply(Pose& pose) const {
     c.depthAfter = after > kTolerance ? after : 0.f;
     out.push_back(c);
   }
-  return out;
 }
 
 std::optional<LimbCorrection> LimbClearance::limitNeck(Pose& pose) const {
@@ -286,10 +301,99 @@ std::optional<LimbCorrection> LimbClearance::limitNeck(Pose& pose) const {
   return c;
 }
 
+void LimbClearance::skip(const std::string& why) { skipped_ += (skipped_.empty() ? "" : "; ") + why; }
+
+void LimbClearance::setUpLimbRegions(const Character& ch) {
+  const std::string what = "body of character '" + ch.name + "'";
+  // The limb joints: per kind, the shallowest joint whose name ends so.
+  std::vector<int> roots;
+  for (const char* kind : {"leftarm", "rightarm", "leftupleg", "rightupleg"}) {
+    int root = -1;
+    for (int j = 1; j < int(skeleton_.size()); ++j)
+      if (io::normaliseJointName(skeleton_.joints[size_t(j)].name).ends_with(kind) &&
+          (root < 0 || depthOf(skeleton_, j) < depthOf(skeleton_, root)))
+        root = j;
+    if (root > 0) roots.push_back(root);
+  }
+  if (roots.empty()) {
+    skip("no joint named ...LeftArm, ...RightArm, ...LeftUpLeg or ...RightUpLeg: no limb regions either");
+    return;
+  }
+  // Per joint, the limb whose subtree holds it (-1: the trunk); per vertex, that of its strongest joint.
+  std::vector<int> jointLimb(skeleton_.size(), -1);
+  for (size_t j = 0; j < skeleton_.size(); ++j)
+    for (int a = int(j); a >= 0 && jointLimb[j] < 0; a = skeleton_.joints[size_t(a)].parent)
+      for (size_t r = 0; r < roots.size(); ++r)
+        if (roots[r] == a) jointLimb[j] = int(r);
+  std::vector<int> vertexLimb(body_.vertexCount());
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) vertexLimb[v] = jointLimb[body_.skin.strongestJoint(v)];
+  // The trunk: the triangles with no corner in a limb region.
+  Mesh trunkMesh = body_;
+  std::vector<Eigen::Index> keep;
+  std::vector<std::vector<uint32_t>> regionVertices(roots.size());
+  std::vector<char> used(body_.vertexCount(), 0);
+  for (Eigen::Index t = 0; t < body_.triangles.rows(); ++t) {
+    bool trunk = true;
+    for (int c = 0; c < 3; ++c) {
+      used[body_.triangles(t, c)] = 1;
+      trunk = trunk && vertexLimb[body_.triangles(t, c)] < 0;
+    }
+    if (trunk) keep.push_back(t);
+  }
+  // One vertex per kRegionSpacing cell (the first by index): a realistic body's limbs hold thousands of
+  // vertices (its fingers most), and a pose's check measures each of them several times.
+  std::unordered_set<uint64_t> cells;
+  for (uint32_t v = 0; v < body_.vertexCount(); ++v) {
+    if (!used[v] || vertexLimb[v] < 0) continue;
+    const Eigen::Vector3i c = (body_.positions.row(v).transpose() / kRegionSpacing).array().floor().cast<int>();
+    const uint64_t key = (uint64_t(uint32_t(vertexLimb[v])) << 60) ^ (uint64_t(uint32_t(c.x()) & 0xFFFFF) << 40) ^
+                         (uint64_t(uint32_t(c.y()) & 0xFFFFF) << 20) ^ uint64_t(uint32_t(c.z()) & 0xFFFFF);
+    if (cells.insert(key).second) regionVertices[size_t(vertexLimb[v])].push_back(v);
+  }
+  if (keep.empty() || keep.size() == size_t(body_.triangles.rows())) {
+    skip("the limb joints' skin regions leave no trunk, or no limb: no limb regions either");
+    return;
+  }
+  trunkMesh.triangles.resize(Eigen::Index(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) trunkMesh.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
+  trunk_.emplace(trunkMesh, kCell, what + " (without its limb regions)");
+  // Kept clear: the trunk near the garment, away from the seams where the limb regions were cut off (an
+  // open surface's sign means nothing at its openings).
+  guarded_.assign(size_t(trunk_->triangles().rows()), 1);
+  if (settings_.garmentReach > 0.f && ch.garment.vertexCount() > 0 && ch.garment.positions.allFinite())
+    guarded_ = trianglesNearGarment(body_.positions, trunk_->triangles(), ch.garment.positions, settings_.garmentReach);
+  size_t limbVertexCount = 0;
+  for (const auto& r : regionVertices) limbVertexCount += r.size();
+  Points3f limbPoints(Eigen::Index(limbVertexCount), 3);
+  Eigen::Index k = 0;
+  for (const auto& r : regionVertices)
+    for (uint32_t v : r) limbPoints.row(k++) = body_.positions.row(v);
+  const std::vector<char> seam =
+      trianglesNearGarment(body_.positions, trunk_->triangles(), limbPoints, settings_.seamBorder);
+  for (size_t t = 0; t < guarded_.size(); ++t)
+    if (seam[t]) guarded_[t] = 0;
+  const Pose rest = skeleton_.restPose();
+  BodyCollider trunkCollider = *trunk_;
+  trunkCollider.pose(skeleton_.skinningMatrices(rest));
+  const auto g = skeleton_.globalTransforms(rest);
+  for (size_t r = 0; r < roots.size(); ++r) {
+    Limb limb;
+    limb.rootJoint = roots[r];
+    addLimb(std::move(limb), regionVertices[r], trunkCollider, g);
+  }
+  if (limbs_.empty()) {
+    skip("no vertex of the limb regions lies outside the trunk farther than rootRadius from its root joint");
+    trunk_.reset();
+    return;
+  }
+  limbRegions_ = true;
+  skipped_.clear();
+}
+
 void LimbClearance::setUpHead() {
   const std::string what = "body";
   if (neckChain_.empty()) {
-    skipped_ += "; no joint named 'Head': the head is not checked either";
+    skip("no joint named 'Head': the head is not checked either");
     return;
   }
   Head h;
@@ -312,15 +416,15 @@ void LimbClearance::setUpHead() {
     if (heads < 2) keep.push_back(t);
   }
   if (keep.size() == size_t(body_.triangles.rows()) || keep.empty()) {
-    skipped_ += "; the head has no triangles of its own: it is not checked";
+    skip("the head has no triangles of its own: it is not checked");
     return;
   }
   others.triangles.resize(Eigen::Index(keep.size()), 3);
   for (size_t i = 0; i < keep.size(); ++i) others.triangles.row(Eigen::Index(i)) = body_.triangles.row(keep[i]);
   h.whole.emplace(body_, kCell, what);
   if (h.whole->openEdges() > 0) {
-    skipped_ += "; the body is not a closed surface (" + std::to_string(h.whole->openEdges()) +
-                " open edges): the head is not checked";
+    skip("the body is not a closed surface (" + std::to_string(h.whole->openEdges()) +
+         " open edges): the head is not checked");
     return;
   }
   h.rest.emplace(others, kCell, what + " (without the head)");
@@ -340,7 +444,7 @@ void LimbClearance::setUpHead() {
     h.vertices.push_back(v);
   }
   if (h.vertices.empty()) {
-    skipped_ += "; no head vertex lies " + std::to_string(settings_.headBorder) + " m from the rest of the body";
+    skip("no head vertex lies " + std::to_string(settings_.headBorder) + " m from the rest of the body");
     return;
   }
   skipped_.clear();
@@ -395,6 +499,7 @@ std::optional<LimbCorrection> LimbClearance::applyHead(Pose& pose, Pose p) const
   LimbCorrection c{skeleton_.joints[size_t(neckChain_.front())].name, 0.f, before, after > kTolerance ? after : 0.f,
                    float(percent) / 100.f};
   c.degrees = angleDegrees(headInChain(recorded), headInChain(p));
+  c.head = true;
   return c;
 }
 

@@ -19,8 +19,19 @@
 // root joint is the shallowest joint carrying a tenth of its skin weight. Only limb vertices that lie
 // outside the trunk in the rest pose and farther than rootRadius from the root joint are checked:
 // the root of a tube starts inside the trunk by construction. A body that is one connected mesh has
-// no parts to separate, and a trunk that is not a closed surface has no inside; the limbs of either
-// are left unchanged (skipped() says why).
+// no parts of its own: its limbs are regions of its skin instead (below). A trunk that is not a closed
+// surface has no inside; the limbs of such a body are left unchanged (skipped() says why).
+//
+// Limbs of a body that is ONE surface (a glTF character: the shared T-shirt's MakeHuman body). Its arms
+// hang against its sides in a walk just as the mannequin's tubes pass into its torso, and a sleeve
+// pinched there explodes the solve (21 of 30 poses of unseen CMU subjects on the shared T-shirt,
+// docs/baking.md). So each limb is the skin region of a limb joint (named, as the importer compares
+// names, ...LeftArm, ...RightArm, ...LeftUpLeg or ...RightUpLeg: every vertex whose strongest joint is
+// that joint or below it), its root that joint, and the trunk is the rest of the body (the triangles with
+// no corner in a limb region): an open surface whose sign is trusted away from its openings, so the trunk
+// triangles within seamBorder of a limb region at rest (the armpit's and the groin's seams) are never
+// kept clear, and limb vertices are checked as a part's are (beyond rootRadius from the root joint,
+// outside the trunk at rest). Then the same turn as a part's. Off with oneSurfaceLimbs.
 //
 // Head clearance. A body that is ONE closed surface (a glTF character) has no limb parts, but its head
 // can still pass into its own chest: a clip that bows the head further than the body's skinning
@@ -64,6 +75,11 @@ struct LimbClearanceSettings {
   // reads no neck joint, so what the neck does beyond this only adds shapes it cannot explain. Part of
   // the limb clearance: a bake without it (limb_clearance 0) leaves the neck as recorded too.
   float neckRangeDegrees = 90.f;
+  // Whether a body that is one surface has its limbs (skin regions) kept out of its trunk (above).
+  // Recipes: part1.simulation.limb_one_surface (settings recorded before it: false, so that models
+  // baked before keep their truth).
+  bool oneSurfaceLimbs = true;
+  float seamBorder = 0.03f;  // m: one-surface trunk triangles this close to a limb region at rest are not kept clear
 };
 
 struct LimbCorrection {
@@ -77,6 +93,8 @@ struct LimbCorrection {
   // The neck range (joint: the head joint; `degrees` taken off the chain's turn from rest), not a limb
   // turned out of the trunk.
   bool neckRange = false;
+  // Head clearance (a one-surface body's head out of its chest), not a limb turned out of the trunk.
+  bool head = false;
 };
 
 class LimbClearance {
@@ -94,6 +112,8 @@ class LimbClearance {
   size_t trunkTriangles() const { return guarded_.size(); }
   // Why no limb is checked (empty when some are).
   const std::string& skipped() const { return skipped_; }
+  // Whether the limbs are skin regions of a body that is one surface (above), not parts of their own.
+  bool limbsAreRegions() const { return limbRegions_; }
   // Whether the head of a one-surface body is checked (see above), and how many of its vertices.
   bool checksHead() const { return head_.has_value(); }
   size_t headVertexCount() const { return head_ ? head_->vertices.size() : 0; }
@@ -111,6 +131,18 @@ class LimbClearance {
   LimbClearanceSettings settings_;
   std::vector<Limb> limbs_;
   std::string skipped_;
+  bool limbRegions_ = false;
+  // A body that is one surface: its limbs as skin regions and the rest as the trunk (above).
+  void setUpLimbRegions(const Character& character);
+  // The limbs (parts or regions) against the trunk, in place; p: `pose` with its root at rest.
+  void applyLimbs(Pose& pose, Pose& p, std::vector<LimbCorrection>& out) const;
+  // Appends a reason to skipped_.
+  void skip(const std::string& why);
+  // Keeps `limb` (its root set) with its checked vertices among `vertices`: farther than rootRadius from
+  // the root joint's head and outside the rest-posed `trunk`, with their distance to it; a limb with none
+  // is dropped. Shared by parts and skin regions.
+  void addLimb(Limb limb, const std::vector<uint32_t>& vertices, const BodyCollider& trunk,
+               const std::vector<RigidTransform>& restGlobal);
 
   struct Head {
     std::vector<uint32_t> vertices;     // checked head vertices (the joints turned back: neckChain_)

@@ -141,6 +141,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"damping", 1.5},
                           {"limb_garment_reach", 0.1},
                           {"limb_neck_range", 45},
+                          {"limb_one_surface", false},
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25},
@@ -174,6 +175,15 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   EXPECT_FLOAT_EQ(d.part1->limbClearance.garmentReach, LimbClearanceSettings{}.garmentReach);
   EXPECT_FLOAT_EQ(s.limbClearance.neckRangeDegrees, 45.f);
   EXPECT_FLOAT_EQ(d.part1->limbClearance.neckRangeDegrees, 90.f);
+  // One-surface bodies' limbs: on by default, recorded, and off in settings recorded before the key (their
+  // truth is simulated as it was baked).
+  EXPECT_FALSE(s.limbClearance.oneSurfaceLimbs);
+  EXPECT_TRUE(d.part1->limbClearance.oneSurfaceLimbs);
+  EXPECT_EQ(d.part1->toJson()["simulation"]["limb_one_surface"], true);
+  EXPECT_TRUE(poseShapeSettingsFromJson(d.part1->toJson(), "dataset settings").limbClearance.oneSurfaceLimbs);
+  nlohmann::json beforeOneSurface = d.part1->toJson();
+  beforeOneSurface["simulation"].erase("limb_one_surface");
+  EXPECT_FALSE(poseShapeSettingsFromJson(beforeOneSurface, "dataset settings").limbClearance.oneSurfaceLimbs);
   EXPECT_FLOAT_EQ(d.part1->simulation.material.damping, clothMaterialPreset("jersey").damping);
   EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(s.toJson(), "dataset settings").simulation.material.damping, 1.5f);
   EXPECT_FALSE(d.part1->toJson()["simulation"].contains("damping"));  // the preset's: not recorded
@@ -253,6 +263,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"simulation", {{"limb_garment_reach", -0.1}}}}),
        "part1.simulation.limb_garment_reach: -0.1 is outside");
   says(part1Error({{"simulation", {{"limb_neck_range", 800}}}}), "part1.simulation.limb_neck_range: 800 is outside");
+  says(part1Error({{"simulation", {{"limb_one_surface", 1}}}}), "part1.simulation.limb_one_surface");
   says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
   says(part1Error({{"transfer", {{"cover_body_mm", 30}}}}), "part1.transfer.cover_body_mm: 30 is outside");
   says(part1Error({{"transfer", {{"cover_recorded_pose", 1}}}}),
