@@ -13,7 +13,8 @@
 // edge strain below 70%; an explosion stretches it beyond 100%) and the last frames' motion within
 // 50x the equilibrium tolerance. Measured at the time of writing (default character, 3000 vertices):
 // the 99th percentile strain was 30-63% and the residual 0.01-0.26 on these poses (arms crossed the
-// worst; on the T-shirt they left 6.9 mm inside, pinched between arm and chest), the stiff jersey 35%
+// worst; on the T-shirt they left 6.9 mm inside, pinched between arm and chest; 4.4 mm since its arms are
+// turned out of its trunk, session 29), the stiff jersey 35%
 // even at rest: far from the goals of issue 18, which these tests do not
 // claim. A limb put through the chest explodes on both characters even after the retry (DISABLED_
 // below, so that the suite stays green while it is the known gap).
@@ -263,9 +264,9 @@ TEST(ClothExtremePoses, SharedTshirt) {
   runCases(io::importCharacter(file), 0.03f, "T-shirt");
 }
 
-// Known gap (issue 18): the T-shirt's body is one surface, so limb clearance does not apply
-// (limb_clearance.hpp), and the cloth caught between the arm and the chest explodes near the left
-// upper arm, and near Spine on the retry.
+// Known gap (issue 18): the T-shirt's body is one surface; since session 29 limb clearance turns its arms
+// out as skin regions (limb_clearance.hpp), but the arm aimed through the chest still explodes near the
+// left upper arm on every attempt (frame 15 of the first, 26 of the last).
 TEST(ClothExtremePoses, DISABLED_SharedTshirtLimbThroughTheBody) {
   const auto file = tshirtFile();
   if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared test character absent: " << file;
