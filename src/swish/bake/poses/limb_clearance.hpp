@@ -24,14 +24,14 @@
 //
 // Limbs of a body that is ONE surface (a glTF character: the shared T-shirt's MakeHuman body). Its arms
 // hang against its sides in a walk just as the mannequin's tubes pass into its torso, and a sleeve
-// pinched there explodes the solve (21 of 30 poses of unseen CMU subjects on the shared T-shirt,
-// docs/baking.md). So each limb is the skin region of a limb joint (named, as the importer compares
-// names, ...LeftArm, ...RightArm, ...LeftUpLeg or ...RightUpLeg: every vertex whose strongest joint is
-// that joint or below it), its root that joint, and the trunk is the rest of the body (the triangles with
-// no corner in a limb region): an open surface whose sign is trusted away from its openings, so the trunk
-// triangles within seamBorder of a limb region at rest (the armpit's and the groin's seams) are never
-// kept clear, and limb vertices are checked as a part's are (beyond rootRadius from the root joint,
-// outside the trunk at rest). Then the same turn as a part's. Off with oneSurfaceLimbs.
+// pinched there explodes the solve (4 of 30 thinned poses of unseen CMU subjects on the shared T-shirt,
+// none with this step; docs/baking.md). So each limb is the skin region of a limb joint (named, as the importer
+// compares names, ...LeftArm, ...RightArm, ...LeftUpLeg or ...RightUpLeg: every vertex whose strongest joint is that
+// joint or below it), its root that joint, and the trunk is the rest of the body (the triangles with no corner in a
+// limb region): an open surface whose sign is trusted away from its openings, so the trunk triangles within seamBorder
+// of a limb region at rest (the armpit's and the groin's seams) are never kept clear, and limb vertices are checked as
+// a part's are (beyond rootRadius from the root joint, outside the trunk at rest). Then the same turn as a part's. Off
+// with oneSurfaceLimbs.
 //
 // Head clearance. A body that is ONE closed surface (a glTF character) has no limb parts, but its head
 // can still pass into its own chest: a clip that bows the head further than the body's skinning

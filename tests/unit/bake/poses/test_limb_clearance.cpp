@@ -407,7 +407,7 @@ size_t armSamplesInsideTheBody(const Character& c, const Pose& pose) {
 
 // A body that is one surface (a MakeHuman body: the shared T-shirt character) has no limb parts: its arms
 // and legs are the skin regions of LeftArm, RightArm, LeftUpLeg and RightUpLeg, and arms hanging into its
-// sides (as the CMU walks hold them, which exploded 21 of 30 unseen poses of the T-shirt) are turned out as
+// sides (as the CMU walks hold them: 4 of 30 unseen poses of the T-shirt exploded there) are turned out as
 // a part would be. Bakes recorded before it (limb_one_surface absent: oneSurfaceLimbs false) leave them.
 TEST(LimbClearance, OneSurfaceBodyArmsHangingIntoItsSidesAreTurnedOut) {
   const Character* c = tshirtCharacter();
