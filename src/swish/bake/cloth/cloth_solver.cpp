@@ -152,6 +152,7 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
 
   restLocal_ = mesh_.restPositions.rowwise() - origin_.transpose();
   constraints_ = buildClothConstraints(mesh_, restLocal_, settings_.material);
+  schedule_ = buildConstraintSchedule(constraints_);
   if (!constraints_.stretch.empty()) {
     std::vector<float> rest;
     for (const DistanceConstraint& c : constraints_.stretch) rest.push_back(c.rest);
@@ -485,9 +486,20 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, Cloth
       for (int it = 0; it < iterations; ++it) {
         if (it == 0) std::fill(lambda.begin(), lambda.end(), 0.f);
         float* l = lambda.data();
-        for (const DistanceConstraint& c : cc.stretch) projectDistance(c, x.data(), w, invDt2, *l++);
-        for (const ShearConstraint& c : cc.shear) projectShear(c, x.data(), w, invDt2, *l++);
-        for (const DistanceConstraint& c : cc.bending) projectDistance(c, x.data(), w, invDt2, *l++);
+        if (s.sweepKernel == SweepKernel::Sequential) {
+          for (const DistanceConstraint& c : cc.stretch) projectDistance(c, x.data(), w, invDt2, *l++);
+          for (const ShearConstraint& c : cc.shear) projectShear(c, x.data(), w, invDt2, *l++);
+          for (const DistanceConstraint& c : cc.bending) projectDistance(c, x.data(), w, invDt2, *l++);
+        } else {
+          // The same projections in dependency levels (constraint_schedule.hpp): bitwise the same shape.
+          const bool vector = s.sweepKernel == SweepKernel::Vector;
+          sweep(schedule_.stretch, x.data(), w, invDt2, l, vector);
+          l += cc.stretch.size();
+          sweep(schedule_.shear, x.data(), w, invDt2, l, vector);
+          l += cc.shear.size();
+          sweep(schedule_.bending, x.data(), w, invDt2, l, vector);
+          l += cc.bending.size();
+        }
         for (size_t a = 0; a < attached_.size(); ++a, ++l) {
           const uint32_t v = attached_[a];
           V3 xv(x.data() + 3 * size_t(v));

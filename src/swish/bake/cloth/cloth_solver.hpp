@@ -16,6 +16,7 @@
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/cloth/cloth_constraints.hpp"
 #include "swish/bake/cloth/cloth_material.hpp"
+#include "swish/bake/cloth/constraint_schedule.hpp"
 #include "swish/bake/cloth/simulation_mesh.hpp"
 #include "swish/bake/dataset/dataset.hpp"
 
@@ -37,6 +38,15 @@ enum class ClothCarry {
 };
 // "skinning" | "translation": the names recipes and reports use.
 const char* clothCarryName(ClothCarry carry);
+
+// How a sweep runs its stretch, shear and bending blocks. All three give bitwise the same answer
+// (constraint_schedule.hpp), so the choice is not part of the fingerprint; it is there for benchmarks
+// and the tests that check the equality.
+enum class SweepKernel {
+  Sequential,  // the constraints one after another, in the order they were built
+  Levels,      // in dependency levels, one at a time (the scalar twin of Vector)
+  Vector,      // in dependency levels, eight at a time where the processor has AVX2 (the default)
+};
 
 struct ClothSimSettings {
   ClothMaterial material = clothMaterialPreset("jersey");
@@ -91,6 +101,7 @@ struct ClothSimSettings {
   // left out.
   int retries = 1;
   ClothCarry carry = ClothCarry::Skinning;
+  SweepKernel sweepKernel = SweepKernel::Vector;
   // The carries each retry tries in turn until one simulates (the first attempt uses `carry`). Measured
   // on the default bake's 3929 poses: the skinning carry then the translation carry keeps every pose
   // the skinning retry keeps, with the same shape, and 13 of the 24 it loses (docs/baking.md, "The carry").
@@ -164,6 +175,7 @@ class ClothSolver {
   Vec3f origin_;        // the solve's origin in character space
   Points3f restLocal_;  // simulation mesh rest positions relative to origin_
   ClothConstraints constraints_;
+  ConstraintSchedule schedule_;  // constraints_' stretch, shear and bending blocks in dependency levels
   std::vector<uint32_t> attached_;
   std::vector<float> attachCompliance_;  // per attached vertex: 1 / its share of the band's stiffness
   // Where each attached vertex sits relative to the body in the rest pose: its closest body triangle
