@@ -77,6 +77,10 @@ struct ModelInfo {
   std::vector<Quat> restRotations;                     // the rest (A-)pose, per joint
   std::vector<std::array<float, 3>> restTranslations;  // per joint, relative to the parent
   std::vector<uint32_t> inputJoints;                   // joints the network reads (indices)
+  // The network also reads the body's lean: the gravity direction in the root joint's frame, from the
+  // root's rotation in the pose a host passes. A host whose character stands on a tilted floor or a
+  // moving deck passes the root's rotation relative to gravity.
+  bool rootGravity = false;
   uint32_t vertexCount = 0;
   uint32_t triangleCount = 0;
   std::vector<float> restPositions;       // 3 per vertex, the rest pose in character space (bounds, culling)

@@ -64,6 +64,7 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
   }
   m.skeleton.computeInverseBindFromRest();
   for (uint32_t i = 0; i < s.inputJoints; ++i) m.inputJoints.push_back(i % s.joints);
+  m.rootGravity = s.rootGravity;
 
   // Mesh: vertices on a grid of cols x rows (the last row may be partial), triangles between full cells.
   const uint32_t n = s.vertices;

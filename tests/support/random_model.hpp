@@ -11,6 +11,7 @@ namespace swish::test {
 struct RandomModelSpec {
   uint32_t joints = 8;          // skeleton size (a chain with a few branches)
   uint32_t inputJoints = 4;     // Theta joints
+  bool rootGravity = false;     // Theta ends with the gravity values (Model::rootGravity)
   uint32_t vertices = 100;      // game-mesh vertices (a strip of triangles over a UV-mapped grid)
   uint32_t influences = 4;      // skin influences per vertex, 1..8
   uint32_t meshComponents = 6;  // K

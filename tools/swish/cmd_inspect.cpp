@@ -54,8 +54,10 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
 
   json inputs = json::array();
   for (uint32_t idx : m.inputJoints) inputs.push_back({{"index", idx}, {"name", m.skeleton.joints[idx].name}});
-  j["skeleton"] = {
-      {"joints", m.skeleton.size()}, {"inputJoints", inputs}, {"jointsWithSkinWeight", skinnedJointCount(m.gameMesh)}};
+  j["skeleton"] = {{"joints", m.skeleton.size()},
+                   {"inputJoints", inputs},
+                   {"rootGravity", m.rootGravity},
+                   {"jointsWithSkinWeight", skinnedJointCount(m.gameMesh)}};
 
   json layers = json::array();
   for (const auto& l : m.mlp.layers) layers.push_back({{"in", l.weight.cols()}, {"out", l.weight.rows()}});
@@ -108,6 +110,7 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
     << " carry skin weight\n";
   o << "  input joints  " << m.inputJoints.size() << " (Theta = " << m.thetaSize() << " values):";
   for (uint32_t idx : m.inputJoints) o << " " << m.skeleton.joints[idx].name;
+  if (m.rootGravity) o << ", then gravity in the root joint's frame (3)";
   o << "\n";
   o << "  mlp           " << mlpShape(m.mlp) << " (SELU; " << m.mlp.layers.size() << " layers, " << mlpParameters(m.mlp)
     << " parameters)\n";

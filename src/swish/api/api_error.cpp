@@ -56,6 +56,7 @@ ModelInfo describeModel(const swish::Model& m, const std::string& name) {
     info.restTranslations.push_back({j.rest.translation.x(), j.rest.translation.y(), j.rest.translation.z()});
   }
   info.inputJoints = m.inputJoints;
+  info.rootGravity = m.rootGravity;
   const Mesh& g = m.gameMesh;
   info.vertexCount = uint32_t(g.vertexCount());
   info.triangleCount = uint32_t(g.triangleCount());

@@ -31,8 +31,11 @@ void Model::validate(const std::string& what) const {
                       n2s(mlp.layers[l - 1].weight.rows()));
     if (!L.weight.allFinite() || !L.bias.allFinite()) fail("mlp", "layer " + n2s(l) + " has non-finite values");
   }
-  if (mlp.inputSize() != thetaSize())
-    fail("mlp", "input size " + n2s(mlp.inputSize()) + " != 6 x " + n2s(inputJoints.size()) + " input joints");
+  if (mlp.inputSize() != thetaSize()) {
+    const std::string gravity = rootGravity ? " + 3 gravity values" : "";
+    fail("mlp",
+         "input size " + n2s(mlp.inputSize()) + " != 6 x " + n2s(inputJoints.size()) + " input joints" + gravity);
+  }
   // In 64 bits: a corrupt file's sizes may not fit an int (found by fuzz_model_loader).
   if (int64_t(mlp.outputSize()) != int64_t(meshPca.basis.cols()) + int64_t(normalMaps.keys.cols()))
     fail("mlp", "output size " + n2s(mlp.outputSize()) + " != " + n2s(meshPca.basis.cols()) + " mesh components + " +

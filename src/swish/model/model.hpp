@@ -4,6 +4,7 @@
 //
 // Per frame (paper section 2.3):
 //   Theta  = 6D rotations of inputJoints, in order            (size 6 * inputJoints.size())
+//            [+ gravity in the root joint's frame, 3 values, when rootGravity: runtime/theta.hpp]
 //   Lambda = denormalise(MLP(normalise(Theta)))               (size meshComponents + normalCodeDims)
 //   mesh weights = Lambda[0 .. K), normal code = Lambda[K .. K + C)
 //   pre-skin shape = meshPca.mean + meshPca.basis * weights  ->  linear blend skinning
@@ -160,8 +161,11 @@ struct BodyCoverage {
 struct Model {
   Skeleton skeleton;                  // the character's skeleton (for FK and skinning)
   std::vector<uint32_t> inputJoints;  // skeleton joint indices forming Theta, in this order
-  Normalisation inputNorm;            // over Theta
-  Normalisation outputNorm;           // over Lambda
+  // Theta ends with the gravity direction in the root joint's frame (3 values, runtime/theta.hpp): the
+  // body's lean, which the garment hangs by. false in models baked without it (the bake's default).
+  bool rootGravity = false;
+  Normalisation inputNorm;   // over Theta
+  Normalisation outputNorm;  // over Lambda
   Mlp mlp;
   MeshPca meshPca;
   Mesh gameMesh;                 // rest positions, triangles, UVs, skin, rest normals+tangents
@@ -172,7 +176,7 @@ struct Model {
   BodyCoverage bodyCoverage;    // may be empty (models before format 1.2, or baked without a body)
   std::string metadata = "{}";  // free-form JSON: bake settings, errors measured at bake time
 
-  int thetaSize() const { return int(inputJoints.size()) * 6; }
+  int thetaSize() const { return int(inputJoints.size()) * 6 + (rootGravity ? 3 : 0); }
   int meshComponents() const { return meshPca.components(); }
   int normalCodeDims() const { return int(normalMaps.codeDims()); }
   int lambdaSize() const { return meshComponents() + normalCodeDims(); }

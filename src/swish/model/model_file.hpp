@@ -26,7 +26,10 @@
 //   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
 //          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
 //          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
-//   "INPJ" input joints: u32 n, u32[n] skeleton joint indices. Theta = their 6D rotations in order.
+//   "INPJ" input joints: u32 n, u32[n] skeleton joint indices. Theta = their 6D rotations in order. A
+//          last index 0xFFFFFFFF is no joint: Theta then ends with the gravity direction in the root
+//          joint's frame, 3 values (Model::rootGravity; readers from before it refuse such a file,
+//          naming an input joint beyond the skeleton).
 //   "NRMI" input normalisation over Theta:   u32 n, f32[n] mean, f32[n] scale. x' = (x - mean) / scale.
 //   "NRMO" output normalisation over Lambda: u32 n, f32[n] mean, f32[n] scale.
 //   "MLP " u32 layer count; per layer: u32 out, u32 in, f32[out*in] weight (column-major, out x in),

@@ -56,14 +56,22 @@ void readSkeleton(ByteReader& r, Model& m) {
 }
 
 // ---- INPJ -------------------------------------------------------------------------------------
+// The gravity values (Model::rootGravity) are an entry kRootGravityInput after the joints: a file with
+// them is refused by readers from before them (an input joint beyond the skeleton), and a file without
+// them reads as ever.
+constexpr uint32_t kRootGravityInput = 0xFFFFFFFFu;
+
 void writeInputJoints(const Model& m, ByteWriter& w) {
-  w.u32(count32(m.inputJoints.size(), "input joint"));
+  w.u32(count32(m.inputJoints.size() + (m.rootGravity ? 1 : 0), "input joint"));
   w.u32s(m.inputJoints);
+  if (m.rootGravity) w.u32(kRootGravityInput);
 }
 
 void readInputJoints(ByteReader& r, Model& m) {
   m.inputJoints.resize(r.checkCount(r.u32("input joint count"), 4, "input joint"));
   r.u32s(m.inputJoints.data(), m.inputJoints.size(), "input joint");
+  m.rootGravity = !m.inputJoints.empty() && m.inputJoints.back() == kRootGravityInput;
+  if (m.rootGravity) m.inputJoints.pop_back();
 }
 
 // ---- NRMI, NRMO -------------------------------------------------------------------------------

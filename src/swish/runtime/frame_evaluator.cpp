@@ -23,6 +23,7 @@ FrameEvaluator::FrameEvaluator(const Model& model, uint32_t characters, CpuKerne
 
 FrameEvaluator::FrameEvaluator(const Model& model, uint32_t characters, const FrameEvaluatorOptions& options)
     : inputJoints_(validated(model).inputJoints),
+      rootGravity_(model.rootGravity),
       characters_(characters),
       joints_(uint32_t(model.skeleton.size())),
       mlp_(model, options.kernel),
@@ -72,9 +73,10 @@ void FrameEvaluator::beginFrame() {
 }
 
 void FrameEvaluator::thetaOf(uint32_t c, std::span<const Quatf> localRotations) {
-  const size_t size = 6 * inputJoints_.size();
+  const size_t size = thetaSize(inputJoints_.size(), rootGravity_);
   issueScratch_.clear();  // keeps its capacity: a clean frame allocates nothing
-  computeTheta(inputJoints_, localRotations, std::span<float>(theta_.data() + c * size, size), &issueScratch_);
+  computeTheta(inputJoints_, rootGravity_, localRotations, std::span<float>(theta_.data() + c * size, size),
+               &issueScratch_);
   for (const ThetaJointIssue& i : issueScratch_) out_.jointIssues.push_back({c, i});
 }
 

@@ -103,6 +103,7 @@ class FrameEvaluator {
   const FrameOutput& finishFrame(std::span<const float> dtSeconds, double thetaStart);
 
   std::vector<uint32_t> inputJoints_;
+  bool rootGravity_ = false;  // Model::rootGravity
   uint32_t characters_ = 0, joints_ = 0;
   MlpEvaluator mlp_;
   NoveltyGuardEvaluator guard_;

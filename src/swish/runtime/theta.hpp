@@ -1,7 +1,11 @@
 #pragma once
 // Theta, the network's input (paper section 2.1): the 6D rotation representation (Zhou et al. 2020) of
 // the model's input joints, in the model's order, 6 floats per joint, with core/rotation.hpp's toRot6
-// convention ([R00, R10, R20, R01, R11, R21], identity -> [1,0,0, 0,1,0]).
+// convention ([R00, R10, R20, R01, R11, R21], identity -> [1,0,0, 0,1,0]); then, in models that ask
+// for it (Model::rootGravity), the gravity direction in the root joint's frame, R_root^-1 (0, -1, 0):
+// 3 floats that tell the body's lean against gravity, which the source simulation's cloth hangs by
+// (about 0.5 mm of the jersey per degree, docs/baking.md) and no joint's local rotation holds. The
+// root is skeleton joint 0 (parents come first); its heading (a turn about +Y) does not change it.
 //
 // Policy for quaternions that arrive from outside (animation files, a host engine), documented here and
 // applied through core's sanitizeQuaternion:
@@ -35,8 +39,8 @@ struct ThetaReport {
   bool clean() const { return renormalised == 0 && invalid == 0; }
 };
 
-// Builds Theta for one character. `localRotations` are the local rotations of the whole skeleton (as in
-// Pose::local); `inputJoints` the model's input joints (Model::inputJoints). `theta` must hold exactly
+// Builds Theta for one character (without the gravity values). `localRotations` are the local rotations of the whole
+// skeleton (as in Pose::local); `inputJoints` the model's input joints (Model::inputJoints). `theta` must hold exactly
 // 6 * inputJoints.size() floats. Issues are appended to `issues` when it is not null (no allocation when
 // every joint is clean). Throws Error if a joint index is outside `localRotations` or `theta` has the
 // wrong size: those are programming errors of the caller, not bad data.
@@ -46,5 +50,17 @@ ThetaReport computeTheta(std::span<const uint32_t> inputJoints, std::span<const 
 // Convenience: returns Theta as a new vector (tests, tools). Same policy.
 std::vector<float> computeTheta(std::span<const uint32_t> inputJoints, std::span<const Quatf> localRotations,
                                 ThetaReport* report = nullptr, std::vector<ThetaJointIssue>* issues = nullptr);
+
+// The same with the gravity values after the joints' blocks when `rootGravity` (theta: 6 x joints + 3
+// floats). The root's rotation is sanitised by the same policy; an issue with it names joint 0 and the
+// slot after the last joint.
+ThetaReport computeTheta(std::span<const uint32_t> inputJoints, bool rootGravity, std::span<const Quatf> localRotations,
+                         std::span<float> theta, std::vector<ThetaJointIssue>* issues = nullptr);
+std::vector<float> computeTheta(std::span<const uint32_t> inputJoints, bool rootGravity,
+                                std::span<const Quatf> localRotations, ThetaReport* report = nullptr,
+                                std::vector<ThetaJointIssue>* issues = nullptr);
+
+// Theta's size: 6 per joint, 3 more with the gravity values.
+inline size_t thetaSize(size_t inputJoints, bool rootGravity) { return 6 * inputJoints + (rootGravity ? 3 : 0); }
 
 }  // namespace swish::runtime

@@ -179,6 +179,7 @@ void expectBitwiseEqual(const Model& a, const Model& b) {
   for (size_t i = 0; i < a.skeleton.inverseBind.size(); ++i)
     EXPECT_TRUE(sameBits(a.skeleton.inverseBind[i], b.skeleton.inverseBind[i])) << "inverse bind " << i;
   EXPECT_EQ(a.inputJoints, b.inputJoints);
+  EXPECT_EQ(a.rootGravity, b.rootGravity);
   EXPECT_TRUE(sameBits(a.inputNorm.mean, b.inputNorm.mean));
   EXPECT_TRUE(sameBits(a.inputNorm.scale, b.inputNorm.scale));
   EXPECT_TRUE(sameBits(a.outputNorm.mean, b.outputNorm.mean));
@@ -344,6 +345,9 @@ TEST(ModelFile, RoundTripIsBitwiseExactForManyShapes) {
   s.influences = 1;
   s.hiddenLayers = 0;
   shapes.push_back({"1 influence, linear MLP", s});
+  s = {};
+  s.rootGravity = true;
+  shapes.push_back({"gravity in the root's frame after the input joints", s});
   s = {};
   s.bodyAnchors = true;
   shapes.push_back({"body anchors", s});
@@ -865,4 +869,39 @@ TEST(ModelFile, FailedSaveLeavesTheExistingFileIntact) {
   std::sort(entries.begin(), entries.end());
   EXPECT_EQ(entries, (std::vector<std::string>{"folder.swish", "model.swish"}));
   expectBitwiseEqual(swish::loadModel(path), good);
+}
+
+// Model::rootGravity rides in INPJ as a last entry 0xFFFFFFFF (no new section): a file without it reads
+// as before, one with it loses the entry into the flag, and a reader that predates it would see an input
+// joint beyond the skeleton (Model::validate's message, checked here by placing the entry first).
+TEST(ModelFile, RootGravityIsALastInputEntry) {
+  swish::Rng rng(77);
+  RandomModelSpec s;
+  s.rootGravity = true;
+  Model m = swish::test::makeRandomModel(rng, s);
+  EXPECT_EQ(m.thetaSize(), 6 * int(m.inputJoints.size()) + 3);
+  auto sections = splitSections(swish::serializeModel(m));
+  const auto& inpj = sectionOf(sections, "INPJ").payload;
+  ASSERT_EQ(inpj.size(), 4u * (1 + m.inputJoints.size() + 1));
+  auto u32At = [&](size_t at) {
+    uint32_t v;
+    std::memcpy(&v, inpj.data() + at, 4);
+    return v;
+  };
+  EXPECT_EQ(u32At(0), m.inputJoints.size() + 1);
+  EXPECT_EQ(u32At(4 * (1 + m.inputJoints.size())), 0xFFFFFFFFu);
+  EXPECT_TRUE(swish::deserializeModel(assemble(sections), "gravity").rootGravity);
+
+  // The entry anywhere but last is an input joint beyond the skeleton, and so is a network without room.
+  auto moved = sections;
+  auto& p = sectionOf(moved, "INPJ").payload;
+  std::swap_ranges(p.begin() + 4, p.begin() + 8, p.begin() + 4 + 4 * std::ptrdiff_t(m.inputJoints.size()));
+  EXPECT_CONTAINS(loadError(assemble(moved)), "input joints: index 4294967295 >= joint count");
+  m.rootGravity = false;  // the network still reads 3 more values
+  try {
+    m.validate("model");
+    ADD_FAILURE() << "a network reading 3 values more than Theta validated";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(std::string(e.what()), "input size");
+  }
 }
