@@ -5,6 +5,8 @@
 // dataset folder, and checks that a re-run skips part 2. (Part 1 is not wired into runBake yet.)
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -30,11 +32,13 @@ using namespace swish;
 using namespace swish::bake;
 
 namespace {
-Dataset syntheticDataset(uint64_t seed, int poses, uint32_t mapSize) {
+// `lean`: four joints (the root first), the first (largest) field driven by the root's lean (the gravity
+// direction in its frame) instead of a joint, the other two by joints 1 and 2.
+Dataset syntheticDataset(uint64_t seed, int poses, uint32_t mapSize, bool lean = false) {
   Rng rng(seed);
   test::RandomModelSpec spec;
   spec.vertices = 120;
-  spec.inputJoints = 3;
+  spec.inputJoints = lean ? 4 : 3;
   const Model base = test::makeRandomModel(rng, spec);
   Dataset ds;
   ds.character.name = "synthetic";
@@ -54,8 +58,11 @@ Dataset syntheticDataset(uint64_t seed, int poses, uint32_t mapSize) {
     DatasetPose p;
     p.id = uint32_t(i);
     p.pose = test::makeRandomPose(rng, ds.character.skeleton, 0.5f);
-    const std::vector<float> th = runtime::computeTheta(ds.inputJoints, p.pose.local);
-    const Eigen::Vector3f drive(std::sin(2.f * th[1]), th[4] * th[7], std::cos(3.f * th[13]));
+    const std::vector<float> th = runtime::computeTheta(ds.inputJoints, true, p.pose.local);
+    const size_t g = 6 * ds.inputJoints.size();  // the gravity values
+    const Eigen::Vector3f drive =
+        lean ? Eigen::Vector3f(2.f * (th[g + 2] + th[g]), std::sin(2.f * th[7]), th[10] * th[13])
+             : Eigen::Vector3f(std::sin(2.f * th[1]), th[4] * th[7], std::cos(3.f * th[13]));
     VecXf pre = Eigen::Map<const VecXf>(base.gameMesh.positions.data(), Eigen::Index(3 * n)) + fields * drive;
     p.gameMeshPreSkin = Eigen::Map<const Points3f>(pre.data(), Eigen::Index(n), 3);
     p.gameMeshWorld =
@@ -307,6 +314,36 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
             std::string::npos);
   st.inputJoints = {j0, j1, j0};
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("joint '" + j0 + "' is named twice"), std::string::npos);
+}
+
+// train.root_gravity: a shape that follows the root's lean, which no input joint's local rotation holds,
+// is learnt with the gravity values in Theta and not without them; the model carries them through its
+// file, and its own evaluation (the run-time path) reads them.
+TEST(BakePart2, TheRootsLeanIsLearntWithTheGravityValues) {
+  const uint64_t seed = test::testSeed(503);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const Dataset ds = syntheticDataset(seed, 160, 32, true);
+  BakeTrainSettings st = smallTraining();
+  st.normalCodeDims = 0;
+  const auto& joints = ds.character.skeleton.joints;
+  ASSERT_EQ(ds.inputJoints.front(), 0u);  // the root: the network must not read it as a joint
+  st.inputJoints = {joints[ds.inputJoints[1]].name, joints[ds.inputJoints[2]].name, joints[ds.inputJoints[3]].name};
+  const BakeTrainOutput without = trainBake(ds, st);
+  st.rootGravity = true;
+  const BakeTrainOutput with = trainBake(ds, st);
+  EXPECT_FALSE(without.model.rootGravity);
+  EXPECT_TRUE(with.model.rootGravity);
+  EXPECT_EQ(without.model.thetaSize(), 18);
+  EXPECT_EQ(with.model.thetaSize(), 21);
+  EXPECT_EQ(with.model.noveltyGuard.centres.cols(), 21);
+  EXPECT_EQ(nlohmann::json::parse(with.model.metadata)["settings"]["root_gravity"], true);
+  EXPECT_FALSE(nlohmann::json::parse(without.model.metadata)["settings"].contains("root_gravity"));
+  std::printf("regression error on held-out poses: %.3f mm with the gravity values, %.3f mm without\n",
+              with.evaluation.regressionMm.mean, without.evaluation.regressionMm.mean);
+  EXPECT_LT(with.evaluation.regressionMm.mean, 0.5 * without.evaluation.regressionMm.mean);
+  const Model back = deserializeModel(serializeModel(with.model), "with gravity");
+  EXPECT_TRUE(back.rootGravity);
+  EXPECT_EQ(back.inputJoints, with.model.inputJoints);
 }
 
 // Synthesized poses (part1.synthesis, ids from the dataset's synthesized_from_id on) are trained on and

@@ -384,7 +384,8 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "seed",
                                                   "bc5_baseline",
                                                   "input_joints",
-                                                  "anchor_calibration"});
+                                                  "anchor_calibration",
+                                                  "root_gravity"});
   BakeTrainSettings& t = cfg.train;
   t.meshComponents = int(train.wholeNumber("mesh_components", 1, 4096, t.meshComponents));
   t.meshVariance = train.number("mesh_variance", 0, 1, t.meshVariance);
@@ -422,6 +423,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   t.temporalTimeConstant = float(train.number("temporal_time_constant", 0, 10, t.temporalTimeConstant));
   t.seed = uint64_t(train.wholeNumber("seed", 0, 9.007199254740992e15, double(t.seed)));
   t.inputJoints = train.strings("input_joints", t.inputJoints);
+  t.rootGravity = train.boolean("root_gravity", t.rootGravity);
   t.bc5Baseline = train.boolean("bc5_baseline", t.bc5Baseline);
   if (train.has("anchor_calibration")) {
     const JsonReader c = train.child("anchor_calibration");

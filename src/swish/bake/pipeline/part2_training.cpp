@@ -43,6 +43,7 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (mlp.weightDecay > 0.0) j["weight_decay"] = mlp.weightDecay;  // absent when off (older fingerprints stay)
   if (mlp.inputNoise > 0.0) j["input_noise"] = mlp.inputNoise;     // likewise
   if (!calibrateAnchors) j["anchor_calibration"] = "none";         // likewise
+  if (rootGravity) j["root_gravity"] = true;                       // likewise
   return j;
 }
 
@@ -180,9 +181,11 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   // 3. MLP Theta -> Lambda = [mesh weights, normal code].
   report("MLP training", 0.5);
   const int K = out.meshPca.components(), C = maps ? int(normalCodes.rows()) : 0;
-  MatXf theta(Eigen::Index(6 * thetaJoints.size()), Eigen::Index(nTrain)), lambda(K + C, Eigen::Index(nTrain));
+  MatXf theta(Eigen::Index(runtime::thetaSize(thetaJoints.size(), st.rootGravity)), Eigen::Index(nTrain)),
+      lambda(K + C, Eigen::Index(nTrain));
   for (size_t i = 0; i < nTrain; ++i) {
-    const std::vector<float> th = runtime::computeTheta(thetaJoints, ds.poses[out.trainingPoses[i]].pose.local);
+    const std::vector<float> th =
+        runtime::computeTheta(thetaJoints, st.rootGravity, ds.poses[out.trainingPoses[i]].pose.local);
     theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
   }
   lambda.topRows(K) = meshCodes;
@@ -215,6 +218,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   ModelParts parts;
   parts.character = &ds.character;
   parts.inputJoints = thetaJoints;
+  parts.rootGravity = st.rootGravity;
   parts.regressor = &out.regressor;
   parts.meshPca = &out.meshPca;
   parts.normalMaps = db;

@@ -44,6 +44,11 @@ struct BakeTrainSettings {
   // default character, adding the forearms and thighs to its 7 thinning joints took the held-out
   // regression error from 4.09 to 3.40 mm (docs/baking.md).
   std::vector<std::string> inputJoints;
+  // Theta ends with the gravity direction in the root joint's frame (train.root_gravity, default off):
+  // the body's lean against gravity, which the source simulation's cloth hangs by (about 0.5 mm of the
+  // default jersey per degree) and no input joint's local rotation holds (docs/baking.md, "What the
+  // network cannot see").
+  bool rootGravity = false;
   // The push-out's body anchors: calibrated on the training poses so that pushing never takes a
   // vertex further from the simulation there (true, body_anchor_fit.hpp), or every anchor at the margin
   // (false). Where the simulation itself leaves the garment inside the body (the limb clearance's

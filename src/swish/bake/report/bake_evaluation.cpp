@@ -63,7 +63,7 @@ Points3f predictPreSkin(const Model& model, const Pose& pose) {
   const runtime::MlpEvaluator mlp(model);
   const runtime::NoveltyGuardEvaluator guard(model);
   std::vector<float> lambda(size_t(mlp.outputSize()));
-  const std::vector<float> theta = runtime::computeTheta(model.inputJoints, pose.local);
+  const std::vector<float> theta = runtime::computeTheta(model.inputJoints, model.rootGravity, pose.local);
   mlp.evaluate(theta, lambda);
   guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(model.meshComponents())));
   return runtime::referencePcaReconstruct(model.meshPca,
@@ -118,7 +118,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
   for (const DatasetPose* p : heldOut) {
     if (size_t(p->gameMeshWorld.rows()) != n || size_t(p->gameMeshPreSkin.rows()) != n)
       throw Error("bake evaluation: pose " + std::to_string(p->id) + " has a game mesh of another size");
-    const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
+    const std::vector<float> theta = runtime::computeTheta(model.inputJoints, model.rootGravity, p->pose.local);
     mlp.evaluate(theta, lambda);
     guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(K)));
     const auto mats = model.skeleton.skinningMatrices(p->pose);

@@ -98,7 +98,7 @@ QualityLadder measureLadder(const Model& model, const std::vector<const DatasetP
                   std::to_string(model.normalMaps.width) + "x" + std::to_string(model.normalMaps.height));
     const auto mats = model.skeleton.skinningMatrices(p->pose);
     if (networkNeeded) {
-      const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
+      const std::vector<float> theta = runtime::computeTheta(model.inputJoints, model.rootGravity, p->pose.local);
       mlp.evaluate(theta, lambda);
       guard.apply(guard.measureOne(theta), std::span<float>(lambda.data(), size_t(K)));
     }

@@ -184,7 +184,7 @@ GuardStudy studyNoveltyGuard(const Model& model, const std::vector<const Dataset
   auto prepare = [&](const std::vector<const DatasetPose*>& set) {
     std::vector<Prepared> out;
     for (const DatasetPose* p : set) {
-      const std::vector<float> theta = runtime::computeTheta(model.inputJoints, p->pose.local);
+      const std::vector<float> theta = runtime::computeTheta(model.inputJoints, model.rootGravity, p->pose.local);
       Prepared q{p, double(measure.measureOne(theta)), std::vector<float>(size_t(mlp.outputSize())),
                  model.skeleton.skinningMatrices(p->pose)};
       mlp.evaluate(theta, q.lambda);

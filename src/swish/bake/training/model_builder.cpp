@@ -18,6 +18,7 @@ Model buildModel(const ModelParts& p) {
   m.skeleton = ch.skeleton;
   if (m.skeleton.inverseBind.size() != m.skeleton.size()) m.skeleton.computeInverseBindFromRest();
   m.inputJoints = p.inputJoints;
+  m.rootGravity = p.rootGravity;
   m.inputNorm = p.regressor->inputNorm;
   m.outputNorm = p.regressor->outputNorm;
   m.mlp = p.regressor->mlp;

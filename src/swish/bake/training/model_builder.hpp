@@ -15,6 +15,7 @@ namespace swish::bake {
 struct ModelParts {
   const Character* character = nullptr;  // skeleton + garment (game mesh, skinned, with UVs)
   std::vector<uint32_t> inputJoints;
+  bool rootGravity = false;  // Theta ends with the gravity direction in the root's frame (Model::rootGravity)
   const MlpTrainResult* regressor = nullptr;
   const PcaResult* meshPca = nullptr;  // over 3N pre-skin coordinates (vertex v, axis a at 3v + a)
   NormalMapDatabase normalMaps;        // keys + VQ data (may be empty)

@@ -34,6 +34,7 @@ NoveltyGuard fitNoveltyGuard(const Model& model, const MatXf& theta, const MatXf
   // The unit from the run time's own measure, so that the bake and the run time agree to the bit.
   Model probe;
   probe.inputJoints = model.inputJoints;
+  probe.rootGravity = model.rootGravity;
   probe.inputNorm = model.inputNorm;
   probe.noveltyGuard = g;
   const runtime::NoveltyGuardEvaluator eval(probe);

@@ -60,6 +60,16 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_TRUE(
       parseBakeConfig({{"output", "out"}, {"train", {{"anchor_calibration", "strict"}}}}, "recipe.json", "/base")
           .train.calibrateAnchors);
+  // The gravity values in Theta: off unless asked for (and then recorded; absent by default, so that the
+  // fingerprints of earlier bakes stay).
+  EXPECT_FALSE(w.train.rootGravity);
+  EXPECT_FALSE(w.train.toJson().contains("root_gravity"));
+  const BakeConfig g =
+      parseBakeConfig({{"output", "out"}, {"train", {{"root_gravity", true}}}}, "recipe.json", "/base");
+  EXPECT_TRUE(g.train.rootGravity);
+  EXPECT_EQ(g.train.toJson()["root_gravity"], true);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"root_gravity", "yes"}}}}).find("train.root_gravity"),
+            std::string::npos);
 }
 
 TEST(BakeConfig, ErrorsNameTheKey) {
