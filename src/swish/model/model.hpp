@@ -158,6 +158,9 @@ struct BodyCoverage {
   std::vector<uint32_t> covered;  // ascending, < bodyTriangles
 };
 
+// Theta's size: 6 per input joint, 3 more with the gravity values (Model::rootGravity).
+inline size_t thetaSize(size_t inputJoints, bool rootGravity) { return 6 * inputJoints + (rootGravity ? 3 : 0); }
+
 struct Model {
   Skeleton skeleton;                  // the character's skeleton (for FK and skinning)
   std::vector<uint32_t> inputJoints;  // skeleton joint indices forming Theta, in this order
@@ -176,7 +179,7 @@ struct Model {
   BodyCoverage bodyCoverage;    // may be empty (models before format 1.2, or baked without a body)
   std::string metadata = "{}";  // free-form JSON: bake settings, errors measured at bake time
 
-  int thetaSize() const { return int(inputJoints.size()) * 6 + (rootGravity ? 3 : 0); }
+  int thetaSize() const { return int(swish::thetaSize(inputJoints.size(), rootGravity)); }
   int meshComponents() const { return meshPca.components(); }
   int normalCodeDims() const { return int(normalMaps.codeDims()); }
   int lambdaSize() const { return meshComponents() + normalCodeDims(); }

@@ -24,6 +24,7 @@
 
 #include "swish/core/rotation.hpp"
 #include "swish/core/types.hpp"
+#include "swish/model/model.hpp"  // thetaSize
 
 namespace swish::runtime {
 
@@ -59,8 +60,5 @@ ThetaReport computeTheta(std::span<const uint32_t> inputJoints, bool rootGravity
 std::vector<float> computeTheta(std::span<const uint32_t> inputJoints, bool rootGravity,
                                 std::span<const Quatf> localRotations, ThetaReport* report = nullptr,
                                 std::vector<ThetaJointIssue>* issues = nullptr);
-
-// Theta's size: 6 per joint, 3 more with the gravity values.
-inline size_t thetaSize(size_t inputJoints, bool rootGravity) { return 6 * inputJoints + (rootGravity ? 3 : 0); }
 
 }  // namespace swish::runtime

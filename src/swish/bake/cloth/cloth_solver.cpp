@@ -492,13 +492,8 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, Cloth
           for (const DistanceConstraint& c : cc.bending) projectDistance(c, x.data(), w, invDt2, *l++);
         } else {
           // The same projections in dependency levels (constraint_schedule.hpp): bitwise the same shape.
-          const bool vector = s.sweepKernel == SweepKernel::Vector;
-          sweep(schedule_.stretch, x.data(), w, invDt2, l, vector);
-          l += cc.stretch.size();
-          sweep(schedule_.shear, x.data(), w, invDt2, l, vector);
-          l += cc.shear.size();
-          sweep(schedule_.bending, x.data(), w, invDt2, l, vector);
-          l += cc.bending.size();
+          schedule_.sweep(x.data(), invDt2, l, s.sweepKernel == SweepKernel::Vector);
+          l += schedule_.total();
         }
         for (size_t a = 0; a < attached_.size(); ++a, ++l) {
           const uint32_t v = attached_[a];

@@ -105,6 +105,7 @@ ConstraintSchedule buildConstraintSchedule(const ClothConstraints& cc) {
   s.stretch = scheduleDistance(cc.stretch, cc.inverseMass);
   s.bending = scheduleDistance(cc.bending, cc.inverseMass);
   s.shear = scheduleShear(cc.shear, cc.inverseMass);
+  s.inverseMass = cc.inverseMass;
   return s;
 }
 
@@ -118,18 +119,22 @@ bool constraintSweepVectorised() {
   return available;
 }
 
-void sweep(const DistanceSchedule& s, float* x, const float* w, float invDt2, float* lambda, bool vector) {
+void ConstraintSchedule::sweep(float* x, float invDt2, float* lambda, bool vector) const {
+  const float* w = inverseMass.data();
+  vector = vector && constraintSweepVectorised();
+  // The blocks' sweeps, each as `for (c : constraints) project(c, x, w, invDt2, lambda[k++])` in its
+  // scheduled order.
+  auto distance = [&](const DistanceSchedule& s, float* l) {
+    sweepLevels(
+        s, vector, [&](size_t k) { projectDistance(s.constraints[k], x, w, invDt2, l[k]); },
+        [&](size_t begin, size_t end) { detail::sweepDistanceAvx2(s, begin, end, x, invDt2, l); });
+  };
+  distance(stretch, lambda);
+  float* l = lambda + stretch.constraints.size();
   sweepLevels(
-      s, vector && constraintSweepVectorised(),
-      [&](size_t k) { projectDistance(s.constraints[k], x, w, invDt2, lambda[k]); },
-      [&](size_t begin, size_t end) { detail::sweepDistanceAvx2(s, begin, end, x, invDt2, lambda); });
-}
-
-void sweep(const ShearSchedule& s, float* x, const float* w, float invDt2, float* lambda, bool vector) {
-  sweepLevels(
-      s, vector && constraintSweepVectorised(),
-      [&](size_t k) { projectShear(s.constraints[k], x, w, invDt2, lambda[k]); },
-      [&](size_t begin, size_t end) { detail::sweepShearAvx2(s, begin, end, x, invDt2, lambda); });
+      shear, vector, [&](size_t k) { projectShear(shear.constraints[k], x, w, invDt2, l[k]); },
+      [&](size_t begin, size_t end) { detail::sweepShearAvx2(shear, begin, end, x, invDt2, l); });
+  distance(bending, l + shear.constraints.size());
 }
 
 }  // namespace swish::bake

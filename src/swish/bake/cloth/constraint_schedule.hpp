@@ -40,10 +40,18 @@ struct ShearSchedule {
   std::vector<float> a, b, c, d, compliance, w[3];
 };
 
-// The solver's stretch, shear and bending blocks, each in dependency levels.
+// The solver's stretch, shear and bending blocks, each in dependency levels, with the inverse masses
+// they were scheduled with (the vector kernels read them from the blocks' own arrays, the scalar
+// projection from here, so the two cannot disagree).
 struct ConstraintSchedule {
   DistanceSchedule stretch, bending;
   ShearSchedule shear;
+  std::vector<float> inverseMass;
+  // One sweep of the three blocks in the solver's order (stretch, shear, bending), as the sequential
+  // loops over ClothConstraints would run it; lambda: total() multipliers, the blocks' in that order.
+  // `vector`: the AVX2 kernels where the processor has them (false: the scalar projection alone). The
+  // answer is bitwise the same either way.
+  void sweep(float* x, float invDt2, float* lambda, bool vector = true) const;
   // How many constraints ran in vector lanes per sweep (the rest: levels' tails of fewer than eight).
   size_t vectorised() const;
   size_t total() const { return stretch.constraints.size() + shear.constraints.size() + bending.constraints.size(); }
@@ -55,13 +63,6 @@ std::vector<uint32_t> dependencyLevels(size_t vertexCount, size_t constraintCoun
 
 // The schedule of a constraint set; inverseMass is the one the sweeps will use (ClothConstraints').
 ConstraintSchedule buildConstraintSchedule(const ClothConstraints& cc);
-
-// One sweep of a block, as `for (c : constraints) project(c, x, w, invDt2, lambda[k++])` over the
-// block's scheduled order (lambda: one multiplier per scheduled constraint, in that order). `vector`:
-// use the AVX2 kernel where the processor has it (false: the scalar projection alone, for tests and
-// processors without it). The answer is bitwise the same either way.
-void sweep(const DistanceSchedule& s, float* x, const float* w, float invDt2, float* lambda, bool vector = true);
-void sweep(const ShearSchedule& s, float* x, const float* w, float invDt2, float* lambda, bool vector = true);
 
 // Whether this processor runs the AVX2 kernels.
 bool constraintSweepVectorised();

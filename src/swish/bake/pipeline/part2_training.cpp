@@ -181,7 +181,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   // 3. MLP Theta -> Lambda = [mesh weights, normal code].
   report("MLP training", 0.5);
   const int K = out.meshPca.components(), C = maps ? int(normalCodes.rows()) : 0;
-  MatXf theta(Eigen::Index(runtime::thetaSize(thetaJoints.size(), st.rootGravity)), Eigen::Index(nTrain)),
+  MatXf theta(Eigen::Index(thetaSize(thetaJoints.size(), st.rootGravity)), Eigen::Index(nTrain)),
       lambda(K + C, Eigen::Index(nTrain));
   for (size_t i = 0; i < nTrain; ++i) {
     const std::vector<float> th =

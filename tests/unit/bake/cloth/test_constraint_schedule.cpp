@@ -99,10 +99,7 @@ TEST(ConstraintSchedule, ScheduledSweepsGiveTheSequentialSweepsBits) {
     Points3f x = t.x;
     std::vector<float> lambda(n, 0.f);
     for (int it = 0; it < 3; ++it) {
-      float* l = lambda.data();
-      sweep(s.stretch, x.data(), w, invDt2, l, vector);
-      sweep(s.shear, x.data(), w, invDt2, l + cc.stretch.size(), vector);
-      sweep(s.bending, x.data(), w, invDt2, l + cc.stretch.size() + cc.shear.size(), vector);
+      s.sweep(x.data(), invDt2, lambda.data(), vector);
     }
     EXPECT_TRUE(sameBits(x, seq)) << (vector ? "AVX2" : "scalar") << " levels differ from the sequential sweep";
     // The multipliers are the same numbers, in the schedule's order: compare them as multisets.
