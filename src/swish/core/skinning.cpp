@@ -93,4 +93,21 @@ Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const
   return out;
 }
 
+void moveSkinnedShape(Points3f& world, Points3f& preSkin, const Points3f& move,
+                      const std::vector<Eigen::Index>& vertices, const SkinWeights& skin, const std::vector<Mat4f>& m,
+                      const UnskinSettings& settings) {
+  if (world.rows() != preSkin.rows() || move.rows() != world.rows() || size_t(world.rows()) != skin.vertexCount())
+    throw Error("moving a skinned shape: " + std::to_string(world.rows()) + " posed, " +
+                std::to_string(preSkin.rows()) + " pre-skin and " + std::to_string(move.rows()) +
+                " moved positions for " + std::to_string(skin.vertexCount()) + " skinned vertices");
+  for (Eigen::Index v : vertices)
+    if (v < 0 || v >= world.rows())
+      throw Error("moving a skinned shape: vertex " + std::to_string(v) + " out of range");
+  const Points3f drawnBefore = skinPositions(preSkin, skin, m);
+  const Points3f moved = unskinPositions(drawnBefore + move, preSkin, skin, m, settings);
+  for (Eigen::Index v : vertices) preSkin.row(v) = moved.row(v);
+  const Points3f drawn = skinPositions(preSkin, skin, m);
+  for (Eigen::Index v : vertices) world.row(v) += drawn.row(v) - drawnBefore.row(v);
+}
+
 }  // namespace swish

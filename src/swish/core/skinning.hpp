@@ -37,6 +37,15 @@ Points3f unskinPositions(const Points3f& posed, const Points3f& reference, const
                          const std::vector<Mat4f>& skinMatrices, const UnskinSettings& settings = {},
                          UnskinStats* stats = nullptr);
 
+// Moves a stored shape, posed `world` with its pre-skin `preSkin` (what the run time skins), by `move` (posed
+// space) at `vertices` (the other rows are untouched, bitwise). The move is un-skinned, damped as above around
+// `preSkin`, and `world` moves by what that draws: where `world` is what `preSkin` draws it stays so, and where
+// un-skinning had damped (a collapsed blend: `world` is a shape no pre-skin shape draws) it moves by the drawn
+// move only, not to the drawable shape, which can be centimetres away. Throws Error for sizes that differ.
+void moveSkinnedShape(Points3f& world, Points3f& preSkin, const Points3f& move,
+                      const std::vector<Eigen::Index>& vertices, const SkinWeights& skin,
+                      const std::vector<Mat4f>& skinMatrices, const UnskinSettings& settings = {});
+
 // The vertices un-skinning would damp under these matrices (the same test), and the smallest singular
 // value among them: a property of the pose and the weights, not of a shape, so a bake can count them
 // for poses whose shapes it made in an earlier run.

@@ -345,6 +345,8 @@ void DatasetBuildResult::BodyCoverSummary::add(const BodyCoverStats& s) {
   poses += s.verticesMoved > 0;
   vertices += s.verticesMoved;
   posesLeftThrough += s.samplesLeft > 0;
+  posesHeld += s.verticesHeld > 0;
+  verticesHeld += s.verticesHeld;
   largestShift = std::max(largestShift, s.largestShift);
   deepest = std::max(deepest, s.deepest);
 }
@@ -354,7 +356,9 @@ nlohmann::json DatasetBuildResult::BodyCoverSummary::toJson() const {
           {"vertices_moved", vertices},
           {"largest_shift_mm", 1000.0 * largestShift},
           {"deepest_before_mm", 1000.0 * deepest},
-          {"poses_left_through", posesLeftThrough}};
+          {"poses_left_through", posesLeftThrough},
+          {"poses_held_back", posesHeld},
+          {"vertices_held_back", verticesHeld}};
 }
 
 std::vector<uint64_t> DatasetPosePlan::poseFingerprints() const {
@@ -855,12 +859,13 @@ DatasetBuildResult buildDataset(const DatasetBuildSettings& s, const fs::path& d
        {std::pair{&res.bodyCover, "the game mesh kept over the body (cover_body_mm)"},
         std::pair{&res.bodyCoverRecorded, "and again in the recorded pose, where limb clearance had turned a limb,"}}) {
     if (c->poses == 0) continue;
-    char line[360];
+    char line[420];
     std::snprintf(line, sizeof line,
                   "part 1: %s in %zu of %zu poses transferred: %.0f vertices moved per such pose, at most %.1f mm; the "
-                  "body was up to %.1f mm through; %zu poses still have some of it through",
+                  "body was up to %.1f mm through; %zu poses still have some of it through; %zu held back moves "
+                  "so as not to tear an edge",
                   what, c->poses, res.transferred, double(c->vertices) / double(c->poses), 1000.0 * c->largestShift,
-                  1000.0 * c->deepest, c->posesLeftThrough);
+                  1000.0 * c->deepest, c->posesLeftThrough, c->posesHeld);
     log(line);
   }
   nlohmann::json source = {{"tool", "swish bake (part 1)"},

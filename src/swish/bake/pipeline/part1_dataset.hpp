@@ -176,11 +176,13 @@ struct DatasetBuildResult {
   float unskinSmallestSingularValue = 1.f;
   // part1.transfer.cover_body_mm (transfer/body_cover.hpp), over the poses transferred in this run: those
   // whose game mesh it moved, the vertices moved (all such poses), the largest move, the deepest body sample
-  // through the game mesh before, and the poses where some sample stayed through it. bodyCover: in the
+  // through the game mesh before, the poses where some sample stayed through it, and those (and their
+  // vertices) where the cover took back part of its moves so as not to tear an edge. bodyCover: in the
   // simulated pose; bodyCoverRecorded: again in the recorded pose, for poses that limb clearance changed
   // (pose_shape.hpp step 4: the skin the cloth covered round the turned-out arm stays covered).
   struct BodyCoverSummary {
     size_t poses = 0, vertices = 0, posesLeftThrough = 0;
+    size_t posesHeld = 0, verticesHeld = 0;  // moves partly taken back so that no edge tears
     float largestShift = 0.f, deepest = 0.f;
     void add(const BodyCoverStats& s);
     nlohmann::json toJson() const;

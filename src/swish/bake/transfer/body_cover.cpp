@@ -22,9 +22,17 @@ constexpr float kThrough = 0.0005f;
 // A moved vertex's neighbours move at least this share of its move, over this many rings.
 constexpr float kFalloff = 0.5f;
 constexpr int kFalloffRings = 3;
+// The cover lengthens no edge by more than this share of its rest length beyond the longer of its length
+// before and at rest; the ends of one it would take back part of their moves, in up to kHoldRounds rounds
+// of kHoldBack each (then all of them).
+constexpr float kCoverStretch = 0.5f, kHoldBack = 0.7f;
+constexpr int kHoldRounds = 12;
 // The cosine between the skin's normal and the game triangle's at which a sample counts half; its share goes
 // from 0 to 1 over kFacingBlend around it.
 constexpr float kFacing = 0.7f, kFacingBlend = 0.2f;
+// A vertex moves along its normal where that is within 30 degrees of the asking triangle's (cosine kAlong),
+// the way the triangle faces beyond 60 (kAcross), blended between.
+constexpr float kAlong = 0.866f, kAcross = 0.5f;
 
 Vec3f faceNormal(const Points3f& p, const Triangles& t, Eigen::Index k) {
   const Vec3f a = p.row(t(k, 0)), b = p.row(t(k, 1)), c = p.row(t(k, 2));
@@ -53,6 +61,12 @@ BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, c
   if (bodyTriangles.size() > 0 && Eigen::Index(bodyTriangles.maxCoeff()) >= bodyRest.rows())
     throw Error("body cover: a body triangle names a vertex out of range");
   neighbours_ = buildVertexNeighbours(welded_, size_t(gameRest.rows()));
+  for (size_t v = 0; v < neighbours_.size(); ++v)
+    for (uint32_t u : neighbours_[v])
+      if (u > v) {
+        edges_.emplace_back(uint32_t(v), u);
+        edgeRest_.push_back((gameRest.row(Eigen::Index(v)) - gameRest.row(u)).norm());
+      }
   gameTopology_ = buildFrameTopology(gameTriangles, gameRest);
   bodyTopology_ = buildFrameTopology(bodyTriangles, bodyRest);
 }
@@ -123,7 +137,7 @@ BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const std:
   // not reach it: a crease), so that no vertex is pushed round after round into a tear.
   std::vector<float> lastDepth(size_t(samples.rows()), std::numeric_limits<float>::infinity());
   std::vector<char> asking = covered;
-  auto pass = [&](std::vector<float>* ask, float* deepest) {
+  auto pass = [&](std::vector<Vec3f>* ask, float* deepest) {
     const TriangleRayScene mesh(game, welded_, "body cover: game mesh");
     size_t through = 0;
     for (Eigen::Index i = 0; i < samples.rows(); ++i) {
@@ -158,43 +172,99 @@ BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const std:
       const float d = facing * (over + settings_.margin * std::min(1.f, over / kThrough));
       const float w[3] = {1.f - g.u - g.v, g.u, g.v};
       const float norm = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-      for (int e = 0; e < 3; ++e) {  // a vertex keeps its largest ask
-        float& a = (*ask)[size_t(welded_(t, e))];
-        a = std::max(a, w[e] * d / norm);
+      for (int e = 0; e < 3; ++e) {  // a vertex keeps its largest ask, along the asking triangle's normal
+        Vec3f& a = (*ask)[size_t(welded_(t, e))];
+        const float length = w[e] * d / norm;
+        if (length > a.norm()) a = length * n;
       }
     }
     return through;
   };
-  std::vector<float> shifted(size_t(game.rows()), 0.f), ask(size_t(game.rows()));
+  const Points3f before = game;
+  std::vector<float> shifted(size_t(game.rows()), 0.f);
+  std::vector<Vec3f> ask(size_t(game.rows()));
   for (int round = 0; round < settings_.rounds; ++round) {
-    std::fill(ask.begin(), ask.end(), 0.f);
+    std::fill(ask.begin(), ask.end(), Vec3f::Zero());
     const size_t through = pass(&ask, round == 0 ? &stats.deepest : nullptr);
     if (round == 0) stats.samplesThrough = through;
     if (through == 0) break;
     // A smooth bump, not a spike: each vertex moves at least half as far as its farthest-moving neighbour
-    // (three rings), so that no edge between a moved vertex and a still one tears.
+    // (three rings), and the same way, so that no edge between a moved vertex and a still one tears.
     for (int ring = 0; ring < kFalloffRings; ++ring) {
-      const std::vector<float> before = ask;
-      for (size_t v = 0; v < neighbours_.size(); ++v)
-        for (uint32_t u : neighbours_[v]) ask[v] = std::max(ask[v], kFalloff * before[u]);
+      const std::vector<Vec3f> before = ask;
+      for (size_t v = 0; v < neighbours_.size(); ++v) {
+        float longest = ask[v].norm();
+        for (uint32_t u : neighbours_[v]) {
+          const float length = kFalloff * before[u].norm();
+          if (length > longest) {
+            ask[v] = kFalloff * before[u];
+            longest = length;
+          }
+        }
+      }
     }
-    // Out along the area-weighted vertex normals (seam copies share theirs).
+    // Out along the area-weighted vertex normals (seam copies share theirs) where they agree with the way the
+    // asking triangle faces, else that way: in a fold of the game mesh (a sleeve skinned back against the
+    // trunk) neighbouring vertex normals point apart, and moving along them tore the edges between (blended
+    // between kAlong and kAcross, continuous in the pose).
     const Points3f normals = surfaceVertexNormals(game, welded_, gameTopology_);
     for (Eigen::Index v = 0; v < game.rows(); ++v) {
-      const float step = std::min(ask[size_t(v)], settings_.maxShift - shifted[size_t(v)]);
+      const float length = ask[size_t(v)].norm();
+      const float step = std::min(length, settings_.maxShift - shifted[size_t(v)]);
       if (!(step > 0.f) || weld_[size_t(v)] != uint32_t(v)) continue;
-      game.row(v) += normals.row(v) * step;
+      const Vec3f facing = ask[size_t(v)] / length, normal = normals.row(v);
+      const float x = std::clamp((normal.dot(facing) - kAcross) / (kAlong - kAcross), 0.f, 1.f);
+      const float w = x * x * (3.f - 2.f * x);
+      const Vec3f way = w * normal + (1.f - w) * facing;
+      const float wayLength = way.norm();
+      game.row(v) += (wayLength > 0.f ? Vec3f(way / wayLength) : facing).transpose() * step;
       shifted[size_t(v)] += step;
     }
     for (Eigen::Index v = 0; v < game.rows(); ++v) game.row(v) = game.row(weld_[size_t(v)]);  // seam copies follow
   }
+  if (stats.samplesThrough > 0) holdTears(game, before, stats);
   stats.samplesLeft = stats.samplesThrough > 0 ? pass(nullptr, nullptr) : 0;
-  for (Eigen::Index v = 0; v < game.rows(); ++v)
-    if (shifted[size_t(weld_[size_t(v)])] > 0.f) {
-      ++stats.verticesMoved;
-      stats.largestShift = std::max(stats.largestShift, shifted[size_t(weld_[size_t(v)])]);
-    }
+  for (Eigen::Index v = 0; v < game.rows(); ++v) {
+    const float shift = (game.row(v) - before.row(v)).norm();
+    if (!(shift > 0.f)) continue;
+    ++stats.verticesMoved;
+    stats.largestShift = std::max(stats.largestShift, shift);
+  }
   return stats;
+}
+
+void BodyCover::holdTears(Points3f& game, const Points3f& before, BodyCoverStats& stats) const {
+  // The bound per edge, from the shape before the cover.
+  std::vector<float> bound(edges_.size());
+  for (size_t e = 0; e < edges_.size(); ++e) {
+    const auto [a, b] = edges_[e];
+    bound[e] = std::max((before.row(a) - before.row(b)).norm(), edgeRest_[e]) + kCoverStretch * edgeRest_[e];
+  }
+  // Each representative's share of its move; an over-stretched edge's ends give some back.
+  std::vector<float> share(size_t(game.rows()), 1.f);
+  const Points3f moved = game;
+  auto place = [&] {
+    for (Eigen::Index v = 0; v < game.rows(); ++v) {
+      const Eigen::Index r = weld_[size_t(v)];
+      game.row(v) = before.row(r) + share[size_t(r)] * (moved.row(r) - before.row(r));
+    }
+  };
+  std::vector<char> held(share.size(), 0);
+  for (int round = 0; round <= kHoldRounds; ++round) {
+    bool over = false;
+    for (size_t e = 0; e < edges_.size(); ++e) {
+      const auto [a, b] = edges_[e];
+      if (!((game.row(a) - game.row(b)).norm() > bound[e])) continue;
+      over = true;
+      held[a] = held[b] = 1;
+      const float keep = round < kHoldRounds ? kHoldBack : 0.f;
+      share[a] *= keep;
+      share[b] *= keep;
+    }
+    if (!over) break;
+    place();
+  }
+  stats.verticesHeld = size_t(std::count(held.begin(), held.end(), char(1)));
 }
 
 }  // namespace swish::bake

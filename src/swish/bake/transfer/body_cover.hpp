@@ -12,11 +12,15 @@
 // sample of the body's surface (vertices and triangle centroids) within `reach` of the game mesh whose
 // nearest game triangle has it in front of its outward side (the skin through the garment), and which
 // the simulation's cloth covers there (the simulated surface nearest to it is outside it: the game mesh
-// lost what the simulation had), asks the triangle's corners to move out along their vertex normals by
-// the depth plus `margin`, shared by barycentric weight so that the triangle passes `margin` above the
-// sample (delta_i = b_i * d / sum b_j^2; samples less than 0.5 mm through ask nothing). Each vertex takes the
-// largest ask, and its neighbours at least half of it (three rings: a smooth bump, no torn edge); a sample
-// a round did not take halfway out is given up; the total shift of a vertex is bounded by `maxShift`. Triangles on the
+// lost what the simulation had), asks the triangle's corners to move out by the depth plus `margin`, shared
+// by barycentric weight so that the triangle passes `margin` above the sample (delta_i = b_i * d / sum b_j^2;
+// samples less than 0.5 mm through ask nothing). Each vertex takes the largest ask, and its neighbours at least
+// half of it (three rings: a smooth bump); it moves along its vertex normal where that is within 30 degrees of
+// the asking triangle's normal, the way the triangle faces beyond 60 (a fold, where neighbouring vertex normals
+// point apart), blended between. A sample a round did not take halfway out is given up; the total shift of a
+// vertex is bounded by `maxShift`. Last, no edge tears: the ends of any edge the cover stretched by more than
+// half its rest length beyond the longer of its length before and at rest give back part of their moves
+// (BodyCoverStats::verticesHeld; measured on the corpus, docs/baking.md). Triangles on the
 // garment's openings (hem, collar, sleeve ends) ask nothing: a body beyond a hem is not under the cloth. Where the
 // simulation itself has the body through its cloth nothing is asked either: that is the simulation's fault (issue 18),
 // not the transfer's.
@@ -26,6 +30,7 @@
 // pose, posed as recorded, against the re-skinned game mesh (coveredSamples, then apply with that mask).
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "swish/core/mesh_frames.hpp"
@@ -50,6 +55,7 @@ struct BodyCoverStats {
   float deepest = 0.f;        // m, before
   size_t verticesMoved = 0;
   float largestShift = 0.f;  // m
+  size_t verticesHeld = 0;   // held back (part of their move taken back) so that no edge tears
 };
 
 // Built once per garment: its seam copies welded by rest position (they move together) and the vertices
@@ -79,13 +85,18 @@ class BodyCover {
 
  private:
   void checkBody(const Points3f& body) const;  // throws for a body of another vertex count
+  // Takes back part of the moves (`game` against `before`) of the ends of any edge the cover stretched past
+  // its bound (body_cover.cpp, kCoverStretch).
+  void holdTears(Points3f& game, const Points3f& before, BodyCoverStats& stats) const;
 
   BodyCoverSettings settings_;
   std::vector<uint32_t> weld_;  // game vertex -> its welded representative (the first at its rest position)
   Triangles welded_;            // game triangles on the representatives
   std::vector<char> opening_;   // per game vertex
-  std::vector<std::vector<uint32_t>> neighbours_;  // of each representative, over the welded triangles
-  MeshFrameTopology gameTopology_, bodyTopology_;  // for their area-weighted vertex normals, seams welded
+  std::vector<std::vector<uint32_t>> neighbours_;     // of each representative, over the welded triangles
+  std::vector<std::pair<uint32_t, uint32_t>> edges_;  // the welded triangles' unique edges
+  std::vector<float> edgeRest_;                       // their rest lengths
+  MeshFrameTopology gameTopology_, bodyTopology_;     // for their area-weighted vertex normals, seams welded
   Triangles bodyTriangles_;
 };
 

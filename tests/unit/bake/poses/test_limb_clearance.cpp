@@ -439,9 +439,11 @@ TEST(LimbClearance, OneSurfaceBodyArmsHangingIntoItsSidesAreTurnedOut) {
   EXPECT_EQ(turned, (std::vector<std::string>{"LeftArm", "RightArm"}));
   EXPECT_EQ(armSamplesInsideTheBody(*c, p), 0u) << before << " before";
   // Only the upper arms moved; a corrected pose needs no more; deterministic.
-  for (size_t j = 0; j < s.size(); ++j)
-    if (s.joints[j].name != "LeftArm" && s.joints[j].name != "RightArm")
+  for (size_t j = 0; j < s.size(); ++j) {
+    if (s.joints[j].name != "LeftArm" && s.joints[j].name != "RightArm") {
       EXPECT_EQ(p.local[j].coeffs(), recorded.local[j].coeffs()) << s.joints[j].name;
+    }
+  }
   Pose again = p;
   for (const LimbCorrection& f : lc.apply(again))
     ADD_FAILURE() << "again: " << f.joint << " " << f.degrees << " deg, " << f.depthBefore << " m before";
