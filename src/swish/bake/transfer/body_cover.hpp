@@ -18,9 +18,9 @@
 // half of it (three rings: a smooth bump); it moves along its vertex normal where that is within 30 degrees of
 // the asking triangle's normal, the way the triangle faces beyond 60 (a fold, where neighbouring vertex normals
 // point apart), blended between. A sample a round did not take halfway out is given up; the total shift of a
-// vertex is bounded by `maxShift`. Last, no edge tears: the ends of any edge the cover stretched by more than
-// half its rest length beyond the longer of its length before and at rest give back part of their moves
-// (BodyCoverStats::verticesHeld; measured on the corpus, docs/baking.md). Triangles on the
+// vertex is bounded by `maxShift`. Last, no edge tears: the ends of any edge the cover stretched past 200 %
+// strain (and its length before) give back part of their moves (BodyCoverStats::verticesHeld; measured on
+// the corpus, docs/baking.md). Triangles on the
 // garment's openings (hem, collar, sleeve ends) ask nothing: a body beyond a hem is not under the cloth. Where the
 // simulation itself has the body through its cloth nothing is asked either: that is the simulation's fault (issue 18),
 // not the transfer's.
@@ -86,7 +86,7 @@ class BodyCover {
  private:
   void checkBody(const Points3f& body) const;  // throws for a body of another vertex count
   // Takes back part of the moves (`game` against `before`) of the ends of any edge the cover stretched past
-  // its bound (body_cover.cpp, kCoverStretch).
+  // its bound (body_cover.cpp, kCoverStrain).
   void holdTears(Points3f& game, const Points3f& before, BodyCoverStats& stats) const;
 
   BodyCoverSettings settings_;
