@@ -344,6 +344,14 @@ TEST(BakePart2, TheRootsLeanIsLearntWithTheGravityValues) {
   const Model back = deserializeModel(serializeModel(with.model), "with gravity");
   EXPECT_TRUE(back.rootGravity);
   EXPECT_EQ(back.inputJoints, with.model.inputJoints);
+  // Part 1's datasets have every pose upright (the root at its rest rotation, canonicalPose): the gravity
+  // values would be one constant, and the run time would feed the network leans its truth never had.
+  Dataset upright = ds;
+  for (auto& p : upright.poses) p.pose.local[0] = Quatf::Identity();
+  EXPECT_NE(test::errorOf([&] {
+              trainBake(upright, st);
+            }).find("train.root_gravity: every training pose of the dataset has its root joint at one rotation"),
+            std::string::npos);
 }
 
 // Synthesized poses (part1.synthesis, ids from the dataset's synthesized_from_id on) are trained on and

@@ -188,6 +188,18 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
         runtime::computeTheta(thetaJoints, st.rootGravity, ds.poses[out.trainingPoses[i]].pose.local);
     theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
   }
+  if (st.rootGravity && nTrain > 1) {
+    // Part 1 simulates every pose with the root at its rest rotation (pose_shape.hpp, canonicalPose): such a
+    // dataset's gravity values are one constant the network cannot learn from, and the run time would feed it
+    // the recorded root's lean, which its truth never had.
+    const Eigen::Index g = theta.rows() - 3;
+    const float spread = (theta.bottomRows(3).colwise() - theta.block(g, 0, 3, 1).col(0)).cwiseAbs().maxCoeff();
+    if (!(spread > 1e-6f))
+      throw Error(
+          "train.root_gravity: every training pose of the dataset has its root joint at one rotation (part 1 "
+          "simulates poses upright: the root's rotation is reset to its rest rotation), so the gravity "
+          "values are constant and nothing can be learnt from them; turn train.root_gravity off");
+  }
   lambda.topRows(K) = meshCodes;
   if (C) lambda.bottomRows(C) = normalCodes;
   MlpTrainOptions mo = st.mlp;
