@@ -563,6 +563,31 @@ TEST_F(ReplayE2E, AClipWithOtherJointNamesPlaysThroughItsJointMap) {
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
 }
 
+// The replay replaces its output folder whole: a folder with anything no replay wrote (a log beside it, a
+// home folder given as --out) is refused before any work and left as it was; its own earlier output, and an
+// empty folder, are replaced.
+TEST_F(ReplayE2E, AnOutputFolderWithOtherFilesIsRefusedNotDeleted) {
+  const runtime::Scene s = scene(sceneJson({"walk.json"}));
+  fs::create_directories(dir_ / "out");
+  std::ofstream(dir_ / "out" / "notes.txt") << "mine";
+  const std::string e = test::errorOf([&] { replay::runReplayJob(s, jobOptions()); });
+  EXPECT_NE(e.find("holds 'notes.txt', which no replay wrote"), std::string::npos) << e;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "notes.txt"));
+  fs::remove(dir_ / "out" / "notes.txt");
+  replay::runReplayJob(s, jobOptions());  // an empty folder
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "report.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / ".swish-replay"));
+  fs::create_directories(dir_ / "out" / "render");
+  std::ofstream(dir_ / "out" / "render" / "frame.png") << "x";
+  replay::runReplayJob(s, jobOptions());  // its own output: replaced
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "render" / "frame.png"));
+  std::ofstream(dir_ / "file") << "x";
+  runtime::Scene toFile = s;
+  toFile.outputs.directory = dir_ / "file";
+  EXPECT_NE(test::errorOf([&] { replay::runReplayJob(toFile, jobOptions()); }).find("is a file"), std::string::npos);
+  EXPECT_EQ(ctx().validationMessageCount(), 0u);
+}
+
 TEST_F(ReplayE2E, AnErrorLeavesNoPartialOutputs) {
   std::ofstream(dir_ / "broken.json") << "{ \"format\": \"swish-pose-stream\", \"version\": 1, \"joints\": [";
   const runtime::Scene s = scene(sceneJson({"walk.json", "broken.json"}));

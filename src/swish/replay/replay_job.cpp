@@ -1,6 +1,9 @@
 #include "swish/replay/replay_job.hpp"
 
+#include <filesystem>
+#include <fstream>
 #include <optional>
+#include <string>
 
 #include <unistd.h>
 
@@ -32,6 +35,33 @@ void writeNormalMap(const fs::path& file, const runtime::BlendedNormalMap& map) 
   io::writePng(file, io::encodeNormalMap(map.width, map.height, runtime::xyAsFloat(map), 16));
 }
 
+// The names a replay writes into its output folder (and the marker it leaves there).
+constexpr const char* kMarker = ".swish-replay";
+bool writtenByReplay(const std::string& name) {
+  for (const char* n : {kMarker, "report.json", "report.md", "plots", "render", "meshes", "normal_maps"})
+    if (name == n) return true;
+  return false;
+}
+
+// The replay replaces its output folder whole; one that holds anything a replay does not write (a user's
+// files, a home folder given as --out) is refused before any work, never deleted.
+void checkOutputFolder(const fs::path& dir) {
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(dir, ec);
+  if (ec || !fs::exists(st)) return;
+  if (!fs::is_directory(st))
+    throw Error(dir.string() + ": the replay's output folder is a file; choose a new or empty folder (--out)");
+  if (fs::exists(dir / kMarker)) return;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!writtenByReplay(name))
+      throw Error(dir.string() + ": the replay's output folder holds '" + name +
+                  "', which no replay wrote; the replay replaces its whole output folder, so it refuses one that is "
+                  "not a replay's output: choose a new or empty folder (--out)");
+  }
+  if (ec) throw Error(dir.string() + ": cannot read the replay's output folder: " + ec.message());
+}
+
 }  // namespace
 
 ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions& options) {
@@ -42,9 +72,11 @@ ReplayJobResult runReplayJob(const runtime::Scene& scene, const ReplayJobOptions
   const bool writes = out.report || out.normalMaps || out.meshes;
   StagingFolder staging;
   if (writes) {
+    checkOutputFolder(out.directory);
     staging.path = out.directory.string() + ".partial-" + std::to_string(::getpid());
     fs::remove_all(staging.path);
     fs::create_directories(staging.path);
+    std::ofstream(staging.path / kMarker) << "written by swish replay: the next replay into this folder replaces it\n";
   }
   // Meshes of the frame being read back, written as one glTF when the next frame starts (and at the end).
   struct PendingMesh {
