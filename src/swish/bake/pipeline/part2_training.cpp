@@ -122,6 +122,22 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   out.trainingPoses = std::move(split.kept);
   const size_t nTrain = out.trainingPoses.size();
 
+  if (st.rootGravity && nTrain > 1) {
+    // Part 1 simulates every pose with the root at its rest rotation (pose_shape.hpp, canonicalPose): such a
+    // dataset's gravity values are one constant the network cannot learn from, and the run time would feed it
+    // the recorded root's lean, which its truth never had. Refused before any fitting.
+    // (A turn about the vertical changes nothing either: the values are gravity in the root's frame.)
+    auto gravity = [&](uint32_t p) -> Vec3f { return ds.poses[p].pose.local[0].inverse() * Vec3f(0.f, -1.f, 0.f); };
+    const Vec3f first = gravity(out.trainingPoses[0]);
+    bool leans = false;
+    for (uint32_t p : out.trainingPoses) leans = leans || (gravity(p) - first).cwiseAbs().maxCoeff() > 1e-6f;
+    if (!leans)
+      throw Error(
+          "train.root_gravity: every training pose of the dataset has its root joint at one lean (part 1 "
+          "simulates poses upright: the root's rotation is reset to its rest rotation), so the gravity "
+          "values are constant and nothing can be learnt from them; turn train.root_gravity off");
+  }
+
   // 1. Mesh PCA in pre-skinning space.
   report("mesh PCA", 0.0);
   MatXf shapes(Eigen::Index(3 * n), Eigen::Index(nTrain));
@@ -187,18 +203,6 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     const std::vector<float> th =
         runtime::computeTheta(thetaJoints, st.rootGravity, ds.poses[out.trainingPoses[i]].pose.local);
     theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
-  }
-  if (st.rootGravity && nTrain > 1) {
-    // Part 1 simulates every pose with the root at its rest rotation (pose_shape.hpp, canonicalPose): such a
-    // dataset's gravity values are one constant the network cannot learn from, and the run time would feed it
-    // the recorded root's lean, which its truth never had.
-    const Eigen::Index g = theta.rows() - 3;
-    const float spread = (theta.bottomRows(3).colwise() - theta.block(g, 0, 3, 1).col(0)).cwiseAbs().maxCoeff();
-    if (!(spread > 1e-6f))
-      throw Error(
-          "train.root_gravity: every training pose of the dataset has its root joint at one rotation (part 1 "
-          "simulates poses upright: the root's rotation is reset to its rest rotation), so the gravity "
-          "values are constant and nothing can be learnt from them; turn train.root_gravity off");
   }
   lambda.topRows(K) = meshCodes;
   if (C) lambda.bottomRows(C) = normalCodes;
