@@ -105,6 +105,14 @@ std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, 
   return neighbours;
 }
 
+std::vector<std::pair<uint32_t, uint32_t>> uniqueEdges(const std::vector<std::vector<uint32_t>>& neighbours) {
+  std::vector<std::pair<uint32_t, uint32_t>> edges;
+  for (uint32_t a = 0; a < uint32_t(neighbours.size()); ++a)
+    for (const uint32_t b : neighbours[a])
+      if (b > a) edges.emplace_back(a, b);
+  return edges;
+}
+
 std::vector<uint32_t> connectedParts(const Triangles& tris, size_t n) {
   // Union-find; a union hangs the larger root under the smaller, so every root is its part's minimum.
   std::vector<uint32_t> parent(n);

@@ -68,6 +68,8 @@ VertexTriangleAdjacency buildVertexTriangleAdjacency(const Triangles& tris, size
 // representatives hold representatives, and every other vertex's list is empty.
 std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, size_t vertexCount,
                                                          const std::vector<uint32_t>* weld = nullptr);
+// Every edge of those lists once, lower index first, ascending.
+std::vector<std::pair<uint32_t, uint32_t>> uniqueEdges(const std::vector<std::vector<uint32_t>>& neighbours);
 
 // Connected parts by shared vertex indices: per vertex, the smallest vertex index of its part (a
 // vertex in no triangle is a part of its own).

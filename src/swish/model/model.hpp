@@ -165,7 +165,7 @@ struct Model {
   Skeleton skeleton;                  // the character's skeleton (for FK and skinning)
   std::vector<uint32_t> inputJoints;  // skeleton joint indices forming Theta, in this order
   // Theta ends with the gravity direction in the root joint's frame (3 values, runtime/theta.hpp): the
-  // body's lean, which the garment hangs by. false in models baked without it (the bake's default).
+  // body's lean. false in models baked without it (the bake's default; part 1's upright datasets refuse it).
   bool rootGravity = false;
   Normalisation inputNorm;   // over Theta
   Normalisation outputNorm;  // over Lambda

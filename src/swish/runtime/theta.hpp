@@ -3,8 +3,8 @@
 // the model's input joints, in the model's order, 6 floats per joint, with core/rotation.hpp's toRot6
 // convention ([R00, R10, R20, R01, R11, R21], identity -> [1,0,0, 0,1,0]); then, in models that ask
 // for it (Model::rootGravity), the gravity direction in the root joint's frame, R_root^-1 (0, -1, 0):
-// 3 floats that tell the body's lean against gravity, which the source simulation's cloth hangs by
-// (about 0.5 mm of the jersey per degree, docs/baking.md) and no joint's local rotation holds. The
+// 3 floats that tell the body's lean against gravity, which no joint's local rotation holds (part 1's
+// own datasets are simulated upright, so a bake refuses it on them: docs/baking.md). The
 // root is skeleton joint 0 (parents come first); its heading (a turn about +Y) does not change it.
 //
 // Policy for quaternions that arrive from outside (animation files, a host engine), documented here and

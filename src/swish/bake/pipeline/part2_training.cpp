@@ -126,11 +126,15 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     // Part 1 simulates every pose with the root at its rest rotation (pose_shape.hpp, canonicalPose): such a
     // dataset's gravity values are one constant the network cannot learn from, and the run time would feed it
     // the recorded root's lean, which its truth never had. Refused before any fitting.
-    // (A turn about the vertical changes nothing either: the values are gravity in the root's frame.)
-    auto gravity = [&](uint32_t p) -> Vec3f { return ds.poses[p].pose.local[0].inverse() * Vec3f(0.f, -1.f, 0.f); };
-    const Vec3f first = gravity(out.trainingPoses[0]);
+    // (A turn about the vertical changes nothing either: the values are gravity in the root's frame.) The
+    // values are Theta's own: computeTheta with no input joints gives the gravity values alone.
+    auto gravity = [&](uint32_t p) { return runtime::computeTheta({}, true, ds.poses[p].pose.local); };
+    const std::vector<float> first = gravity(out.trainingPoses[0]);
     bool leans = false;
-    for (uint32_t p : out.trainingPoses) leans = leans || (gravity(p) - first).cwiseAbs().maxCoeff() > 1e-6f;
+    for (uint32_t p : out.trainingPoses) {
+      const std::vector<float> g = gravity(p);
+      for (size_t k = 0; k < g.size(); ++k) leans = leans || std::abs(g[k] - first[k]) > 1e-6f;
+    }
     if (!leans)
       throw Error(
           "train.root_gravity: every training pose of the dataset has its root joint at one lean (part 1 "

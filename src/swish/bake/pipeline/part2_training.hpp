@@ -45,9 +45,9 @@ struct BakeTrainSettings {
   // regression error from 4.09 to 3.40 mm (docs/baking.md).
   std::vector<std::string> inputJoints;
   // Theta ends with the gravity direction in the root joint's frame (train.root_gravity, default off):
-  // the body's lean against gravity, which the source simulation's cloth hangs by (about 0.5 mm of the
-  // default jersey per degree) and no input joint's local rotation holds (docs/baking.md, "What the
-  // network cannot see").
+  // the body's lean against gravity, which no input joint's local rotation holds. Part 1 simulates every
+  // pose upright (canonicalPose), so on its datasets the values are constant and trainBake refuses it
+  // (docs/baking.md, "What the network cannot see").
   bool rootGravity = false;
   // The push-out's body anchors: calibrated on the training poses so that pushing never takes a
   // vertex further from the simulation there (true, body_anchor_fit.hpp), or every anchor at the margin

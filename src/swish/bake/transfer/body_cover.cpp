@@ -63,12 +63,9 @@ BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, c
   if (bodyTriangles.size() > 0 && Eigen::Index(bodyTriangles.maxCoeff()) >= bodyRest.rows())
     throw Error("body cover: a body triangle names a vertex out of range");
   neighbours_ = buildVertexNeighbours(welded_, size_t(gameRest.rows()));
-  for (size_t v = 0; v < neighbours_.size(); ++v)
-    for (uint32_t u : neighbours_[v])
-      if (u > v) {
-        edges_.emplace_back(uint32_t(v), u);
-        edgeRest_.push_back((gameRest.row(Eigen::Index(v)) - gameRest.row(u)).norm());
-      }
+  edges_ = uniqueEdges(neighbours_);
+  edgeRest_.reserve(edges_.size());
+  for (const auto& [a, b] : edges_) edgeRest_.push_back((gameRest.row(a) - gameRest.row(b)).norm());
   gameTopology_ = buildFrameTopology(gameTriangles, gameRest);
   bodyTopology_ = buildFrameTopology(bodyTriangles, bodyRest);
 }
@@ -193,13 +190,13 @@ BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const std:
     // A smooth bump, not a spike: each vertex moves at least half as far as its farthest-moving neighbour
     // (three rings), and the same way, so that no edge between a moved vertex and a still one tears.
     for (int ring = 0; ring < kFalloffRings; ++ring) {
-      const std::vector<Vec3f> before = ask;
+      const std::vector<Vec3f> last = ask;
       for (size_t v = 0; v < neighbours_.size(); ++v) {
         float longest = ask[v].norm();
         for (uint32_t u : neighbours_[v]) {
-          const float length = kFalloff * before[u].norm();
+          const float length = kFalloff * last[u].norm();
           if (length > longest) {
-            ask[v] = kFalloff * before[u];
+            ask[v] = kFalloff * last[u];
             longest = length;
           }
         }

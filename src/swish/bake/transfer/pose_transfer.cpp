@@ -30,10 +30,7 @@ PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, 
       smoother_(character.garment.triangles, character.garment.positions, settings.smoothing),
       baker_(character.garment.uvs, character.garment.triangles, character.garment.positions, settings.normalMap) {
   const Points3f& p = character.garment.positions;
-  const auto neighbours = buildVertexNeighbours(character.garment.triangles, size_t(p.rows()));
-  for (uint32_t a = 0; a < uint32_t(neighbours.size()); ++a)
-    for (const uint32_t b : neighbours[a])
-      if (b > a) edges_.emplace_back(a, b);
+  edges_ = uniqueEdges(buildVertexNeighbours(character.garment.triangles, size_t(p.rows())));
   edgeRest_.reserve(edges_.size());
   for (const auto& [a, b] : edges_) edgeRest_.push_back((p.row(a) - p.row(b)).norm());
   if (settings.cover.enabled() && character.body.triangleCount() > 0)
