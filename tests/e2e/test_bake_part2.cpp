@@ -316,6 +316,29 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("joint '" + j0 + "' is named twice"), std::string::npos);
 }
 
+// train.anchor_margin_mm: uncalibrated anchors keep the recipe's margin, which the model carries through
+// its file (the run-time push-out reads it per anchor as the clearance) and its metadata records.
+TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
+  const uint64_t seed = test::testSeed(504);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const Dataset ds = syntheticDataset(seed, 80, 32);
+  BakeTrainSettings st = smallTraining();
+  st.normalCodeDims = 0;
+  st.mlp.maxEpochs = 20;
+  st.calibrateAnchors = false;
+  st.anchorMargin = 0.006f;
+  const BakeTrainOutput out = trainBake(ds, st);
+  const test::TempDir tmp("bake_part2_margin_" + std::to_string(seed));
+  saveModel(out.model, tmp / "m.swish");
+  const Model loaded = loadModel(tmp / "m.swish");
+  EXPECT_FLOAT_EQ(loaded.bodyAnchors.margin, 0.006f);
+  ASSERT_GT(loaded.bodyAnchors.anchored(), 0u);
+  for (const BodyAnchor& a : loaded.bodyAnchors.anchors)
+    if (a.present()) ASSERT_FLOAT_EQ(a.clearance, 0.006f);
+  const auto meta = nlohmann::json::parse(loaded.metadata);
+  EXPECT_NEAR(meta["settings"]["anchor_margin_mm"].get<double>(), 6.0, 1e-4);
+}
+
 // train.root_gravity: a shape that follows the root's lean, which no input joint's local rotation holds,
 // is learnt with the gravity values in Theta and not without them; the model carries them through its
 // file, and its own evaluation (the run-time path) reads them.

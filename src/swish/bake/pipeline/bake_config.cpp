@@ -385,6 +385,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "bc5_baseline",
                                                   "input_joints",
                                                   "anchor_calibration",
+                                                  "anchor_margin_mm",
                                                   "root_gravity"});
   BakeTrainSettings& t = cfg.train;
   t.meshComponents = int(train.wholeNumber("mesh_components", 1, 4096, t.meshComponents));
@@ -431,6 +432,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
     if (v != "strict" && v != "none") c.fail("must be \"strict\" or \"none\"");
     t.calibrateAnchors = v == "strict";
   }
+  t.anchorMargin = float(train.number("anchor_margin_mm", 0, 50, 1000.0 * t.anchorMargin) / 1000.0);
   return cfg;
 }
 

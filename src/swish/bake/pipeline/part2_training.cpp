@@ -44,6 +44,7 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (mlp.inputNoise > 0.0) j["input_noise"] = mlp.inputNoise;     // likewise
   if (!calibrateAnchors) j["anchor_calibration"] = "none";         // likewise
   if (rootGravity) j["root_gravity"] = true;                       // likewise
+  if (anchorMargin != BodyAnchorFitSettings{}.margin) j["anchor_margin_mm"] = 1000.0 * anchorMargin;  // likewise
   return j;
 }
 
@@ -261,7 +262,9 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
   // new ones, which makes the calibration cautious (it pushes less), not bold.
   if (ds.character.body.triangleCount() > 0) {
     report("body anchors", 0.92);
-    BodyAnchorFit fit = fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh);
+    BodyAnchorFitSettings fitSettings;
+    fitSettings.margin = st.anchorMargin;
+    BodyAnchorFit fit = fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh, fitSettings);
     out.metadata["body_anchors"] = toJson(fit);
     if (st.calibrateAnchors) {
       std::vector<Points3f> predicted(out.trainingPoses.size());

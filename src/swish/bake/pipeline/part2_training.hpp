@@ -56,6 +56,12 @@ struct BakeTrainSettings {
   // push-out from covering the body there, and the body shows through; without it the push-out covers
   // it and moves those vertices away from that truth.
   bool calibrateAnchors = true;
+  // The clearance the push-out keeps between the garment and its anchors' balls, in metres
+  // (train.anchor_margin_mm; BodyAnchorFitSettings::margin, `swish body-proxy --margin-mm`). Uncalibrated
+  // anchors keep it everywhere; on motion the model never saw, a wider margin covers the body where the
+  // network's garment dips into it, for a little more error against the truth (docs/baking.md, "The
+  // margin, measured").
+  float anchorMargin = 0.002f;
 
   nlohmann::json toJson() const;
 };

@@ -60,6 +60,16 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_TRUE(
       parseBakeConfig({{"output", "out"}, {"train", {{"anchor_calibration", "strict"}}}}, "recipe.json", "/base")
           .train.calibrateAnchors);
+  // Their margin: 2 mm unless the recipe says (then recorded; absent at the default, likewise).
+  EXPECT_FLOAT_EQ(w.train.anchorMargin, 0.002f);
+  EXPECT_FALSE(w.train.toJson().contains("anchor_margin_mm"));
+  const BakeConfig m =
+      parseBakeConfig({{"output", "out"}, {"train", {{"anchor_margin_mm", 6}}}}, "recipe.json", "/base");
+  EXPECT_FLOAT_EQ(m.train.anchorMargin, 0.006f);
+  EXPECT_NEAR(m.train.toJson()["anchor_margin_mm"].get<double>(), 6.0, 1e-4);
+  EXPECT_NE(
+      errorOf({{"output", "o"}, {"train", {{"anchor_margin_mm", 60}}}}).find("train.anchor_margin_mm: 60 is outside"),
+      std::string::npos);
   // The gravity values in Theta: off unless asked for (and then recorded; absent by default, so that the
   // fingerprints of earlier bakes stay).
   EXPECT_FALSE(w.train.rootGravity);
