@@ -43,7 +43,7 @@ struct BodyProxyOptions {
   std::string model, out;
   float maxDistanceMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.maxDistance;
   float marginMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.margin;
-  bool remove = false, oneAnchor = false, secondAtMargin = false;
+  bool remove = false, oneAnchor = false, secondAtMargin = false, uncalibrated = false;
   std::vector<std::string> clips;
   size_t poses = 48;
   float toleranceMm = 1000.f * swish::bake::BodyAnchorCalibrationSettings{}.tolerance;
@@ -71,8 +71,13 @@ std::vector<fs::path> clipFiles(const std::vector<std::string>& args) {
 }
 
 // Calibrates `anchors` on the truth of `count` frames spread evenly over the clips.
-swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& entry, swish::BodyAnchors& anchors,
-                                             const BodyProxyOptions& o) {
+// Frames of the --clips with their source simulation (the failed ones left out, as the bake leaves them out).
+struct SimulatedFrames {
+  std::vector<swish::Pose> poses;
+  std::vector<swish::bake::PoseShape> shapes;  // each ok
+};
+
+SimulatedFrames simulateClipFrames(const swish::replay::ModelEntry& entry, const BodyProxyOptions& o) {
   using namespace swish;
   std::vector<Pose> frames;
   for (const fs::path& c : clipFiles(o.clips)) {
@@ -88,7 +93,7 @@ swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& en
   const size_t count = std::min(o.poses, frames.size());
   std::vector<Pose> poses;
   for (size_t i = 0; i < count; ++i) poses.push_back(frames[i * frames.size() / count]);
-  std::printf("Calibrating on %zu frames of %zu clip frames (the source simulation of each, in parallel)...\n",
+  std::printf("Simulating %zu frames of %zu clip frames (the source simulation of each, in parallel)...\n",
               poses.size(), frames.size());
   std::vector<bake::PoseShape> shapes(poses.size());
   std::atomic<size_t> done{0};
@@ -98,18 +103,27 @@ swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& en
     std::fflush(stdout);
   });
   std::printf("\n");
-  std::vector<Points3f> predicted(poses.size());
-  std::vector<bake::BodyAnchorCalibrationPose> cal;
-  size_t failed = 0;
+  SimulatedFrames out;
   for (size_t i = 0; i < poses.size(); ++i) {
-    if (!shapes[i].ok) {
-      ++failed;
-      continue;
-    }
-    predicted[i] = bake::predictPositions(entry.model, poses[i], false);
-    cal.push_back({entry.model.skeleton.skinningMatrices(poses[i]), &shapes[i].gameMeshWorld, &predicted[i]});
+    if (!shapes[i].ok) continue;
+    out.poses.push_back(poses[i]);
+    out.shapes.push_back(std::move(shapes[i]));
   }
-  if (failed) std::printf("  %zu simulations failed and are left out (as the bake leaves them out)\n", failed);
+  if (out.poses.size() < poses.size())
+    std::printf("  %zu simulations failed and are left out (as the bake leaves them out)\n",
+                poses.size() - out.poses.size());
+  return out;
+}
+
+swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& entry, swish::BodyAnchors& anchors,
+                                             const SimulatedFrames& sim, const BodyProxyOptions& o) {
+  using namespace swish;
+  std::vector<Points3f> predicted(sim.poses.size());
+  std::vector<bake::BodyAnchorCalibrationPose> cal;
+  for (size_t i = 0; i < sim.poses.size(); ++i) {
+    predicted[i] = bake::predictPositions(entry.model, sim.poses[i], false);
+    cal.push_back({entry.model.skeleton.skinningMatrices(sim.poses[i]), &sim.shapes[i].gameMeshWorld, &predicted[i]});
+  }
   bake::BodyAnchorCalibrationSettings cs;
   cs.tolerance = o.toleranceMm / 1000.f;
   cs.second = !o.secondAtMargin;
@@ -147,7 +161,15 @@ int runBodyProxy(const BodyProxyOptions& o) {
   s.maxDistance = o.maxDistanceMm / 1000.f;
   s.margin = o.marginMm / 1000.f;
   s.secondAnchors = !o.oneAnchor;
-  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(character->body, entry.model.skeleton, entry.model.gameMesh, s);
+  // The clips' simulated frames also show where the cloth slides over the body (the slide anchors); without
+  // --clips there are none.
+  SimulatedFrames sim;
+  if (!o.clips.empty()) sim = simulateClipFrames(entry, o);
+  std::vector<bake::BodyAnchorSlidePose> slidePoses;
+  for (size_t i = 0; i < sim.poses.size(); ++i)
+    slidePoses.push_back({entry.model.skeleton.skinningMatrices(sim.poses[i]), &sim.shapes[i].gameMeshWorld});
+  const bake::BodyAnchorFit fit =
+      bake::fitBodyAnchors(character->body, entry.model.skeleton, entry.model.gameMesh, s, slidePoses);
   if (fit.anchored == 0)
     throw Error(o.model + ": no garment vertex lies within " + std::to_string(o.maxDistanceMm) +
                 " mm of the body of '" + character->name + "' (nothing written)");
@@ -155,15 +177,17 @@ int runBodyProxy(const BodyProxyOptions& o) {
       "Body of '%s' (%s): %zu of %zu garment vertices anchored (%zu farther than %.0f mm get none).\n"
       "  distance to the anchor at rest: median %.1f mm, p95 %.1f mm, max %.1f mm; ball radius: 10th percentile "
       "%.1f mm, median %.1f mm; %zu inside the body at rest, %zu within the %.1f mm margin of their ball (the "
-      "push-out moves them at rest); %zu normals turned outward; %zu also anchored on a second body part%s.\n",
+      "push-out moves them at rest); %zu normals turned outward; %zu with a second anchor%s, %zu of them where the "
+      "cloth slides to on its own part (%zu poses%s).\n",
       character->name.c_str(), loaded.how.c_str(), fit.anchored, entry.model.gameMesh.vertexCount(), fit.tooFar,
       fit.maxDistanceMm, fit.medianMm, fit.p95Mm, fit.maxMm, fit.radiusP10Mm, fit.radiusMedianMm, fit.insideAtRest,
-      fit.withinMargin, o.marginMm, fit.flippedNormals, fit.secondAnchored, o.oneAnchor ? " (--one-anchor)" : "");
+      fit.withinMargin, o.marginMm, fit.flippedNormals, fit.secondAnchored, o.oneAnchor ? " (--one-anchor)" : "",
+      fit.slideAnchored, fit.slidePoses, o.clips.empty() ? ": they need --clips" : "");
   BodyAnchors anchors = fit.anchors;
   nlohmann::json j = bake::toJson(fit);
   j["made_by"] = "swish body-proxy (after the bake)";
-  if (!o.clips.empty()) {
-    const bake::BodyAnchorCalibration cal = calibrate(entry, anchors, o);
+  if (!o.clips.empty() && !o.uncalibrated) {
+    const bake::BodyAnchorCalibration cal = calibrate(entry, anchors, sim, o);
     std::printf(
         "Calibrated on %zu simulated poses: %zu clearances lowered below the margin (median %.1f mm), %zu anchors "
         "dropped (%zu of them second anchors); on those poses the push-out moves %.1f %% of the vertices and takes "
@@ -176,7 +200,8 @@ int runBodyProxy(const BodyProxyOptions& o) {
     j["calibration"]["poses_from"] = "frames of the clips, simulated";
     j["calibration"]["clips"] = clips;
   } else {
-    std::printf("Not calibrated (no --clips): every anchor keeps the %.1f mm margin.\n", o.marginMm);
+    std::printf("Not calibrated (%s): every anchor keeps the %.1f mm margin.\n",
+                o.clips.empty() ? "no --clips" : "--uncalibrated", o.marginMm);
   }
   entry.model.bodyAnchors = anchors;
   entry.model.metadata = withMetadata(entry.model.metadata, "body_anchors", j);
@@ -200,14 +225,18 @@ swish::cli::CommandRegistration reg{
                      "clearance the push-out keeps between the garment and the anchor's ball (default 2)")
           ->check(CLI::Range(0.f, 1000.f * swish::kMaxAnchorMargin));
       app.add_option("--clips", o->clips,
-                     "calibrate on the source simulation of frames of these clips (files or folders of BVH/FBX/glTF "
-                     "on the model's skeleton; ideally motion like the model's training clips)");
+                     "calibrate on the source simulation of frames of these clips, and take from it where the cloth "
+                     "slides over the body (the slide anchors: without --clips there are none) (files or folders of "
+                     "BVH/FBX/glTF on the model's skeleton; ideally motion like the model's training clips)");
       app.add_option("--poses", o->poses, "frames simulated for the calibration, spread over the clips (default 48)")
           ->check(CLI::Range(size_t(1), size_t(100000)));
       app.add_option("--tolerance-mm", o->toleranceMm,
                      "with --clips: mean distance to the simulation per pose that pushing a vertex may add (default "
                      "0: none)")
           ->check(CLI::Range(0.f, 100.f));
+      app.add_flag("--uncalibrated", o->uncalibrated,
+                   "with --clips: find the slide anchors only; every anchor keeps the margin (as the committed "
+                   "default model's: train.anchor_calibration \"none\")");
       app.add_flag("--second-at-margin", o->secondAtMargin,
                    "with --clips: calibrate the first anchors only; the second ones keep the margin");
       app.add_flag("--one-anchor", o->oneAnchor,
@@ -219,7 +248,10 @@ swish::cli::CommandRegistration reg{
           "The push-out: each garment vertex is kept outside the ball of its anchor (the largest ball inside the "
           "rest body touching it at the vertex's closest point, its centre skinned with the body's own weights "
           "there), `margin` off it; it never pulls a vertex in, and a vertex answers to its own anchors only: the one "
-          "on its nearest body part, then (format 1.4) one on the nearest other part within reach, where parts meet. "
+          "on its nearest body part, then (format 1.4) one on the nearest other part within reach, where parts meet, "
+          "or, "
+          "for a vertex with no such part, one on its own part where the cloth slid to farthest in the simulated "
+          "poses (the jersey rides up over the belly when the arms rise). "
           "The "
           "bake calibrates "
           "each anchor's clearance on its training poses: the highest at which pushing the network's garment does "

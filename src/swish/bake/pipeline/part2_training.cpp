@@ -44,7 +44,8 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (mlp.inputNoise > 0.0) j["input_noise"] = mlp.inputNoise;     // likewise
   if (!calibrateAnchors) j["anchor_calibration"] = "none";         // likewise
   if (rootGravity) j["root_gravity"] = true;                       // likewise
-  if (anchorMargin != BodyAnchorFitSettings{}.margin) j["anchor_margin_mm"] = 1000.0 * anchorMargin;  // likewise
+  if (anchorMargin != BodyAnchorFitSettings{}.margin)  // likewise; in micrometres' steps, as the recipe writes it
+    j["anchor_margin_mm"] = std::round(1e6 * double(anchorMargin)) / 1e3;
   return j;
 }
 
@@ -264,7 +265,14 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     report("body anchors", 0.92);
     BodyAnchorFitSettings fitSettings;
     fitSettings.margin = st.anchorMargin;
-    BodyAnchorFit fit = fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh, fitSettings);
+    // The training poses' simulated garments show where the cloth slides over the body (the slide anchors).
+    std::vector<BodyAnchorSlidePose> slidePoses(out.trainingPoses.size());
+    for (size_t i = 0; i < out.trainingPoses.size(); ++i) {
+      const DatasetPose& p = ds.poses[out.trainingPoses[i]];
+      slidePoses[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld};
+    }
+    BodyAnchorFit fit =
+        fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh, fitSettings, slidePoses);
     out.metadata["body_anchors"] = toJson(fit);
     if (st.calibrateAnchors) {
       std::vector<Points3f> predicted(out.trainingPoses.size());

@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/core/error.hpp"
 #include "swish/runtime/reference_push_out.hpp"
@@ -56,10 +59,84 @@ float percentile(std::vector<float> v, double q) {
   return v[i];
 }
 
+// The slide anchors (BodyAnchorFitSettings::slideMinGap): per vertex with a first anchor and no second,
+// over the poses (evenly spread, at most slidePoses) where the garment vertex lies within slideContact
+// of its first anchor's part of the POSED body, how far that body's closest point lies outside the
+// first anchor's posed ball (the skin the ball misses under the cloth). The pose where that gap is
+// largest gives the second anchor: its closest point taken back to the rest body by its triangle's
+// barycentric coordinates, when the gap is slideMinGap or more. Poses in order and the strict "larger"
+// keep it deterministic.
+template <class AnchorAt>
+void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
+                     const std::vector<BodyAnchorSlidePose>& poses, const BodyAnchorFitSettings& s,
+                     const AnchorAt& anchorAt) {
+  const size_t n = firstPart.size();
+  std::vector<float> farthest(n, 0.f);
+  std::vector<Vec3f> farthestPoint(n, Vec3f::Zero());
+  std::vector<int> farthestTriangle(n, -1);
+  BodyCollider posed = rest;
+  const Triangles& tris = rest.triangles();
+  const Points3f& restPos = rest.positions();
+  const size_t step =
+      std::max<size_t>(1, (poses.size() + std::max<size_t>(1, s.slidePoses) - 1) / std::max<size_t>(1, s.slidePoses));
+  for (size_t p = 0; p < poses.size(); p += step) {
+    posed.pose(poses[p].skinMatrices);
+    ++fit.slidePoses;
+    const Points3f& g = *poses[p].garment;
+    const Points3f& pos = posed.positions();
+    // Each vertex writes its own entries only: the same answer on any thread count.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t v = range.begin(); v < range.end(); ++v) {
+        if (firstPart[v] < 0 || fit.anchors.second[v].present()) continue;
+        const Vec3f x = g.row(Eigen::Index(v)).transpose();
+        if (!x.allFinite()) continue;
+        const BodyCollider::Hit h = posed.closest(x, s.slideContact, firstPart[v]);
+        if (!h.found || h.triangle < 0) continue;
+        // How far under the skin the cloth lies on the first ball's surface there (its skinned centre).
+        const BodyAnchor& first = fit.anchors.anchors[v];
+        const float gap = (h.point - runtime::skinAnchorCentre(first, poses[p].skinMatrices)).norm() - first.radius;
+        if (!(gap > farthest[v])) continue;
+        const uint32_t c[3] = {tris(h.triangle, 0), tris(h.triangle, 1), tris(h.triangle, 2)};
+        const Vec3f bc =
+            barycentric(h.point, pos.row(c[0]).transpose(), pos.row(c[1]).transpose(), pos.row(c[2]).transpose());
+        const Vec3f r = bc[0] * restPos.row(c[0]).transpose() + bc[1] * restPos.row(c[1]).transpose() +
+                        bc[2] * restPos.row(c[2]).transpose();
+        farthest[v] = gap;
+        farthestPoint[v] = r;
+        farthestTriangle[v] = h.triangle;
+      }
+    });
+  }
+  std::vector<float> slides, gaps;
+  for (size_t v = 0; v < n; ++v) {
+    if (farthestTriangle[v] < 0 || farthest[v] < s.slideMinGap) continue;
+    // The rest body's own answer at that point (its pseudo-normal, as the first anchors have), from
+    // just outside it along the triangle's face normal.
+    const int t = farthestTriangle[v];
+    const Vec3f a = restPos.row(tris(t, 0)).transpose(), b = restPos.row(tris(t, 1)).transpose(),
+                c = restPos.row(tris(t, 2)).transpose();
+    const Vec3f fn = (b - a).cross(c - a);
+    if (!(fn.norm() > 0.f)) continue;
+    const BodyCollider::Hit h = rest.closest(farthestPoint[v] + 0.001f * fn.normalized(), 0.01f, firstPart[v]);
+    if (!h.found || h.triangle < 0) continue;
+    bool flipped = false;
+    const BodyAnchor anchor = anchorAt(h, flipped);
+    if (!anchor.present()) continue;
+    fit.anchors.second[v] = anchor;
+    ++fit.secondAnchored;
+    ++fit.slideAnchored;
+    slides.push_back(1000.f * (farthestPoint[v] - fit.anchors.anchors[v].position).norm());
+    gaps.push_back(1000.f * farthest[v]);
+  }
+  fit.slideMedianMm = percentile(slides, 0.5);
+  fit.slideMaxMm = slides.empty() ? 0.f : *std::max_element(slides.begin(), slides.end());
+  fit.slideGapMedianMm = percentile(gaps, 0.5);
+}
+
 }  // namespace
 
 BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const Mesh& garment,
-                             const BodyAnchorFitSettings& s) {
+                             const BodyAnchorFitSettings& s, const std::vector<BodyAnchorSlidePose>& poses) {
   body.validate("body anchor fit: body", skeleton.size());
   if (body.triangleCount() == 0) throw Error("body anchor fit: the body has no triangles");
   if (body.skin.vertexCount() != body.vertexCount()) throw Error("body anchor fit: the body has no skin weights");
@@ -68,6 +145,16 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     throw Error("body anchor fit: the largest anchor distance must be a positive number of metres");
   if (!(s.margin >= 0.f && s.margin <= kMaxAnchorMargin))
     throw Error("body anchor fit: the margin must be in [0, 0.05] metres");
+  for (size_t p = 0; p < poses.size(); ++p) {
+    if (poses[p].skinMatrices.size() != skeleton.size())
+      throw Error("body anchor fit: slide pose " + std::to_string(p) + " has " +
+                  std::to_string(poses[p].skinMatrices.size()) + " skinning matrices for " +
+                  std::to_string(skeleton.size()) + " joints");
+    if (!poses[p].garment || poses[p].garment->rows() != garment.positions.rows())
+      throw Error("body anchor fit: slide pose " + std::to_string(p) + " has a garment of " +
+                  std::to_string(poses[p].garment ? poses[p].garment->rows() : 0) + " vertices for " +
+                  std::to_string(garment.vertexCount()));
+  }
 
   // The rest body (skinning matrices all identity), searched with cells about the bound's size.
   BodyCollider collider(body, std::clamp(s.maxDistance, 0.01f, 0.1f), "body anchor fit: body");
@@ -134,6 +221,7 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
   fit.anchors.anchors.assign(n, BodyAnchor{});
   if (s.secondAnchors) fit.anchors.second.assign(n, BodyAnchor{});
   std::vector<float> distances, radii;
+  std::vector<int> firstPart(n, -1);  // the part of each vertex's first anchor (-1: none)
   for (size_t v = 0; v < n; ++v) {
     const Vec3f x = garment.positions.row(Eigen::Index(v)).transpose();
     const BodyCollider::Hit hit = collider.closest(x, s.maxDistance);
@@ -145,6 +233,7 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     }
     fit.flippedNormals += flipped ? 1 : 0;
     fit.anchors.anchors[v] = a;
+    firstPart[v] = hit.part;
     ++fit.anchored;
     if (hit.signedDistance < 0.f) ++fit.insideAtRest;
     if ((x - a.centre()).norm() - a.radius < s.margin) ++fit.withinMargin;
@@ -159,6 +248,7 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     fit.anchors.second[v] = b;
     ++fit.secondAnchored;
   }
+  if (s.secondAnchors && !poses.empty()) fitSlideAnchors(fit, collider, firstPart, poses, s, anchorAt);
   if (fit.secondAnchored == 0) fit.anchors.second.clear();  // a model without them, not N empty ones
   fit.medianMm = percentile(distances, 0.5);
   fit.p95Mm = percentile(distances, 0.95);
@@ -285,6 +375,11 @@ nlohmann::json toJson(const BodyAnchorCalibration& c) {
 nlohmann::json toJson(const BodyAnchorFit& f) {
   return {{"anchored", f.anchored},
           {"second_anchored", f.secondAnchored},
+          {"slide_anchored", f.slideAnchored},
+          {"slide_poses", f.slidePoses},
+          {"slide_median_mm", f.slideMedianMm},
+          {"slide_max_mm", f.slideMaxMm},
+          {"slide_gap_median_mm", f.slideGapMedianMm},
           {"too_far", f.tooFar},
           {"margin_mm", 1000.0 * double(f.anchors.margin)},
           {"max_distance_mm", f.maxDistanceMm},

@@ -36,13 +36,37 @@ struct BodyAnchorFitSettings {
   // another body part within maxDistance, fitted the same way (a shoulder's jersey on the trunk gets
   // the upper arm, whose end rises through it when the arm hangs).
   bool secondAnchors = true;
+  // Slide anchors (with poses given to fitBodyAnchors): cloth slides over the body (the jersey rides up
+  // over the belly when the arms rise), and a ball touching the body where the vertex sat at rest then
+  // lies under the skin the vertex has slid onto: the push-out, out of that ball, leaves it inside the
+  // body (measured on the default model's first frame of CMU 01_01, arms out: 33 belly and chest
+  // vertices up to 2.8 mm inside after the push-out, each 52-74 mm from its anchor's contact, its
+  // ball's surface 16-30 mm under the skin there). A vertex with no second anchor then gets, as its
+  // second, the ball at the rest-body point under it in the pose where its cloth touches the body (within
+  // `slideContact`) and the first ball misses that skin most, on the same part, when it misses it by
+  // `slideMinGap` or more. Every ball lies inside the body, so a second one pushes only a vertex
+  // already inside the body (as the first).
+  float slideContact = 0.01f;  // metres from the posed body
+  float slideMinGap = 0.003f;  // metres
+  size_t slidePoses = 400;     // at most this many of the poses given, evenly spread
+};
+
+// A pose to find the slide anchors in (see the settings): the body's skinning matrices and the
+// garment there (character space, posed, one row per garment vertex), both in the anchors' skeleton.
+struct BodyAnchorSlidePose {
+  std::vector<Mat4f> skinMatrices;
+  const Points3f* garment = nullptr;
 };
 
 struct BodyAnchorFit {
   BodyAnchors anchors;
   size_t anchored = 0;        // vertices with an anchor
-  size_t secondAnchored = 0;  // vertices with a second anchor (on another part; see the settings)
-  size_t tooFar = 0;          // vertices beyond maxDistance (no anchor)
+  size_t secondAnchored = 0;  // vertices with a second anchor (on another part or a slide one; see the settings)
+  size_t slideAnchored = 0;   // of them, slide anchors (on the vertex's own part, where it slid to)
+  size_t slidePoses = 0;      // poses searched for them
+  float slideMedianMm = 0, slideMaxMm = 0;  // of the slide anchors: distance of their contact from the first's (rest)
+  float slideGapMedianMm = 0;               // of the slide anchors: how far the first ball missed the skin there
+  size_t tooFar = 0;                        // vertices beyond maxDistance (no anchor)
   size_t insideAtRest = 0;    // anchored vertices inside the body at rest (the push-out moves them at rest)
   size_t withinMargin = 0;    // anchored vertices nearer their ball than the margin at rest (pushed at rest)
   size_t flippedNormals = 0;  // interpolated normals turned to agree with the pseudo-normal
@@ -54,8 +78,11 @@ struct BodyAnchorFit {
 
 // `body` skinned to `skeleton` (rest positions, triangles, skin; validated, errors name the problem),
 // `garment` the game mesh at rest (character space, as the body). Deterministic.
+// `poses` (may be empty: no slide anchors): see BodyAnchorFitSettings::slideMinGap; errors name a pose whose
+// sizes do not fit.
 BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const Mesh& garment,
-                             const BodyAnchorFitSettings& settings = {});
+                             const BodyAnchorFitSettings& settings = {},
+                             const std::vector<BodyAnchorSlidePose>& poses = {});
 
 // Calibration against the source simulation. The ball stands for the body, but the bake's own
 // simulated garment (the truth the network learns) lies inside it in places: cloth squeezed between an

@@ -241,6 +241,68 @@ TEST(BodyAnchorFit, SecondAnchorOnTheOtherPart) {
   EXPECT_GT(c1.pushedShare, 0.0);
 }
 
+// Cloth that slides over the body: the capsule's garment in a pose where it has slid 10 cm up and lies
+// 4 mm off the skin. Each vertex's first ball (centred on the axis at its rest height) misses the skin
+// there by 3.4 cm, so the push-out cannot keep the slid cloth out of the body; the slide anchor, the
+// ball under where the cloth slid to, does. Cloth that touches the skin where it sat at rest, or that
+// does not touch it at all, gets none.
+TEST(BodyAnchorFit, SlideAnchorsCoverTheSkinTheClothSlidOnto) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  const std::vector<Mat4f> rest = identities(ch.skeleton.size());
+  auto onSkin = [&](float up, float off) {  // the garment moved `up`, `off` from the (analytic) skin
+    Points3f g = ch.garment.positions;
+    for (Eigen::Index v = 0; v < g.rows(); ++v) {
+      const Vec3f p = g.row(v).transpose();
+      const Vec3f radial = Vec3f(p.x(), 0.f, p.z()).normalized();
+      g.row(v) = (radial * (spec.radius + off) + Vec3f(0.f, std::min(p.y() + up, spec.axisHigh), 0.f)).transpose();
+    }
+    return g;
+  };
+  const Points3f slid = onSkin(0.1f, 0.004f), unslid = onSkin(0.f, 0.004f), away = onSkin(0.1f, 0.03f);
+  const bake::BodyAnchorFit plain = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
+  EXPECT_EQ(plain.slideAnchored, 0u);
+  EXPECT_TRUE(plain.anchors.second.empty()) << "a one-part body has no other part";
+  const bake::BodyAnchorFit none =
+      bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment, {}, {{rest, &unslid}, {rest, &away}});
+  EXPECT_EQ(none.slideAnchored, 0u);
+  EXPECT_EQ(none.slidePoses, 2u);
+  const bake::BodyAnchorFit fit =
+      bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment, {}, {{rest, &unslid}, {rest, &slid}, {rest, &away}});
+  EXPECT_EQ(fit.slideAnchored, ch.garment.vertexCount());
+  EXPECT_EQ(fit.secondAnchored, fit.slideAnchored);
+  ASSERT_EQ(fit.anchors.second.size(), ch.garment.vertexCount());
+  for (size_t v = 0; v < ch.garment.vertexCount(); ++v) {
+    const BodyAnchor& a = fit.anchors.anchors[v];
+    const BodyAnchor& b = fit.anchors.second[v];
+    ASSERT_TRUE(b.present()) << v;
+    const float want = std::min(a.position.y() + 0.1f, spec.axisHigh);
+    EXPECT_NEAR(b.position.y(), want, 0.012f) << v << ": where the cloth slid to";
+    EXPECT_NEAR(test::capsuleSignedDistance(spec, b.position), 0.f, 0.001f) << v;
+    EXPECT_NEAR(b.radius, spec.radius, 0.003f) << v;
+  }
+  // The slid cloth 3 mm under the skin: the first balls leave it there, the slide anchors push it out.
+  const Points3f inside = onSkin(0.1f, -0.003f);
+  bake::BodyCollider collider(ch.body, 0.05f);
+  collider.pose(rest);
+  const uint32_t before = bake::measurePenetration(collider, inside).inside;
+  EXPECT_GT(before, uint32_t(inside.rows()) * 9 / 10);
+  Points3f p = inside;
+  runtime::referencePushOut(p, plain.anchors, rest);
+  EXPECT_GT(bake::measurePenetration(collider, p).inside, uint32_t(inside.rows()) * 9 / 10);
+  p = inside;
+  runtime::referencePushOut(p, fit.anchors, rest);
+  EXPECT_EQ(bake::measurePenetration(collider, p).inside, 0u);
+  // A pose whose sizes do not fit is named.
+  const std::vector<Mat4f> short_(1, Mat4f::Identity());
+  try {
+    bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment, {}, {{rest, &slid}, {short_, &slid}});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("slide pose 1 has 1 skinning matrices"), std::string::npos) << e.what();
+  }
+}
+
 // On the analytic capsule body every garment vertex (a tube 12 mm off it) is anchored on the surface
 // straight under it, with the radial normal and the body's own weights there.
 TEST(BodyAnchorFit, AnalyticCapsule) {
