@@ -45,7 +45,8 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
   const std::string before = readText(defaultModel());
 
   const fs::path plain = tmp / "plain.swish";
-  const CommandResult a = swishCmd({"body-proxy", defaultModel().string(), "--margin-mm", "4", "--out", plain.string()});
+  const CommandResult a =
+      swishCmd({"body-proxy", defaultModel().string(), "--margin-mm", "4", "--out", plain.string()});
   ASSERT_EQ(a.exitCode, 0) << a.out << a.err;
   EXPECT_NE(a.out.find("0 of them where the cloth slides to on its own part (0 poses: they need --clips)"),
             std::string::npos)
@@ -55,9 +56,9 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
   EXPECT_EQ(nlohmann::json::parse(p.metadata)["body_anchors"]["slide_anchored"], 0);
 
   const fs::path slid = tmp / "slid.swish";
-  const CommandResult b = swishCmd({"body-proxy", defaultModel().string(), "--margin-mm", "4", "--clips",
-                                    test::debianMocap("01_01.bvh").string(), "--poses", "2", "--uncalibrated",
-                                    "--out", slid.string()});
+  const CommandResult b =
+      swishCmd({"body-proxy", defaultModel().string(), "--margin-mm", "4", "--clips",
+                test::debianMocap("01_01.bvh").string(), "--poses", "2", "--uncalibrated", "--out", slid.string()});
   ASSERT_EQ(b.exitCode, 0) << b.out << b.err;
   EXPECT_NE(b.out.find("Not calibrated (--uncalibrated): every anchor keeps the 4.0 mm margin."), std::string::npos)
       << b.out;
@@ -78,8 +79,8 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
   EXPECT_EQ(filled, anchors["slide_anchored"].get<size_t>());
 
   const fs::path never = tmp / "never.swish";
-  const CommandResult c = swishCmd({"body-proxy", defaultModel().string(), "--clips", (tmp / "gone.bvh").string(),
-                                    "--out", never.string()});
+  const CommandResult c = swishCmd(
+      {"body-proxy", defaultModel().string(), "--clips", (tmp / "gone.bvh").string(), "--out", never.string()});
   EXPECT_NE(c.exitCode, 0);
   EXPECT_NE((c.out + c.err).find("gone.bvh"), std::string::npos) << c.out << c.err;
   EXPECT_FALSE(fs::exists(never));

@@ -111,7 +111,9 @@ struct BodyAnchors {
   // Format 1.4: empty, or one per game-mesh vertex (only with `anchors`): the nearest point of ANOTHER
   // body part within the fit's reach, applied after `anchors`. Where two parts meet (a shoulder, whose
   // jersey lies on the trunk while the upper arm's end turns up through it when the arm hangs), the
-  // vertex's own part cannot see the other one; its second anchor does.
+  // vertex's own part cannot see the other one; its second anchor does. A vertex with no other part in
+  // reach may have a slide anchor here instead: a ball on its own part where the bake's simulation had
+  // the cloth slide to (body_anchor_fit.hpp). The run time treats both alike.
   std::vector<BodyAnchor> second;
   bool empty() const { return anchors.empty(); }
   // Anchor sets the push-out applies, in order: 0 (none), 1 (`anchors`) or 2 (then `second`).
