@@ -311,11 +311,28 @@ TEST_F(ReplayTruth, CoverAndLimbClearanceOverridesReachTheTruthAndAreSaid) {
   }
   o.coverBodyMm = 2.5f;
   o.limbClearanceMm = 0.f;
-  const replay::ModelTruth t(*models.entries()[0], o);
+  {
+    // The committed default model was baked with the cover in both poses: the override changes its margin.
+    const replay::ModelTruth t(*models.entries()[0], o);
+    ASSERT_TRUE(t.available()) << t.note();
+    EXPECT_NE(t.note().find("overridden for this run (not the bake's): substeps cover_body_mm 2.5 limb clearance 0 mm"),
+              std::string::npos)
+        << t.note();
+  }
+  // A model baked before the cover ran in the recorded pose too (its settings lack cover_recorded_pose):
+  // the override runs the cover as bakes run it today, in both poses, and says so.
+  Model older = models.entries()[0]->model;
+  json meta = json::parse(older.metadata);
+  ASSERT_TRUE(meta["dataset_settings"]["transfer"].contains("cover_recorded_pose")) << meta["dataset_settings"].dump();
+  meta["dataset_settings"]["transfer"].erase("cover_recorded_pose");
+  older.metadata = meta.dump();
+  saveModel(older, *tmp_ / "older.swish");
+  json c = character("walker", true);
+  c["model"] = (*tmp_ / "older.swish").string();
+  const runtime::Scene so = scene(1, json::array({c}));
+  replay::ModelLibrary olderModels(so);
+  const replay::ModelTruth t(*olderModels.entries()[0], o);
   ASSERT_TRUE(t.available()) << t.note();
-  // The scene's model (the committed default) was baked before the cover ran in the recorded pose too (its
-  // settings lack cover_recorded_pose): the override runs the cover as bakes run it today, in both poses, and
-  // says so.
   EXPECT_NE(t.note().find("overridden for this run (not the bake's): substeps cover_body_mm 2.5 (in the recorded "
                           "pose too) limb clearance 0 mm"),
             std::string::npos)
