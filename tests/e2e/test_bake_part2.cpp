@@ -333,8 +333,11 @@ TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
   const Model loaded = loadModel(tmp / "m.swish");
   EXPECT_FLOAT_EQ(loaded.bodyAnchors.margin, 0.006f);
   ASSERT_GT(loaded.bodyAnchors.anchored(), 0u);
-  for (const BodyAnchor& a : loaded.bodyAnchors.anchors)
-    if (a.present()) ASSERT_FLOAT_EQ(a.clearance, 0.006f);
+  for (const BodyAnchor& a : loaded.bodyAnchors.anchors) {
+    if (a.present()) {
+      ASSERT_FLOAT_EQ(a.clearance, 0.006f);
+    }
+  }
   const auto meta = nlohmann::json::parse(loaded.metadata);
   EXPECT_NEAR(meta["settings"]["anchor_margin_mm"].get<double>(), 6.0, 1e-4);
 }

@@ -5,35 +5,22 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "support/paths.hpp"
+#include "support/swish_cli.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/cluster/process.hpp"
 #include "swish/model/model_file.hpp"
 
 using namespace swish;
 namespace fs = std::filesystem;
-using cluster::CommandResult;
 
 namespace {
 
-CommandResult swishCmd(std::vector<std::string> args) {
-  args.insert(args.begin(), SWISH_CLI);
-  return cluster::runCommand(args);
-}
-
-std::string readText(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-fs::path defaultModel() { return test::sourceDir() / "assets/default/default.swish"; }
+using test::readText;
+using test::swishCmd;
+fs::path defaultModel() { return test::committedDefaultModel(); }
 
 }  // namespace
 
@@ -45,7 +32,7 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
   const std::string before = readText(defaultModel());
 
   const fs::path plain = tmp / "plain.swish";
-  const CommandResult a =
+  const cluster::CommandResult a =
       swishCmd({"body-proxy", defaultModel().string(), "--margin-mm", "4", "--out", plain.string()});
   ASSERT_EQ(a.exitCode, 0) << a.out << a.err;
   EXPECT_NE(a.out.find("0 of them where the cloth slides to on its own part (0 poses: they need --clips)"),
@@ -56,7 +43,7 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
   EXPECT_EQ(nlohmann::json::parse(p.metadata)["body_anchors"]["slide_anchored"], 0);
 
   const fs::path slid = tmp / "slid.swish";
-  const CommandResult b =
+  const cluster::CommandResult b =
       swishCmd({"body-proxy", defaultModel().string(), "--margin-mm", "4", "--clips",
                 test::debianMocap("01_01.bvh").string(), "--poses", "2", "--uncalibrated", "--out", slid.string()});
   ASSERT_EQ(b.exitCode, 0) << b.out << b.err;
@@ -72,14 +59,18 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
   size_t filled = 0;
   for (size_t v = 0; v < s.gameMesh.vertexCount(); ++v) {
     const bool had = !p.bodyAnchors.second.empty() && p.bodyAnchors.second[v].present();
-    if (had) EXPECT_EQ(s.bodyAnchors.second[v].position, p.bodyAnchors.second[v].position) << v;
+    if (had) {
+      EXPECT_EQ(s.bodyAnchors.second[v].position, p.bodyAnchors.second[v].position) << v;
+    }
     if (!had && s.bodyAnchors.second[v].present()) ++filled;
-    if (s.bodyAnchors.anchors[v].present()) EXPECT_FLOAT_EQ(s.bodyAnchors.anchors[v].clearance, 0.004f) << v;
+    if (s.bodyAnchors.anchors[v].present()) {
+      EXPECT_FLOAT_EQ(s.bodyAnchors.anchors[v].clearance, 0.004f) << v;
+    }
   }
   EXPECT_EQ(filled, anchors["slide_anchored"].get<size_t>());
 
   const fs::path never = tmp / "never.swish";
-  const CommandResult c = swishCmd(
+  const cluster::CommandResult c = swishCmd(
       {"body-proxy", defaultModel().string(), "--clips", (tmp / "gone.bvh").string(), "--out", never.string()});
   EXPECT_NE(c.exitCode, 0);
   EXPECT_NE((c.out + c.err).find("gone.bvh"), std::string::npos) << c.out << c.err;

@@ -6,36 +6,23 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "support/paths.hpp"
+#include "support/swish_cli.hpp"
 #include "support/temp_dir.hpp"
-#include "swish/cluster/process.hpp"
 #include "swish/model/model_file.hpp"
 #include "swish/runtime/quality_levels.hpp"
 
 using namespace swish;
 namespace fs = std::filesystem;
-using cluster::CommandResult;
 
 namespace {
 
-CommandResult swishCmd(std::vector<std::string> args) {
-  args.insert(args.begin(), SWISH_CLI);
-  return cluster::runCommand(args);
-}
-
-std::string readText(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-fs::path defaultModel() { return test::sourceDir() / "assets/default/default.swish"; }
+using test::readText;
+using test::swishCmd;
+fs::path defaultModel() { return test::committedDefaultModel(); }
 
 }  // namespace
 
@@ -49,7 +36,7 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   // The clips are given: the default model is baked from the motion corpus of ../shared/mocap, and its
   // metadata names those clips where the bake read them. Debian's 01_01 and 01_03 are two of the corpus's
   // training clips (subject 01, at their recorded 120 fps).
-  const CommandResult r =
+  const cluster::CommandResult r =
       swishCmd({"levels", defaultModel().string(), "--clips", test::debianMocap("01_01.bvh").string(),
                 test::debianMocap("01_03.bvh").string(), "--frames", "2", "--threads", "2", "--out", out.string(),
                 "--report", report.string(),
@@ -64,8 +51,11 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
   const Model original = loadModel(defaultModel());
   const auto meta = nlohmann::json::parse(m.metadata), meta0 = nlohmann::json::parse(original.metadata);
   ASSERT_TRUE(meta.contains(runtime::kQualityLevelsKey));
-  for (const auto& [key, value] : meta0.items())  // the rest is kept (the ladder is measured anew)
-    if (key != runtime::kQualityLevelsKey) EXPECT_EQ(meta[key], value) << key;
+  for (const auto& [key, value] : meta0.items()) {  // the rest is kept (the ladder is measured anew)
+    if (key != runtime::kQualityLevelsKey) {
+      EXPECT_EQ(meta[key], value) << key;
+    }
+  }
   const runtime::QualityLadder l = runtime::ladderOf(m);
   ASSERT_EQ(l.size(), 5u);  // K = 128 with maps: full, k64, k32-flat, k16-flat, skinned
   EXPECT_GE(l.poses, 1u);
@@ -95,17 +85,17 @@ TEST(LevelsCli, MeasuresTheDefaultModelsLadderAgainstItsSourceSimulation) {
 
 TEST(LevelsCli, ErrorsNameTheFile) {
   const test::TempDir tmp("levels_cli_errors");
-  const CommandResult missing = swishCmd({"levels", (tmp / "nope.swish").string()});
+  const cluster::CommandResult missing = swishCmd({"levels", (tmp / "nope.swish").string()});
   EXPECT_EQ(missing.exitCode, 1);
   EXPECT_NE(missing.err.find("nope.swish"), std::string::npos) << missing.err;
   if (!fs::exists(defaultModel())) GTEST_SKIP() << "no committed default model at " << defaultModel();
   const fs::path out = tmp / "out.swish";
-  const CommandResult clip =
+  const cluster::CommandResult clip =
       swishCmd({"levels", defaultModel().string(), "--clips", (tmp / "gone.bvh").string(), "--out", out.string()});
   EXPECT_EQ(clip.exitCode, 1);
   EXPECT_NE(clip.err.find("gone.bvh does not exist"), std::string::npos) << clip.err;
   EXPECT_FALSE(fs::exists(out));  // nothing written
-  const CommandResult range =
+  const cluster::CommandResult range =
       swishCmd({"levels", defaultModel().string(), "--truth-cover-mm", "50", "--out", out.string()});
   EXPECT_NE(range.exitCode, 0);
   EXPECT_NE((range.out + range.err).find("--truth-cover-mm"), std::string::npos) << range.out << range.err;
@@ -115,7 +105,7 @@ TEST(LevelsCli, ErrorsNameTheFile) {
   Model m = loadModel(defaultModel());
   m.metadata = "{}";
   saveModel(m, bare);
-  const CommandResult noTruth = swishCmd({"levels", bare.string(), "--out", out.string()});
+  const cluster::CommandResult noTruth = swishCmd({"levels", bare.string(), "--out", out.string()});
   EXPECT_EQ(noTruth.exitCode, 1);
   EXPECT_NE(noTruth.err.find("bare.swish: no truth to measure the levels against"), std::string::npos) << noTruth.err;
   EXPECT_FALSE(fs::exists(out));

@@ -55,7 +55,9 @@ TEST(BodyCoverage, CoveredInEveryPoseIsWhatTheGarmentHidesInAll) {
       EXPECT_TRUE(inOne[t]) << t << " y " << y;
       ++inside;
     }
-    if (y < spec.garmentLow - 0.015f || y > spec.garmentHigh + 0.015f) EXPECT_FALSE(inOne[t]) << t << " y " << y;
+    if (y < spec.garmentLow - 0.015f || y > spec.garmentHigh + 0.015f) {
+      EXPECT_FALSE(inOne[t]) << t << " y " << y;
+    }
   }
   EXPECT_GT(inside, 100u);
 
