@@ -70,8 +70,8 @@ std::vector<fs::path> clipFiles(const std::vector<std::string>& args) {
   return out;
 }
 
-// Calibrates `anchors` on the truth of `count` frames spread evenly over the clips.
-// Frames of the --clips with their source simulation (the failed ones left out, as the bake leaves them out).
+// `--poses` frames spread evenly over the --clips, with their source simulation (the failed ones left out, as the bake
+// leaves them out).
 struct SimulatedFrames {
   std::vector<swish::Pose> poses;
   std::vector<swish::bake::PoseShape> shapes;  // each ok
@@ -115,6 +115,7 @@ SimulatedFrames simulateClipFrames(const swish::replay::ModelEntry& entry, const
   return out;
 }
 
+// Calibrates `anchors` on those frames: the model's garment there against their simulation.
 swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& entry, swish::BodyAnchors& anchors,
                                              const SimulatedFrames& sim, const BodyProxyOptions& o) {
   using namespace swish;

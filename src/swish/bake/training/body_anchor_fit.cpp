@@ -71,9 +71,9 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
                      const std::vector<BodyAnchorSlidePose>& poses, const BodyAnchorFitSettings& s,
                      const AnchorAt& anchorAt) {
   const size_t n = firstPart.size();
-  std::vector<float> farthest(n, 0.f);
-  std::vector<Vec3f> farthestPoint(n, Vec3f::Zero());
-  std::vector<int> farthestTriangle(n, -1);
+  std::vector<float> worstGap(n, 0.f);
+  std::vector<Vec3f> worstPoint(n, Vec3f::Zero());
+  std::vector<int> worstTriangle(n, -1);
   BodyCollider posed = rest;
   const Triangles& tris = rest.triangles();
   const Points3f& restPos = rest.positions();
@@ -95,29 +95,29 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
         // How far under the skin the cloth lies on the first ball's surface there (its skinned centre).
         const BodyAnchor& first = fit.anchors.anchors[v];
         const float gap = (h.point - runtime::skinAnchorCentre(first, poses[p].skinMatrices)).norm() - first.radius;
-        if (!(gap > farthest[v])) continue;
+        if (!(gap > worstGap[v])) continue;
         const uint32_t c[3] = {tris(h.triangle, 0), tris(h.triangle, 1), tris(h.triangle, 2)};
         const Vec3f bc =
             barycentric(h.point, pos.row(c[0]).transpose(), pos.row(c[1]).transpose(), pos.row(c[2]).transpose());
         const Vec3f r = bc[0] * restPos.row(c[0]).transpose() + bc[1] * restPos.row(c[1]).transpose() +
                         bc[2] * restPos.row(c[2]).transpose();
-        farthest[v] = gap;
-        farthestPoint[v] = r;
-        farthestTriangle[v] = h.triangle;
+        worstGap[v] = gap;
+        worstPoint[v] = r;
+        worstTriangle[v] = h.triangle;
       }
     });
   }
   std::vector<float> slides, gaps;
   for (size_t v = 0; v < n; ++v) {
-    if (farthestTriangle[v] < 0 || farthest[v] < s.slideMinGap) continue;
+    if (worstTriangle[v] < 0 || worstGap[v] < s.slideMinGap) continue;
     // The rest body's own answer at that point (its pseudo-normal, as the first anchors have), from
     // just outside it along the triangle's face normal.
-    const int t = farthestTriangle[v];
+    const int t = worstTriangle[v];
     const Vec3f a = restPos.row(tris(t, 0)).transpose(), b = restPos.row(tris(t, 1)).transpose(),
                 c = restPos.row(tris(t, 2)).transpose();
     const Vec3f fn = (b - a).cross(c - a);
     if (!(fn.norm() > 0.f)) continue;
-    const BodyCollider::Hit h = rest.closest(farthestPoint[v] + 0.001f * fn.normalized(), 0.01f, firstPart[v]);
+    const BodyCollider::Hit h = rest.closest(worstPoint[v] + 0.001f * fn.normalized(), 0.01f, firstPart[v]);
     if (!h.found || h.triangle < 0) continue;
     bool flipped = false;
     const BodyAnchor anchor = anchorAt(h, flipped);
@@ -125,8 +125,8 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
     fit.anchors.second[v] = anchor;
     ++fit.secondAnchored;
     ++fit.slideAnchored;
-    slides.push_back(1000.f * (farthestPoint[v] - fit.anchors.anchors[v].position).norm());
-    gaps.push_back(1000.f * farthest[v]);
+    slides.push_back(1000.f * (worstPoint[v] - fit.anchors.anchors[v].position).norm());
+    gaps.push_back(1000.f * worstGap[v]);
   }
   fit.slideMedianMm = percentile(slides, 0.5);
   fit.slideMaxMm = slides.empty() ? 0.f : *std::max_element(slides.begin(), slides.end());
