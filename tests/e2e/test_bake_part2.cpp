@@ -339,7 +339,8 @@ TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
     }
   }
   const auto meta = nlohmann::json::parse(loaded.metadata);
-  EXPECT_NEAR(meta["settings"]["anchor_margin_mm"].get<double>(), 6.0, 1e-4);
+  EXPECT_EQ(meta["settings"]["anchor_margin_mm"].get<double>(), 6.0);
+  EXPECT_EQ(meta["body_anchors"]["margin_mm"].get<double>(), 6.0);
 }
 
 // train.root_gravity: a shape that follows the root's lean, which no input joint's local rotation holds,

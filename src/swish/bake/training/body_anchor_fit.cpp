@@ -381,7 +381,7 @@ nlohmann::json toJson(const BodyAnchorFit& f) {
           {"slide_max_mm", f.slideMaxMm},
           {"slide_gap_median_mm", f.slideGapMedianMm},
           {"too_far", f.tooFar},
-          {"margin_mm", 1000.0 * double(f.anchors.margin)},
+          {"margin_mm", std::round(1e6 * double(f.anchors.margin)) / 1e3},  // in micrometre steps: 6, not 6.000000052
           {"max_distance_mm", f.maxDistanceMm},
           {"inside_at_rest", f.insideAtRest},
           {"within_margin_at_rest", f.withinMargin},
