@@ -74,7 +74,8 @@ std::vector<fs::path> clipFiles(const std::vector<std::string>& args) {
 // leaves them out).
 struct SimulatedFrames {
   std::vector<swish::Pose> poses;
-  std::vector<swish::bake::PoseShape> shapes;  // each ok
+  std::vector<std::vector<swish::Mat4f>> skinMatrices;  // each pose's
+  std::vector<swish::bake::PoseShape> shapes;           // each ok
 };
 
 SimulatedFrames simulateClipFrames(const swish::replay::ModelEntry& entry, const BodyProxyOptions& o) {
@@ -107,6 +108,7 @@ SimulatedFrames simulateClipFrames(const swish::replay::ModelEntry& entry, const
   for (size_t i = 0; i < poses.size(); ++i) {
     if (!shapes[i].ok) continue;
     out.poses.push_back(poses[i]);
+    out.skinMatrices.push_back(entry.model.skeleton.skinningMatrices(poses[i]));
     out.shapes.push_back(std::move(shapes[i]));
   }
   if (out.poses.size() < poses.size())
@@ -123,7 +125,7 @@ swish::bake::BodyAnchorCalibration calibrate(const swish::replay::ModelEntry& en
   std::vector<bake::BodyAnchorCalibrationPose> cal;
   for (size_t i = 0; i < sim.poses.size(); ++i) {
     predicted[i] = bake::predictPositions(entry.model, sim.poses[i], false);
-    cal.push_back({entry.model.skeleton.skinningMatrices(sim.poses[i]), &sim.shapes[i].gameMeshWorld, &predicted[i]});
+    cal.push_back({sim.skinMatrices[i], &sim.shapes[i].gameMeshWorld, &predicted[i]});
   }
   bake::BodyAnchorCalibrationSettings cs;
   cs.tolerance = o.toleranceMm / 1000.f;
@@ -168,7 +170,7 @@ int runBodyProxy(const BodyProxyOptions& o) {
   if (!o.clips.empty()) sim = simulateClipFrames(entry, o);
   std::vector<bake::BodyAnchorSlidePose> slidePoses;
   for (size_t i = 0; i < sim.poses.size(); ++i)
-    slidePoses.push_back({entry.model.skeleton.skinningMatrices(sim.poses[i]), &sim.shapes[i].gameMeshWorld});
+    slidePoses.push_back({sim.skinMatrices[i], &sim.shapes[i].gameMeshWorld});
   const bake::BodyAnchorFit fit =
       bake::fitBodyAnchors(character->body, entry.model.skeleton, entry.model.gameMesh, s, slidePoses);
   if (fit.anchored == 0)

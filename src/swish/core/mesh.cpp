@@ -113,6 +113,13 @@ std::vector<std::pair<uint32_t, uint32_t>> uniqueEdges(const std::vector<std::ve
   return edges;
 }
 
+std::vector<float> edgeLengths(const Points3f& positions, const std::vector<std::pair<uint32_t, uint32_t>>& edges) {
+  std::vector<float> lengths;
+  lengths.reserve(edges.size());
+  for (const auto& [a, b] : edges) lengths.push_back((positions.row(a) - positions.row(b)).norm());
+  return lengths;
+}
+
 std::vector<uint32_t> connectedParts(const Triangles& tris, size_t n) {
   // Union-find; a union hangs the larger root under the smaller, so every root is its part's minimum.
   std::vector<uint32_t> parent(n);

@@ -70,6 +70,8 @@ std::vector<std::vector<uint32_t>> buildVertexNeighbours(const Triangles& tris, 
                                                          const std::vector<uint32_t>* weld = nullptr);
 // Every edge of those lists once, lower index first, ascending.
 std::vector<std::pair<uint32_t, uint32_t>> uniqueEdges(const std::vector<std::vector<uint32_t>>& neighbours);
+// The length of each of those edges in `positions`.
+std::vector<float> edgeLengths(const Points3f& positions, const std::vector<std::pair<uint32_t, uint32_t>>& edges);
 
 // Connected parts by shared vertex indices: per vertex, the smallest vertex index of its part (a
 // vertex in no triangle is a part of its own).

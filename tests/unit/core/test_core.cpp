@@ -201,6 +201,21 @@ TEST(MeshFrames, SeamCopiesShareTheirNormal) {
 
 // A quad strip closed into a tube by a UV seam (its first column repeated): welded, only the two rims are
 // openings; unwelded, the seam is too.
+// A unit square of two triangles: five edges, each once, lower index first, and their lengths.
+TEST(Mesh, UniqueEdgesAndTheirLengths) {
+  Points3f p(4, 3);
+  p << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  Triangles t(2, 3);
+  t << 0, 1, 2, 0, 2, 3;
+  const auto edges = uniqueEdges(buildVertexNeighbours(t, 4));
+  using E = std::pair<uint32_t, uint32_t>;
+  EXPECT_EQ(edges, (std::vector<E>{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}}));
+  const std::vector<float> l = edgeLengths(p, edges);
+  ASSERT_EQ(l.size(), 5u);
+  EXPECT_FLOAT_EQ(l[1], std::sqrt(2.f));
+  for (size_t e : {0, 2, 3, 4}) EXPECT_FLOAT_EQ(l[e], 1.f) << e;
+}
+
 TEST(Mesh, OpenEdgesAreTheRimsOnceTheSeamIsWelded) {
   const int around = 6;
   Points3f p((around + 1) * 2, 3);

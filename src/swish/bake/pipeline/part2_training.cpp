@@ -132,11 +132,12 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     // values are Theta's own: computeTheta with no input joints gives the gravity values alone.
     auto gravity = [&](uint32_t p) { return runtime::computeTheta({}, true, ds.poses[p].pose.local); };
     const std::vector<float> first = gravity(out.trainingPoses[0]);
-    bool leans = false;
-    for (uint32_t p : out.trainingPoses) {
+    const bool leans = std::any_of(out.trainingPoses.begin(), out.trainingPoses.end(), [&](uint32_t p) {
       const std::vector<float> g = gravity(p);
-      for (size_t k = 0; k < g.size(); ++k) leans = leans || std::abs(g[k] - first[k]) > 1e-6f;
-    }
+      for (size_t k = 0; k < g.size(); ++k)
+        if (std::abs(g[k] - first[k]) > 1e-6f) return true;
+      return false;
+    });
     if (!leans)
       throw Error(
           "train.root_gravity: every training pose of the dataset has its root joint at one lean (part 1 "
@@ -280,7 +281,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       for (size_t i = 0; i < out.trainingPoses.size(); ++i) {
         const DatasetPose& p = ds.poses[out.trainingPoses[i]];
         predicted[i] = predictPositions(out.model, p.pose, false);
-        cal[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld, &predicted[i]};
+        cal[i] = {slidePoses[i].skinMatrices, &p.gameMeshWorld, &predicted[i]};  // the same pose's matrices
       }
       const BodyAnchorCalibration calibration = calibrateBodyAnchors(fit.anchors, cal);
       out.metadata["body_anchors"]["calibration"] = toJson(calibration);

@@ -64,8 +64,7 @@ BodyCover::BodyCover(const Points3f& gameRest, const Triangles& gameTriangles, c
     throw Error("body cover: a body triangle names a vertex out of range");
   neighbours_ = buildVertexNeighbours(welded_, size_t(gameRest.rows()));
   edges_ = uniqueEdges(neighbours_);
-  edgeRest_.reserve(edges_.size());
-  for (const auto& [a, b] : edges_) edgeRest_.push_back((gameRest.row(a) - gameRest.row(b)).norm());
+  edgeRest_ = edgeLengths(gameRest, edges_);
   gameTopology_ = buildFrameTopology(gameTriangles, gameRest);
   bodyTopology_ = buildFrameTopology(bodyTriangles, bodyRest);
 }
@@ -234,11 +233,8 @@ BodyCoverStats BodyCover::apply(Points3f& game, const Points3f& body, const std:
 
 void BodyCover::holdTears(Points3f& game, const Points3f& before, BodyCoverStats& stats) const {
   // The bound per edge, from the shape before the cover.
-  std::vector<float> bound(edges_.size());
-  for (size_t e = 0; e < edges_.size(); ++e) {
-    const auto [a, b] = edges_[e];
-    bound[e] = std::max((before.row(a) - before.row(b)).norm(), (1.f + kCoverStrain) * edgeRest_[e]);
-  }
+  std::vector<float> bound = edgeLengths(before, edges_);
+  for (size_t e = 0; e < edges_.size(); ++e) bound[e] = std::max(bound[e], (1.f + kCoverStrain) * edgeRest_[e]);
   // Each representative's share of its move; an over-stretched edge's ends give some back.
   std::vector<float> share(size_t(game.rows()), 1.f);
   const Points3f moved = game;

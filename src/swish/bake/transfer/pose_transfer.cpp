@@ -31,8 +31,7 @@ PoseTransfer::PoseTransfer(const Character& character, const Points3f& simRest, 
       baker_(character.garment.uvs, character.garment.triangles, character.garment.positions, settings.normalMap) {
   const Points3f& p = character.garment.positions;
   edges_ = uniqueEdges(buildVertexNeighbours(character.garment.triangles, size_t(p.rows())));
-  edgeRest_.reserve(edges_.size());
-  for (const auto& [a, b] : edges_) edgeRest_.push_back((p.row(a) - p.row(b)).norm());
+  edgeRest_ = edgeLengths(p, edges_);
   if (settings.cover.enabled() && character.body.triangleCount() > 0)
     cover_.emplace(character.garment.positions, character.garment.triangles, character.body.positions,
                    character.body.triangles, settings.cover);
