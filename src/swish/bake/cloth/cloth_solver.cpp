@@ -29,6 +29,42 @@ std::string describeVertex(const SimulationMesh& mesh, const Skeleton& skeleton,
   return "simulation vertex " + std::to_string(v) + ", near joint '" +
          skeleton.joints[mesh.skin.strongestJoint(v)].name + "'" + at;
 }
+// The dual-quaternion blend (Kavan et al. 2007) of each vertex's joints' transforms (ClothCarry::
+// DualQuaternion): the joints' skinning matrices are rigid (a skeleton without scale), their quaternions
+// are taken to the first influence's hemisphere, weighted, summed and normalised; rigid per vertex.
+void dualQuaternionBlends(const SkinWeights& skin, const std::vector<Mat4f>& m, std::vector<Affine34>& out) {
+  std::vector<Eigen::Vector4f> real(m.size()), dual(m.size());  // (x, y, z, w) coefficients
+  for (size_t j = 0; j < m.size(); ++j) {
+    const Quatf r = Quatf(Mat3f(m[j].topLeftCorner<3, 3>())).normalized();
+    const Vec3f t = m[j].topRightCorner<3, 1>();
+    real[j] = r.coeffs();
+    dual[j] = 0.5f * (Quatf(0.f, t.x(), t.y(), t.z()) * r).coeffs();
+  }
+  const size_t n = out.size(), inf = size_t(skin.influences);
+  for (size_t v = 0; v < n; ++v) {
+    Eigen::Vector4f r = Eigen::Vector4f::Zero(), d = Eigen::Vector4f::Zero();
+    int pivot = -1;
+    for (size_t k = 0; k < inf; ++k) {
+      const float w = skin.weights[v * inf + k];
+      if (!(w > 0.f)) continue;
+      const size_t j = skin.joints[v * inf + k];
+      if (pivot < 0) pivot = int(j);
+      const float sign = real[size_t(pivot)].dot(real[j]) < 0.f ? -1.f : 1.f;
+      r += sign * w * real[j];
+      d += sign * w * dual[j];
+    }
+    const float len = r.norm();
+    if (!(len > 1e-12f)) {  // no weight: the identity (a carry that moves nothing)
+      out[v] = Affine34::Identity();
+      continue;
+    }
+    const Quatf R(Eigen::Vector4f(r / len)), D(Eigen::Vector4f(d / len));
+    const Quatf t = D * R.conjugate();  // half the translation, as a pure quaternion
+    out[v].leftCols<3>() = R.toRotationMatrix();
+    out[v].col(3) = 2.f * Vec3f(t.x(), t.y(), t.z());
+  }
+}
+
 // How far from the body a band vertex may be to be anchored to it (m).
 constexpr float kAnchorReach = 0.1f;
 // Band vertices this close to a body part other than the trunk are not attached (m); over the next
@@ -94,7 +130,17 @@ std::vector<uint8_t> colliderJointGroups(const Skeleton& sk) {
   return group;
 }
 
-const char* clothCarryName(ClothCarry carry) { return carry == ClothCarry::Translation ? "translation" : "skinning"; }
+const char* clothCarryName(ClothCarry carry) {
+  switch (carry) {
+    case ClothCarry::Translation:
+      return "translation";
+    case ClothCarry::DualQuaternion:
+      return "dual_quaternion";
+    case ClothCarry::Skinning:
+      break;
+  }
+  return "skinning";
+}
 
 void ClothSimSettings::validate() const {
   validateClothMaterial(material);
@@ -126,20 +172,24 @@ void ClothSimSettings::validate() const {
         "equilibriumSeconds must be in [0, 60]");
   check(equilibriumIterations >= 0 && equilibriumIterations <= 1000, "equilibriumIterations must be in [0, 1000]");
   check(retries >= 0 && retries <= 4, "retries must be in [0, 4]");
-  check(!retryCarries.empty() && retryCarries.size() <= 2 &&
-            (retryCarries.size() == 1 || retryCarries[0] != retryCarries[1]),
-        "retryCarries must name one or two different carries");
+  bool distinct = true;
+  for (size_t i = 0; i < retryCarries.size(); ++i)
+    for (size_t k = 0; k < i; ++k) distinct = distinct && retryCarries[i] != retryCarries[k];
+  check(!retryCarries.empty() && retryCarries.size() <= 3 && distinct,
+        "retryCarries must name one to three different carries");
   check(std::isfinite(staticTolerance) && staticTolerance > 0.f, "staticTolerance must be positive");
   check(staticIterations >= 1 && staticIterations <= 1000, "staticIterations must be in [1, 1000]");
 }
 
-ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSettings settings)
+ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSettings settings,
+                         PathClearance pathClearance)
     : skeleton_(ch.skeleton),
       mesh_(std::move(mesh)),
       settings_((settings.validate(), std::move(settings))),
       origin_(garmentCentre(mesh_)),
       colliderPrototype_(shiftedBody(ch, origin_), settings_.thickness + settings_.contactMargin,
-                         "body of character '" + ch.name + "'", colliderJointGroups(ch.skeleton)) {
+                         "body of character '" + ch.name + "'", colliderJointGroups(ch.skeleton)),
+      pathClearance_(std::move(pathClearance)) {
   skeleton_.validate("skeleton of character '" + ch.name + "'");
   if (skeleton_.inverseBind.empty()) skeleton_.computeInverseBindFromRest();
   const std::string what = "simulation mesh of character '" + ch.name + "'";
@@ -293,14 +343,20 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
     f.value(s.staticTolerance);
     f.value(s.staticIterations);
   }
-  // (9, hashed only for the translation carry, for the same reason.)
+  // (9 and 12, hashed only for the translation and dual-quaternion carries, for the same reason.)
   if (s.carry == ClothCarry::Translation) f.value(uint32_t(9));
+  if (s.carry == ClothCarry::DualQuaternion) f.value(uint32_t(12));
   firstAttemptFingerprint_ = f.h;
   // (10: the retries' carries, hashed only when they are not the skinning one alone. A first-attempt
   // result does not depend on them: the pose driver reuses those by firstAttemptFingerprint.)
   if (!s.skinningRetriesOnly()) {
     f.value(uint32_t(10));
     for (ClothCarry c : s.retryCarries) f.value(uint32_t(c));
+  }
+  // (11: the safer-path retries, and whether the path can be kept clear, hashed only when on.)
+  if (s.saferPathRetries && s.retries > 0) {
+    f.value(uint32_t(11));
+    f.value(uint32_t(bool(pathClearance_)));
   }
   fingerprint_ = f.h;
 }
@@ -370,14 +426,37 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
       last.residuals.seconds = seconds;
       if (last.ok) return last;
     }
-  last.failure = "after " + std::to_string(last.attempts) + " attempts (the last with " +
-                 std::to_string(1 << settings_.retries) + "x the substeps and transition, the " +
-                 clothCarryName(settings_.retryCarries.back()) + " carry): " + last.failure +
-                 "; first attempt: " + first.failure;
+  std::string lastWay = std::to_string(1 << settings_.retries) + "x the substeps and transition, the " +
+                        clothCarryName(settings_.retryCarries.back()) + " carry";
+  if (settings_.saferPathRetries) {
+    // The safer paths (ClothSimSettings::saferPathRetries), in this order.
+    struct Way {
+      int slowdown;
+      ClothCarry carry;
+      bool clearPath;
+      const char* what;
+    };
+    for (const Way& way :
+         {Way{1, ClothCarry::Skinning, true, "the path kept clear of the trunk"},
+          Way{2, ClothCarry::Skinning, true, "the path kept clear of the trunk at 2x"},
+          Way{1, ClothCarry::DualQuaternion, false, "the dual_quaternion carry"},
+          Way{2, ClothCarry::Translation, true, "the path kept clear of the trunk at 2x and the translation carry"}}) {
+      if (way.clearPath && !pathClearance_) continue;
+      last = simulateOnce(target, way.slowdown, way.carry, way.clearPath);
+      seconds += last.residuals.seconds;
+      last.attempts = ++attempts;
+      last.firstFailure = first.failure;
+      last.residuals.seconds = seconds;
+      if (last.ok) return last;
+      lastWay = way.what;
+    }
+  }
+  last.failure = "after " + std::to_string(last.attempts) + " attempts (the last with " + lastWay +
+                 "): " + last.failure + "; first attempt: " + first.failure;
   return last;
 }
 
-PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, ClothCarry carry) const {
+PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, ClothCarry carry, bool clearPath) const {
   const double start = threadCpuSeconds();
   PoseSimulation out;
   auto fail = [&](std::string why) {
@@ -416,6 +495,10 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, Cloth
   Points3f x = restLocal_, xPrev = restLocal_, vel = Points3f::Zero(Eigen::Index(nv), 3);
   std::vector<Affine34> blendOld(nv), blendNew(nv);
   auto blendAll = [&](const std::vector<Mat4f>& m, std::vector<Affine34>& b) {
+    if (carry == ClothCarry::DualQuaternion) {
+      dualQuaternionBlends(mesh_.skin, m, b);
+      return;
+    }
     for (size_t v = 0; v < nv; ++v) b[v] = blendedSkinMatrix(mesh_.skin, v, m).topRows<3>();
   };
   blendAll(localSkinMatrices(rest), blendOld);
@@ -434,6 +517,8 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, Cloth
     const float keep = std::max(0.f, 1.f - mat.damping * dt);
     Pose p = rest;
     for (size_t j = 0; j < skeleton_.size(); ++j) p.local[j] = slerpShortest(rest.local[j], goal.local[j], t);
+    // The safer path: this frame's limbs out of the trunk too (the target's already are).
+    if (clearPath && t < 1.f) pathClearance_(p);
     const std::vector<Mat4f> m = localSkinMatrices(p);
     blendAll(m, blendNew);
 

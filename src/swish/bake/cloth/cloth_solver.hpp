@@ -11,6 +11,7 @@
 // Coordinates: the solve runs relative to the garment's rest centre (huge character coordinates lose
 // no precision inside the solve) and ignores the pose's root translation (the shape is a function of
 // the joint rotations alone). Results are in character space with the root at its rest position.
+#include <functional>
 #include <string>
 
 #include "swish/bake/cloth/body_collider.hpp"
@@ -35,8 +36,15 @@ enum class ClothCarry {
   // explode with Skinning: 11 of 16 simulate; on ordinary poses it is less converged (12.7 against
   // 9.7 mm mean on 16 poses), so it is not the default (docs/baking.md, "The carry").
   Translation,
+  // Each vertex moved by the change of its dual-quaternion blend of the joints' transforms (Kavan et
+  // al. 2007): rigid per vertex, so where linear blends collapse (an upper arm twisted far about its
+  // bone: the sleeve's blends of the shoulder and the arm shrink to a fifth of their volume) the cloth
+  // is turned with the arm instead of being drawn into it. Measured on the default bake's 11 lost
+  // poses: it keeps one of them (pose 717) that both other carries lose. Only the carry: the game
+  // mesh is still skinned linearly, by the run time as by the transfer.
+  DualQuaternion,
 };
-// "skinning" | "translation": the names recipes and reports use.
+// "skinning" | "translation" | "dual_quaternion": the names recipes and reports use.
 const char* clothCarryName(ClothCarry carry);
 
 // How a sweep runs its stretch, shear and bending blocks. All three give bitwise the same answer
@@ -106,6 +114,18 @@ struct ClothSimSettings {
   // on the default bake's 3929 poses: the skinning carry then the translation carry keeps every pose
   // the skinning retry keeps, with the same shape, and 13 of the 24 it loses (docs/baking.md, "The carry").
   std::vector<ClothCarry> retryCarries = {ClothCarry::Skinning, ClothCarry::Translation};
+  // After the retries (when retries >= 1), four attempts along safer paths before the pose is left
+  // out: the transition with the limbs kept out of the trunk at every frame (the solver's path
+  // clearance, given by the bake: limb_clearance.hpp applied to each frame's pose, not only the
+  // target's) at the base speed and at half of it, both with the skinning carry, then the base path
+  // with the dual-quaternion carry, then the cleared path at half speed with the translation carry. Why: a transition
+  // that slerps each joint from the A-pose swings an arm through the trunk on its way to a target in front of or behind
+  // the body, and the cloth caught between them explodes whatever the substeps; a far twist collapses the linear blends
+  // the carry follows. Measured on the 11 poses the session-32 default bake lost in its simulation (docs/baking.md,
+  // "Safer paths"): the cleared path keeps 4 (3 at the base speed, 1 at half), the dual-quaternion carry 1.
+  // A pose that simulates before them is simulated as before. Recipes: part1.simulation.safer_path_retries (settings
+  // recorded before it: false).
+  bool saferPathRetries = true;
   // The retries of bakes from before retryCarries was a setting: the skinning carry alone. Fingerprints,
   // dataset settings and descriptions name retryCarries only when it differs from that.
   bool skinningRetriesOnly() const { return retryCarries == std::vector<ClothCarry>{ClothCarry::Skinning}; }
@@ -136,7 +156,11 @@ class ClothSolver {
   // Validates the character's body and skeleton against the mesh and prepares constraints, masses,
   // attachments and the collider prototype. Throws Error on bad input (including a garment that
   // starts inside the body by more than failPenetration).
-  ClothSolver(const Character& character, SimulationMesh mesh, ClothSimSettings settings);
+  // `pathClearance` (may be empty): turns a pose's limbs out of the trunk in place, for the safer-path
+  // retries (ClothSimSettings::saferPathRetries); without it those retries keep the dual-quaternion one.
+  using PathClearance = std::function<void(Pose&)>;
+  ClothSolver(const Character& character, SimulationMesh mesh, ClothSimSettings settings,
+              PathClearance pathClearance = {});
 
   // Simulates one target pose. Thread-safe and deterministic: all state is local to the call, every
   // loop is sequential, so the same input gives bitwise the same output on any thread. Bad poses
@@ -162,7 +186,8 @@ class ClothSolver {
  private:
   // One attempt: the transition `slowdown` times slower with `slowdown` times the substeps, the cloth
   // carried by `carry`.
-  PoseSimulation simulateOnce(const Pose& target, int slowdown, ClothCarry carry) const;
+  // With `clearPath`, every frame's pose of the transition goes through pathClearance_ first.
+  PoseSimulation simulateOnce(const Pose& target, int slowdown, ClothCarry carry, bool clearPath = false) const;
   std::vector<Mat4f> localSkinMatrices(const Pose& pose) const;
   float penetrationOf(const BodyCollider& body, const Vec3f& p) const;
   struct BodyAnchor;
@@ -195,6 +220,7 @@ class ClothSolver {
   float shortEdgeFloor_ = 0.f;
   std::vector<Tether> tethers_;
   BodyCollider colliderPrototype_;
+  PathClearance pathClearance_;
   uint64_t fingerprint_ = 0;
   uint64_t firstAttemptFingerprint_ = 0;
 };

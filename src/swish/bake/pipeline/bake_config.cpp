@@ -105,6 +105,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "final_projection",
                                                   "carry",
                                                   "retry_carries",
+                                                  "safer_path_retries",
                                                   "check_poses",
                                                   "source",
                                                   "path",
@@ -164,20 +165,25 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   cs.finalProjection = sim.boolean("final_projection", cs.finalProjection);
   // How the cloth follows the body from frame to frame (cloth_solver.hpp, ClothCarry).
   auto carryOf = [](const JsonReader& at, const std::string& c) {
-    for (ClothCarry k : {ClothCarry::Skinning, ClothCarry::Translation})
+    for (ClothCarry k : {ClothCarry::Skinning, ClothCarry::Translation, ClothCarry::DualQuaternion})
       if (c == clothCarryName(k)) return k;
-    at.fail("'" + c + "' is not \"skinning\" or \"translation\"");
+    at.fail("'" + c + "' is not \"skinning\", \"translation\" or \"dual_quaternion\"");
   };
   cs.carry = carryOf(sim.child("carry"), sim.nonEmptyString("carry", "skinning"));
   // The carries a failed pose's retries try in turn (cloth_solver.hpp, ClothSimSettings::retryCarries).
   if (sim.has("retry_carries")) {
     const JsonReader list = sim.child("retry_carries");
     const std::vector<std::string> names = list.strings();
-    if (names.size() > 2 || (names.size() == 2 && names[0] == names[1]))
-      list.fail("must name one or two different carries (\"skinning\", \"translation\")");
+    bool distinct = true;
+    for (size_t i = 0; i < names.size(); ++i)
+      for (size_t k = 0; k < i; ++k) distinct = distinct && names[i] != names[k];
+    if (names.size() > 3 || !distinct)
+      list.fail("must name one to three different carries (\"skinning\", \"translation\", \"dual_quaternion\")");
     cs.retryCarries.clear();
     for (size_t i = 0; i < names.size(); ++i) cs.retryCarries.push_back(carryOf(list.at(i), names[i]));
   }
+  // After the retries, the safer paths (cloth_solver.hpp, ClothSimSettings::saferPathRetries).
+  cs.saferPathRetries = sim.boolean("safer_path_retries", cs.saferPathRetries);
   // Poses sampled for the report's convergence and noise figures (simulation_quality.hpp; 0: none).
   s.quality.poses = size_t(sim.wholeNumber("check_poses", 0, 1000, double(s.quality.poses)));
   try {
@@ -335,6 +341,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (sim.is_object() && !sim.contains("carry")) s.simulation.carry = ClothCarry::Skinning;
   // Settings recorded before the retries had their own carries retried with the skinning one.
   if (sim.is_object() && !sim.contains("retry_carries")) s.simulation.retryCarries = {ClothCarry::Skinning};
+  // Settings recorded before the safer-path retries left a pose out after the retries above.
+  if (sim.is_object() && !sim.contains("safer_path_retries")) s.simulation.saferPathRetries = false;
   // Settings recorded before it carried every corrected vertex through pre-skin space.
   const nlohmann::json tr = datasetSettings.value("transfer", nlohmann::json::object());
   if (tr.is_object() && !tr.contains("reskin_min_singular_value")) s.transfer.reskinMinSingularValue = 0.f;

@@ -286,8 +286,9 @@ nlohmann::json DatasetBuildSettings::toJson() const {
     out["simulation"]["static_tolerance"] = m.staticTolerance;
     out["simulation"]["static_iterations"] = m.staticIterations;
   }
-  if (m.carry == ClothCarry::Translation) out["simulation"]["carry"] = clothCarryName(m.carry);  // likewise
-  if (transfer.reskinMinSingularValue > 0.f)                                                     // likewise
+  if (m.carry != ClothCarry::Skinning) out["simulation"]["carry"] = clothCarryName(m.carry);  // likewise
+  if (m.saferPathRetries) out["simulation"]["safer_path_retries"] = true;                     // likewise
+  if (transfer.reskinMinSingularValue > 0.f)                                                  // likewise
     out["transfer"]["reskin_min_singular_value"] = transfer.reskinMinSingularValue;
   if (transfer.cover.enabled()) {  // likewise
     out["transfer"]["cover_body_mm"] = 1000.f * transfer.cover.margin;

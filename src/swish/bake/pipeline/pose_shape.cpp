@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include <Eigen/SVD>
 
@@ -18,6 +19,15 @@ std::optional<LimbClearance> makeClearance(const Character& c, const LimbClearan
   return std::nullopt;
 }
 
+// The solver's path clearance (ClothSimSettings::saferPathRetries): the same limb clearance as the
+// targets', on each frame of the transition. The solver keeps its own copy, so that it does not depend
+// on where this simulator lives.
+ClothSolver::PathClearance pathClearanceOf(const std::optional<LimbClearance>& clearance) {
+  if (!clearance) return {};
+  auto c = std::make_shared<const LimbClearance>(*clearance);
+  return [c](Pose& p) { c->apply(p); };
+}
+
 }  // namespace
 
 Pose canonicalPose(const Skeleton& skeleton, Pose p) {
@@ -30,7 +40,8 @@ PoseShapeSimulator::PoseShapeSimulator(const Character& character, const PoseSha
     : character_(&character),
       settings_(settings),
       clearance_(makeClearance(character, settings.limbClearance)),
-      solver_(character, buildSimulationMesh(character, settings.simulationVertices), settings.simulation),
+      solver_(character, buildSimulationMesh(character, settings.simulationVertices), settings.simulation,
+              pathClearanceOf(clearance_)),
       transfer_(character, solver_.mesh().restPositions, solver_.mesh().triangles, settings.transfer) {}
 
 Pose PoseShapeSimulator::poseToSimulate(const Pose& recorded, std::vector<LimbCorrection>* corrections) const {

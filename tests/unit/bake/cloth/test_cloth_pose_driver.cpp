@@ -130,6 +130,7 @@ TEST(ClothPoseDriver, RetrySettingsKeepFirstAttemptResults) {
   const Character ch = test::capsuleCharacter();
   ClothSimSettings skinningRetry = fastSettings();
   skinningRetry.retryCarries = {ClothCarry::Skinning};  // as bakes before the setting retried
+  skinningRetry.saferPathRetries = false;               // and before the safer paths
   const ClothSolver solver(ch, buildSimulationMesh(ch, 0), skinningRetry);
   const std::vector<Pose> poses = somePoses(ch.skeleton, 2);
   const test::TempDir tmp("cloth_retry_settings");

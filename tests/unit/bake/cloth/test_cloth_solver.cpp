@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <set>
 #include <span>
 #include <thread>
@@ -752,6 +753,7 @@ TEST(ClothSolver, AFailedPoseIsRetriedAndTheRetryIsRecorded) {
   s.failStrain = 1e-4f;
   s.failShare = 0.f;
   s.retries = 1;
+  s.saferPathRetries = false;
   // The retry tries each of its carries in turn: 3 attempts by default (skinning, then translation).
   ASSERT_EQ(s.retryCarries, (std::vector<ClothCarry>{ClothCarry::Skinning, ClothCarry::Translation}));
   const PoseSimulation r = ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(bentPose(ch.skeleton, 0.3f));
@@ -762,6 +764,27 @@ TEST(ClothSolver, AFailedPoseIsRetriedAndTheRetryIsRecorded) {
   EXPECT_NE(r.failure.find("the translation carry"), std::string::npos) << r.failure;
   s.retryCarries = {ClothCarry::Skinning};
   EXPECT_EQ(ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(bentPose(ch.skeleton, 0.3f)).attempts, 2);
+  // The safer paths (on by default) come after: the path kept clear at 1x and 2x, each through the
+  // path clearance the solver was given (here one that counts its frames), then the dual-quaternion carry,
+  // then the cleared path at 2x with the translation carry.
+  s.saferPathRetries = true;
+  auto frames = std::make_shared<int>(0);
+  const ClothSolver safer(ch, buildSimulationMesh(ch, 0), s, [frames](Pose&) { ++*frames; });
+  const PoseSimulation last = safer.simulate(bentPose(ch.skeleton, 0.3f));
+  EXPECT_FALSE(last.ok);
+  EXPECT_EQ(last.attempts, 6);
+  EXPECT_NE(last.failure.find("after 6 attempts (the last with the path kept clear of the trunk at 2x and the "
+                              "translation carry)"),
+            std::string::npos)
+      << last.failure;
+  EXPECT_EQ(*frames, 3);  // each attempt along the cleared path explodes at its first frame
+  // Without a path clearance only the dual-quaternion attempt is left; the fingerprint tells them apart.
+  const ClothSolver unclear(ch, buildSimulationMesh(ch, 0), s);
+  const PoseSimulation dual = unclear.simulate(bentPose(ch.skeleton, 0.3f));
+  EXPECT_EQ(dual.attempts, 3);
+  EXPECT_NE(dual.failure.find("the last with the dual_quaternion carry"), std::string::npos) << dual.failure;
+  EXPECT_NE(unclear.fingerprint(), safer.fingerprint());
+  EXPECT_EQ(unclear.firstAttemptFingerprint(), safer.firstAttemptFingerprint());
   s.retries = 0;
   const PoseSimulation once = ClothSolver(ch, buildSimulationMesh(ch, 0), s).simulate(bentPose(ch.skeleton, 0.3f));
   EXPECT_FALSE(once.ok);

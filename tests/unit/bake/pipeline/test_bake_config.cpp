@@ -166,7 +166,8 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25},
                           {"carry", "translation"},
-                          {"retry_carries", {"translation"}}}},
+                          {"retry_carries", {"translation"}},
+                          {"safer_path_retries", false}}},
                         {"transfer",
                          {{"smoothing_strength", 0.3},
                           {"smoothing_weights", "uniform"},
@@ -238,6 +239,21 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   withoutCarry["simulation"].erase("retry_carries");
   EXPECT_EQ(poseShapeSettingsFromJson(withoutCarry, "dataset settings").simulation.retryCarries,
             std::vector<ClothCarry>{ClothCarry::Skinning});
+  // The safer-path retries: on by default, recorded only when on; off when asked, and in settings
+  // recorded before them (a model baked before keeps the truth it was baked on).
+  EXPECT_FALSE(s.simulation.saferPathRetries);
+  EXPECT_FALSE(s.toJson()["simulation"].contains("safer_path_retries"));
+  EXPECT_TRUE(d.part1->simulation.saferPathRetries);
+  EXPECT_EQ(d.part1->toJson()["simulation"]["safer_path_retries"], true);
+  EXPECT_TRUE(poseShapeSettingsFromJson(d.part1->toJson(), "dataset settings").simulation.saferPathRetries);
+  EXPECT_FALSE(poseShapeSettingsFromJson(withoutCarry, "dataset settings").simulation.saferPathRetries);
+  // The dual-quaternion carry by name, recorded as such.
+  nlohmann::json dualCarry = d.part1->toJson();
+  dualCarry["simulation"]["carry"] = "dual_quaternion";
+  dualCarry["simulation"]["retry_carries"] = {"skinning", "translation", "dual_quaternion"};
+  const PoseShapeSettings dual = poseShapeSettingsFromJson(dualCarry, "dataset settings");
+  EXPECT_EQ(dual.simulation.carry, ClothCarry::DualQuaternion);
+  EXPECT_EQ(dual.simulation.retryCarries.back(), ClothCarry::DualQuaternion);
   // The re-skinning of corrected poses (pose_transfer.hpp): 0.4 by default, recorded; absent: 0.
   EXPECT_FLOAT_EQ(d.part1->transfer.reskinMinSingularValue, 0.4f);
   EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(d.part1->toJson(), "dataset settings").transfer.reskinMinSingularValue,
@@ -289,13 +305,13 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
   says(part1Error({{"transfer", {{"cover_recorded_pose", 1}}}}),
        "part1.transfer.cover_recorded_pose: must be true or false");
   says(part1Error({{"simulation", {{"carry", "rigid"}}}}),
-       "part1.simulation.carry: 'rigid' is not \"skinning\" or \"translation\"");
+       "part1.simulation.carry: 'rigid' is not \"skinning\", \"translation\" or \"dual_quaternion\"");
   says(part1Error({{"simulation", {{"retry_carries", "translation"}}}}),
        "part1.simulation.retry_carries: must be a non-empty array of strings");
   says(part1Error({{"simulation", {{"retry_carries", {"skinning", "rigid"}}}}}),
-       "part1.simulation.retry_carries[1]: 'rigid' is not \"skinning\" or \"translation\"");
+       "part1.simulation.retry_carries[1]: 'rigid' is not \"skinning\", \"translation\" or \"dual_quaternion\"");
   says(part1Error({{"simulation", {{"retry_carries", {"skinning", "skinning"}}}}}),
-       "part1.simulation.retry_carries: must name one or two different carries");
+       "part1.simulation.retry_carries: must name one to three different carries");
   says(part1Error({{"normal_maps", {{"size", 30}}}}), "part1.normal_maps.size: must be a multiple of 4");
   says(part1Error({{"normal_maps", {{"bit_depth", 12}}}}), "part1.normal_maps.bit_depth: must be 8 or 16");
   says(part1Error({{"thinning", {{"tolerance", 0.1}, {"target_poses", 10}}}}), "part1.thinning: give exactly one");
