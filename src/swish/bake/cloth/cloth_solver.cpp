@@ -8,6 +8,7 @@
 #include <cstring>
 #include <ctime>
 #include <map>
+#include <set>
 
 #include "swish/bake/cloth/static_solve.hpp"
 #include "swish/bake/transfer/triangle_ray_scene.hpp"
@@ -172,9 +173,7 @@ void ClothSimSettings::validate() const {
         "equilibriumSeconds must be in [0, 60]");
   check(equilibriumIterations >= 0 && equilibriumIterations <= 1000, "equilibriumIterations must be in [0, 1000]");
   check(retries >= 0 && retries <= 4, "retries must be in [0, 4]");
-  bool distinct = true;
-  for (size_t i = 0; i < retryCarries.size(); ++i)
-    for (size_t k = 0; k < i; ++k) distinct = distinct && retryCarries[i] != retryCarries[k];
+  const bool distinct = std::set<ClothCarry>(retryCarries.begin(), retryCarries.end()).size() == retryCarries.size();
   check(!retryCarries.empty() && retryCarries.size() <= 3 && distinct,
         "retryCarries must name one to three different carries");
   check(std::isfinite(staticTolerance) && staticTolerance > 0.f, "staticTolerance must be positive");
@@ -417,15 +416,18 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
   double seconds = first.residuals.seconds;
   PoseSimulation last;
   int attempts = 1;
+  // One more attempt; true when it simulated (`last` is then the answer).
+  auto attempt = [&](int slowdown, ClothCarry carry, bool clearPath) {
+    last = simulateOnce(target, slowdown, carry, clearPath);
+    seconds += last.residuals.seconds;
+    last.attempts = ++attempts;
+    last.firstFailure = first.failure;
+    last.residuals.seconds = seconds;
+    return last.ok;
+  };
   for (int retry = 1; retry <= settings_.retries; ++retry)
-    for (ClothCarry carry : settings_.retryCarries) {
-      last = simulateOnce(target, 1 << retry, carry);
-      seconds += last.residuals.seconds;
-      last.attempts = ++attempts;
-      last.firstFailure = first.failure;
-      last.residuals.seconds = seconds;
-      if (last.ok) return last;
-    }
+    for (ClothCarry carry : settings_.retryCarries)
+      if (attempt(1 << retry, carry, false)) return last;
   std::string lastWay = std::to_string(1 << settings_.retries) + "x the substeps and transition, the " +
                         clothCarryName(settings_.retryCarries.back()) + " carry";
   if (settings_.saferPathRetries) {
@@ -442,12 +444,7 @@ PoseSimulation ClothSolver::simulate(const Pose& target) const {
           Way{1, ClothCarry::DualQuaternion, false, "the dual_quaternion carry"},
           Way{2, ClothCarry::Translation, true, "the path kept clear of the trunk at 2x and the translation carry"}}) {
       if (way.clearPath && !pathClearance_) continue;
-      last = simulateOnce(target, way.slowdown, way.carry, way.clearPath);
-      seconds += last.residuals.seconds;
-      last.attempts = ++attempts;
-      last.firstFailure = first.failure;
-      last.residuals.seconds = seconds;
-      if (last.ok) return last;
+      if (attempt(way.slowdown, way.carry, way.clearPath)) return last;
       lastWay = way.what;
     }
   }

@@ -174,10 +174,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   if (sim.has("retry_carries")) {
     const JsonReader list = sim.child("retry_carries");
     const std::vector<std::string> names = list.strings();
-    bool distinct = true;
-    for (size_t i = 0; i < names.size(); ++i)
-      for (size_t k = 0; k < i; ++k) distinct = distinct && names[i] != names[k];
-    if (names.size() > 3 || !distinct)
+    if (names.size() > 3 || std::set<std::string>(names.begin(), names.end()).size() != names.size())
       list.fail("must name one to three different carries (\"skinning\", \"translation\", \"dual_quaternion\")");
     cs.retryCarries.clear();
     for (size_t i = 0; i < names.size(); ++i) cs.retryCarries.push_back(carryOf(list.at(i), names[i]));

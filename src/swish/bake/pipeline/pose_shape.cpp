@@ -14,18 +14,17 @@ namespace swish::bake {
 
 namespace {
 
-std::optional<LimbClearance> makeClearance(const Character& c, const LimbClearanceSettings& s) {
-  if (s.clearance > 0.f) return std::optional<LimbClearance>(std::in_place, c, s);
-  return std::nullopt;
+std::shared_ptr<const LimbClearance> makeClearance(const Character& c, const LimbClearanceSettings& s) {
+  if (s.clearance > 0.f) return std::make_shared<const LimbClearance>(c, s);
+  return nullptr;
 }
 
 // The solver's path clearance (ClothSimSettings::saferPathRetries): the same limb clearance as the
-// targets', on each frame of the transition. The solver keeps its own copy, so that it does not depend
-// on where this simulator lives.
-ClothSolver::PathClearance pathClearanceOf(const std::optional<LimbClearance>& clearance) {
+// targets', on each frame of the transition. It shares the simulator's (apply is const), so it does not
+// depend on where the simulator lives.
+ClothSolver::PathClearance pathClearanceOf(const std::shared_ptr<const LimbClearance>& clearance) {
   if (!clearance) return {};
-  auto c = std::make_shared<const LimbClearance>(*clearance);
-  return [c](Pose& p) { c->apply(p); };
+  return [clearance](Pose& p) { clearance->apply(p); };
 }
 
 }  // namespace

@@ -16,7 +16,7 @@
 // The bake keeps steps 1-3 apart (clearance over all poses first, then resumable per-pose simulation
 // files), so each step is its own call; simulate() runs them all for one pose. Everything is const and
 // deterministic: poses may be simulated on several threads at once with bitwise the same results.
-#include <optional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -61,7 +61,7 @@ class PoseShapeSimulator {
 
   const Character& character() const { return *character_; }
   const PoseShapeSettings& settings() const { return settings_; }
-  const LimbClearance* clearance() const { return clearance_ ? &*clearance_ : nullptr; }  // null when off
+  const LimbClearance* clearance() const { return clearance_.get(); }  // null when off
   const ClothSolver& solver() const { return solver_; }
   const PoseTransfer& transfer() const { return transfer_; }
 
@@ -76,7 +76,7 @@ class PoseShapeSimulator {
  private:
   const Character* character_;
   PoseShapeSettings settings_;
-  std::optional<LimbClearance> clearance_;
+  std::shared_ptr<const LimbClearance> clearance_;  // null when off; shared with solver_'s path clearance
   ClothSolver solver_;
   PoseTransfer transfer_;
 };
