@@ -26,7 +26,7 @@
 //
 // The push-out (runtime/reference_push_out.hpp, the specification): after skinning, each instance's
 // vertex is kept outside its body anchors' balls, one after the other (the first anchor, then the
-// second where the model has them). Each anchor (rest centre, reach, four influences) is loaded once
+// second and the third where the model has them). Each anchor (rest centre, reach, four influences) is loaded once
 // per thread with the rest of the vertex, and its centre skinned per instance with the instance's
 // matrix rows like the vertex itself: 12 more texel fetches and a 3x4 blend per anchor, vertex and
 // instance, no per-frame input. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
@@ -78,7 +78,7 @@ vec3 mean;
 float basis[3 * K];
 uint joints[INFLUENCES];
 float skinW[INFLUENCES];
-// Its body anchors (p.pushOut of them, at most SWISH_MAX_ANCHOR_SLOTS: the first, then the second).
+// Its body anchors (p.pushOut of them, at most SWISH_MAX_ANCHOR_SLOTS: the first, the second, the third).
 vec3 anchorC[SWISH_MAX_ANCHOR_SLOTS];   // each ball's centre (rest)
 float anchorR[SWISH_MAX_ANCHOR_SLOTS];  // its reach (radius + clearance; 0: no anchor)
 uint anchorJ[SWISH_MAX_ANCHOR_SLOTS][4];

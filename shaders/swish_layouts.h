@@ -41,7 +41,7 @@ struct alignas(8) Address {
 
 // 32-bit words per vertex of the body-anchor buffer (layout above), and the most anchor sets in it.
 #define SWISH_ANCHOR_WORDS 12
-#define SWISH_MAX_ANCHOR_SLOTS 2
+#define SWISH_MAX_ANCHOR_SLOTS 3
 
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
 // push-out of the body anchors' balls (runtime/reference_push_out.hpp). The mesh weights

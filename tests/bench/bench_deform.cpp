@@ -102,6 +102,7 @@ DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint
   spec.meshComponents = components;
   spec.bodyAnchors = anchorSets > 0;
   spec.secondAnchors = anchorSets > 1;
+  spec.thirdAnchors = anchorSets > 2;
   spec.influences = 4;
   spec.joints = 24;
   spec.normalMaps = 0;
@@ -182,7 +183,8 @@ BENCHMARK(BM_Deform)
     ->MinTime(0.5);
 
 // The deform pass with and without its push-out step: args instances, K, anchor sets (1: BodyAnchors::
-// anchors, 2: and BodyAnchors::second). Each iteration times both
+// anchors, 2: and BodyAnchors::second, 3: and BodyAnchors::third; the random model leaves every 7th vertex
+// without a first anchor, every 5th without a second, every 3rd without a third). Each iteration times both
 // dispatches (alternating, so that drift of a shared machine hits both alike); the reported time is the
 // timed region with the push-out (`pass_us` one pass), `pushout_share` its extra time over the plain deform.
 void BM_DeformPushOut(benchmark::State& state) {
@@ -218,7 +220,9 @@ BENCHMARK(BM_DeformPushOut)
     ->Args({22, 30, 1})
     ->Args({22, 128, 1})
     ->Args({22, 128, 2})
+    ->Args({22, 128, 3})
     ->Args({1, 128, 2})
+    ->Args({1, 128, 3})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(0.5);

@@ -1,5 +1,5 @@
 // Conformance of the push-out step of the deform kernel (shaders/deform.glsl: each vertex kept outside
-// its body anchors' balls, Model::bodyAnchors, one set or two) to its CPU reference
+// its body anchors' balls, Model::bodyAnchors, one set, two or three) to its CPU reference
 // runtime::referencePushOut, on seeded random models with random anchors (seed printed;
 // SWISH_TEST_SEED overrides): the kernel deforms, skins and then pushes, and must match
 // referencePcaReconstruct -> referenceSkin -> referencePushOut. Outputs are followed by guard words;
@@ -27,11 +27,11 @@ using test::GuardedOutput;
 
 struct PushCase {
   uint32_t vertices, influences, instances;
-  bool second = false;  // second anchors too (BodyAnchors::second)
+  uint32_t sets = 1;  // anchor sets: 1, 2 (BodyAnchors::second too) or 3 (and BodyAnchors::third)
 };
 void PrintTo(const PushCase& c, std::ostream* os) {
   *os << c.vertices << " vertices, " << c.influences << " influences, " << c.instances << " instances"
-      << (c.second ? ", two anchor sets" : "");
+      << ", " << c.sets << " anchor set" << (c.sets > 1 ? "s" : "");
 }
 
 struct PushInputs {
@@ -49,7 +49,8 @@ PushInputs randomInputs(uint64_t seed, const PushCase& c) {
   spec.meshComponents = 5;
   spec.normalMaps = 0;
   spec.bodyAnchors = true;
-  spec.secondAnchors = c.second;
+  spec.secondAnchors = c.sets >= 2;
+  spec.thirdAnchors = c.sets >= 3;
   PushInputs in;
   in.model = test::makeRandomModel(rng, spec);
   in.instances = c.instances;
@@ -78,8 +79,8 @@ struct Reference {
 // compute to a few ulps) errs by about 1e-5 relative, times r. So
 //   |dx| <= |dc| + (r / |e|) (|dy| + |dc|) + 1e-5 r.
 // A vertex near the sphere (|e| ~ r) may be pushed on one side and not on the other; the push there is
-// r - |e|, within the same bound: the step is continuous. With two anchor sets the second push starts
-// from the first's output, so its |dy| is the first's bound.
+// r - |e|, within the same bound: the step is continuous. With two or three anchor sets each push starts
+// from the one before's output, so its |dy| is that one's bound.
 Reference reference(const PushInputs& in, bool pushOut) {
   const Model& m = in.model;
   const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
@@ -161,7 +162,7 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut) {
 std::string caseName(const ::testing::TestParamInfo<PushCase>& info) {
   const auto& c = info.param;
   return "V" + std::to_string(c.vertices) + "_I" + std::to_string(c.influences) + "_N" + std::to_string(c.instances) +
-         (c.second ? "_Two" : "");
+         (c.sets > 1 ? "_Sets" + std::to_string(c.sets) : "");
 }
 
 class PushOutConformance : public test::GpuTest, public ::testing::WithParamInterface<PushCase> {};
@@ -203,11 +204,12 @@ TEST_P(PushOutConformance, OffIsThePlainDeform) {
 }
 
 // 1 vertex; a prime vertex count with the 22 instances of the default scene; 1 and 8 skin influences
-// (the anchors have 4 whatever the garment has); one anchor set and two.
+// (the anchors have 4 whatever the garment has); one anchor set, two and three.
 INSTANTIATE_TEST_SUITE_P(Sizes, PushOutConformance,
                          ::testing::Values(PushCase{1, 4, 1}, PushCase{97, 1, 3}, PushCase{997, 4, 22},
-                                           PushCase{401, 8, 4}, PushCase{1, 4, 1, true}, PushCase{97, 1, 3, true},
-                                           PushCase{997, 4, 22, true}),
+                                           PushCase{401, 8, 4}, PushCase{1, 4, 1, 2}, PushCase{97, 1, 3, 2},
+                                           PushCase{997, 4, 22, 2}, PushCase{1, 4, 1, 3}, PushCase{97, 1, 3, 3},
+                                           PushCase{997, 4, 22, 3}, PushCase{401, 8, 4, 3}),
                          caseName);
 
 class PushOutSpecialCases : public test::GpuTest {};
@@ -278,6 +280,24 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
   for (const auto& p : gpu2.problems) ADD_FAILURE() << p;
   EXPECT_TRUE(
       test::matchesReference("kernel, two anchor sets", gpu2.positions, expected2, [](size_t) { return 1e-6; }));
+
+  // A third set, after the second: vertex 0's third ball (radius 3.1 cm, centre at z = -0.03, reach 3.3 cm)
+  // takes it from the second's z = -0.002 (2.8 cm off its centre) up to -0.03 + 0.033 = 0.003. Applied
+  // before the second it would be pushed down again to -0.002: the answer shows the order.
+  BodyAnchor third = anchor(0.f, 0);
+  third.position = Vec3f(0.f, 1.f, 0.001f);
+  third.radius = 0.031f;
+  m.bodyAnchors.third = {third, BodyAnchor{}, BodyAnchor{}, BodyAnchor{}, BodyAnchor{}};
+  std::vector<float> expected3 = expected2;
+  expected3[2] = 0.003f;
+  const Reference ref3 = reference(in, true);
+  EXPECT_TRUE(
+      test::matchesReference("reference, three anchor sets", ref3.positions, expected3, [](size_t) { return 1e-6; }));
+  EXPECT_EQ(ref3.moved, 3u);
+  const auto gpu3 = runDeform(ctx(), in, true);
+  for (const auto& p : gpu3.problems) ADD_FAILURE() << p;
+  EXPECT_TRUE(
+      test::matchesReference("kernel, three anchor sets", gpu3.positions, expected3, [](size_t) { return 1e-6; }));
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // `swish body-proxy MODEL`: the push-out's body anchors re-fitted on a model already baked. Runs the swish
 // program on the committed default model: without clips (no slide anchors: they need simulated poses),
-// with 2 simulated frames of a training clip and --uncalibrated (slide anchors, every clearance at the
-// margin), and with a clip that is not there (a clear error, nothing written).
+// with 2 simulated frames of a training clip and --uncalibrated (slide and cover anchors, every clearance
+// at the margin), and with a clip that is not there (a clear error, nothing written).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -68,6 +68,16 @@ TEST(BodyProxyCli, SlideAnchorsFromSimulatedClipFramesAndTheMarginAsked) {
     }
   }
   EXPECT_EQ(filled, anchors["slide_anchored"].get<size_t>());
+  // The third set (cover anchors, format 1.5): where the first two still miss the skin under the cloth.
+  EXPECT_GT(anchors["cover_anchored"].get<size_t>(), 0u) << anchors.dump();
+  EXPECT_EQ(s.bodyAnchors.anchored(2), anchors["cover_anchored"].get<size_t>());
+  EXPECT_LE(anchors["cover_covered"].get<size_t>(), anchors["cover_misses"].get<size_t>());
+  EXPECT_NE(b.out.find("with a third (cover) anchor"), std::string::npos) << b.out;
+  for (const BodyAnchor& a : s.bodyAnchors.third)
+    if (a.present()) {
+      EXPECT_FLOAT_EQ(a.clearance, 0.004f);
+    }
+  EXPECT_TRUE(p.bodyAnchors.third.empty()) << "no poses, no cover anchors";
 
   const fs::path never = tmp / "never.swish";
   const cluster::CommandResult c = swishCmd(

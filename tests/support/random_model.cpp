@@ -168,6 +168,11 @@ Model makeRandomModel(Rng& rng, const RandomModelSpec& s) {
     for (uint32_t v = 0; v < n; ++v)
       if (v % 5 != 1) m.bodyAnchors.second[v] = randomAnchor(rng, m, v, s.joints);
   }
+  if (s.bodyAnchors && s.secondAnchors && s.thirdAnchors) {
+    m.bodyAnchors.third.resize(n);
+    for (uint32_t v = 0; v < n; ++v)
+      if (v % 3 != 2) m.bodyAnchors.third[v] = randomAnchor(rng, m, v, s.joints);
+  }
   m.validate("random model");
   return m;
 }

@@ -24,6 +24,7 @@ struct RandomModelSpec {
   bool bodyAnchors = false;     // one body anchor per vertex (every 7th without), drawn after the MLP
   uint32_t noveltyCentres = 0;  // novelty guard centres (drawn after the anchors), with clamp and blend
   bool secondAnchors = false;   // with bodyAnchors: second anchors too (every 5th without), drawn last
+  bool thirdAnchors = false;    // with secondAnchors: third anchors too (every 3rd from 2 without), drawn after them
 };
 
 Model makeRandomModel(Rng& rng, const RandomModelSpec& spec = {});

@@ -1,8 +1,8 @@
 // swish body-proxy MODEL [--out OUT]: fits the body anchors of the run-time push-out
 // (bake/training/body_anchor_fit.hpp: per garment vertex, the closest point of the rest body, its
 // outward normal and its skin) to the body the model was baked on, and writes the model with them
-// (format 1.3). `swish bake` fits them itself; this is for a model baked before they existed: nothing
-// else in the model changes, and the network is not retrained. `--remove` writes the model without
+// (format 1.3; the second set 1.4, the third 1.5). `swish bake` fits them itself; this is for a model baked before they
+// existed: nothing else in the model changes, and the network is not retrained. `--remove` writes the model without
 // them (no push-out at run time).
 //
 // `--clips` calibrates the anchors as the bake does on its training poses (calibrateBodyAnchors): the
@@ -43,7 +43,7 @@ struct BodyProxyOptions {
   std::string model, out;
   float maxDistanceMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.maxDistance;
   float marginMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.margin;
-  bool remove = false, oneAnchor = false, secondAtMargin = false, uncalibrated = false;
+  bool remove = false, oneAnchor = false, secondAtMargin = false, uncalibrated = false, noCover = false;
   std::vector<std::string> clips;
   size_t poses = 48;
   float toleranceMm = 1000.f * swish::bake::BodyAnchorCalibrationSettings{}.tolerance;
@@ -164,6 +164,7 @@ int runBodyProxy(const BodyProxyOptions& o) {
   s.maxDistance = o.maxDistanceMm / 1000.f;
   s.margin = o.marginMm / 1000.f;
   s.secondAnchors = !o.oneAnchor;
+  s.coverAnchors = !o.noCover;
   // The clips' simulated frames also show where the cloth slides over the body (the slide anchors); without
   // --clips there are none.
   SimulatedFrames sim;
@@ -186,6 +187,12 @@ int runBodyProxy(const BodyProxyOptions& o) {
       fit.maxDistanceMm, fit.medianMm, fit.p95Mm, fit.maxMm, fit.radiusP10Mm, fit.radiusMedianMm, fit.insideAtRest,
       fit.withinMargin, o.marginMm, fit.flippedNormals, fit.secondAnchored, o.oneAnchor ? " (--one-anchor)" : "",
       fit.slideAnchored, fit.slidePoses, o.clips.empty() ? ": they need --clips" : "");
+  if (!fit.anchors.third.empty())
+    std::printf(
+        "  %zu with a third (cover) anchor: of the %zu (pose, vertex) pairs whose skin the first two sets miss by "
+        "%.0f mm or more, it covers %zu (%.1f %%).\n",
+        fit.coverAnchored, fit.coverMisses, 1000.0 * double(s.slideMinGap), fit.coverCovered,
+        fit.coverMisses ? 100.0 * double(fit.coverCovered) / double(fit.coverMisses) : 0.0);
   BodyAnchors anchors = fit.anchors;
   nlohmann::json j = bake::toJson(fit);
   j["made_by"] = "swish body-proxy (after the bake)";
@@ -242,6 +249,9 @@ swish::cli::CommandRegistration reg{
                    "default model's: train.anchor_calibration \"none\")");
       app.add_flag("--second-at-margin", o->secondAtMargin,
                    "with --clips: calibrate the first anchors only; the second ones keep the margin");
+      app.add_flag("--no-cover-anchors", o->noCover,
+                   "with --clips: no third anchor set (format 1.4's push-out: the first set and the second, on another "
+                   "part or where the cloth slid farthest)");
       app.add_flag("--one-anchor", o->oneAnchor,
                    "one anchor per vertex (its nearest body part) instead of also a second one on the nearest other "
                    "part, where two parts meet (format 1.3's push-out)");
@@ -254,7 +264,8 @@ swish::cli::CommandRegistration reg{
           "on its nearest body part, then (format 1.4) one on the nearest other part within reach, where parts meet, "
           "or, "
           "for a vertex with no such part, one on its own part where the cloth slid to farthest in the simulated "
-          "poses (the jersey rides up over the belly when the arms rise). "
+          "poses (the jersey rides up over the belly when the arms rise), then (format 1.5) a third, the ball "
+          "covering most of the skin the first two still miss in those poses (a bent elbow under its sleeve). "
           "The "
           "bake calibrates "
           "each anchor's clearance on its training poses: the highest at which pushing the network's garment does "

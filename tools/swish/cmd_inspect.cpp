@@ -92,6 +92,7 @@ nlohmann::json describe(const Model& m, const ModelFileInfo& info, uint64_t file
   j["qualityLevels"] = swish::runtime::toJson(swish::runtime::ladderOf(m));
   j["bodyAnchors"] = {{"anchored", m.bodyAnchors.anchored()},
                       {"secondAnchored", m.bodyAnchors.anchored(1)},
+                      {"thirdAnchored", m.bodyAnchors.anchored(2)},
                       {"vertices", m.bodyAnchors.anchors.size()},
                       {"marginM", m.bodyAnchors.margin}};
   // Metadata is meant to be JSON; show it as such when it is, as text when it is not.
@@ -145,12 +146,12 @@ void printText(const std::string& path, const Model& m, const ModelFileInfo& inf
   if (m.bodyAnchors.empty()) {
     o << "  body anchors  none (no push-out at run time; swish body-proxy fits them)\n";
   } else {
-    char line[200];
+    char line[240];
     std::snprintf(line, sizeof line,
-                  "  body anchors  %zu of %zu vertices (%zu with a second one), margin %.1f mm (the run-time push-out "
-                  "keeps them off the body)\n",
+                  "  body anchors  %zu of %zu vertices (%zu with a second one, %zu with a third), margin %.1f mm (the "
+                  "run-time push-out keeps them off the body)\n",
                   m.bodyAnchors.anchored(), m.bodyAnchors.anchors.size(), m.bodyAnchors.anchored(1),
-                  1000.0 * double(m.bodyAnchors.margin));
+                  m.bodyAnchors.anchored(2), 1000.0 * double(m.bodyAnchors.margin));
     o << line;
   }
   o << "  sections\n";

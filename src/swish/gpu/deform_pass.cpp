@@ -140,7 +140,8 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.positionsOut = layout::Address::of(a.positionsOut);
   p.anchors = layout::Address::of(a.anchors);
   if (a.anchors && (a.anchorSlots < 1 || a.anchorSlots > kMaxAnchorSlots))
-    throw Error("deform pass: " + std::to_string(a.anchorSlots) + " body anchor sets (1 or 2)");
+    throw Error("deform pass: " + std::to_string(a.anchorSlots) + " body anchor sets (1 to " +
+                std::to_string(kMaxAnchorSlots) + ")");
   p.pushOut = a.anchors ? a.anchorSlots : 0u;
   p.vertexCount = a.vertexCount;
   p.instanceCount = a.instanceCount;

@@ -40,7 +40,7 @@ class DeformPass {
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
     // The push-out: word[anchorSlots][N][SWISH_ANCHOR_WORDS], packAnchors' layout (the model's,
     // GpuModel::anchors); 0: no push-out. Only with skinning applied (the anchors are skinned like the
-    // vertices). anchorSlots: the anchor sets in it (1 or 2: BodyAnchors::slots()).
+    // vertices). anchorSlots: the anchor sets in it (1 to 3: BodyAnchors::slots()).
     VkDeviceAddress anchors = 0;
     uint32_t anchorSlots = 1;
     VkDescriptorSet instanceInputs = VK_NULL_HANDLE;  // from bindInstanceInputs

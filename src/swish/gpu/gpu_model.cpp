@@ -134,7 +134,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   if (!m.bodyAnchors.empty()) {
     for (uint32_t s = 0; s < m.bodyAnchors.slots(); ++s) {
       const std::vector<BodyAnchor>& set = m.bodyAnchors.slot(s);
-      const std::string what = s ? "second body anchor" : "body anchor";
+      const std::string what = s ? std::string(anchorSlotName(s)) + " body anchor" : "body anchor";
       if (set.size() != n) fail(std::to_string(set.size()) + " " + what + "s for " + std::to_string(n) + " vertices");
       for (size_t v = 0; v < n; ++v)
         for (const uint16_t j : set[v].joints)

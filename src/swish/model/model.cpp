@@ -90,6 +90,8 @@ void Model::validate(const std::string& what) const {
     fail("normal maps", "keys have dimensions but no maps");
   }
   if (bodyAnchors.empty() && !bodyAnchors.second.empty()) fail("body anchors", "second anchors without first ones");
+  if (bodyAnchors.second.empty() && !bodyAnchors.third.empty())
+    fail("body anchors", "third anchors without second ones");
   if (!bodyAnchors.empty()) {
     const BodyAnchors& ba = bodyAnchors;
     if (ba.anchors.size() != n)
@@ -98,12 +100,18 @@ void Model::validate(const std::string& what) const {
     if (!ba.second.empty() && ba.second.size() != n)
       fail("body anchors",
            n2s(ba.second.size()) + " second anchors for " + n2s(n) + " game-mesh vertices (one each, or none)");
+    if (!ba.third.empty() && ba.third.size() != n)
+      fail("body anchors",
+           n2s(ba.third.size()) + " third anchors for " + n2s(n) + " game-mesh vertices (one each, or none)");
     if (!(ba.margin >= 0.f && ba.margin <= kMaxAnchorMargin))
       fail("body anchors", "margin " + std::to_string(ba.margin) + " m is not in [0, 0.05] metres");
     for (size_t e = 0; e < ba.slots() * n; ++e) {
       const size_t v = e % n;
       const BodyAnchor& a = ba.slot(uint32_t(e / n))[v];
-      const std::string which = std::string(e < n ? "anchor" : "second anchor") + " of vertex " + n2s(v);
+      const std::string which = std::string(e < n       ? "anchor"
+                                            : e < 2 * n ? "second anchor"
+                                                        : "third anchor") +
+                                " of vertex " + n2s(v);
       if (!a.present()) {
         if (a.position != Vec3f::Zero() || a.normal != Vec3f::Zero() || a.radius != 0.f || a.clearance != 0.f)
           fail("body anchors", which + " has no weights (no anchor) but a position, normal, radius or clearance");

@@ -115,14 +115,22 @@ struct BodyAnchors {
   // reach may have a slide anchor here instead: a ball on its own part where the bake's simulation had
   // the cloth slide to (body_anchor_fit.hpp). The run time treats both alike.
   std::vector<BodyAnchor> second;
+  // Format 1.5: empty, or one per game-mesh vertex (only with `second`): a cover anchor, applied after
+  // `second`. Cloth slides to more than one place: the second set's slide anchor holds the pose where
+  // the first ball misses the skin most (the jersey ridden up over the belly with the arms out, rare
+  // and large), and the cover anchor the ball that covers most of the skin the first two still miss
+  // over the bake's poses (a bent elbow's skin under its sleeve, frequent; body_anchor_fit.hpp).
+  std::vector<BodyAnchor> third;
   bool empty() const { return anchors.empty(); }
-  // Anchor sets the push-out applies, in order: 0 (none), 1 (`anchors`) or 2 (then `second`).
-  uint32_t slots() const { return anchors.empty() ? 0u : second.empty() ? 1u : 2u; }
-  const std::vector<BodyAnchor>& slot(uint32_t s) const { return s == 0 ? anchors : second; }
-  std::vector<BodyAnchor>& slot(uint32_t s) { return s == 0 ? anchors : second; }
+  // Anchor sets the push-out applies, in order: 0 (none), 1 (`anchors`), 2 (then `second`) or 3 (then `third`).
+  uint32_t slots() const { return anchors.empty() ? 0u : second.empty() ? 1u : third.empty() ? 2u : 3u; }
+  const std::vector<BodyAnchor>& slot(uint32_t s) const { return s == 0 ? anchors : s == 1 ? second : third; }
+  std::vector<BodyAnchor>& slot(uint32_t s) { return s == 0 ? anchors : s == 1 ? second : third; }
   size_t anchored(uint32_t slot = 0) const;  // vertices with an anchor in that set
 };
-inline constexpr uint32_t kMaxAnchorSlots = 2;
+inline constexpr uint32_t kMaxAnchorSlots = 3;
+// The sets' names in messages: "first", "second", "third".
+inline const char* anchorSlotName(uint32_t s) { return s == 0 ? "first" : s == 1 ? "second" : "third"; }
 
 // Largest margin a model may ask for (metres): beyond a few centimetres the push-out would hold
 // the garment visibly off the body, which is not what it is for.

@@ -1,7 +1,7 @@
 #pragma once
 // The .swish model file: everything the run time needs for one garment, in one checked binary file.
 //
-// ==================================== Layout, format version 1.4 ====================================
+// ==================================== Layout, format version 1.5 ====================================
 // All integers are unsigned little-endian unless marked i32 (two's complement). f32 is IEEE-754
 // binary32, little-endian, bit pattern kept exactly. There is no padding or alignment anywhere: fields
 // follow each other byte after byte. Matrices are column-major (Eigen's order) unless said otherwise.
@@ -9,7 +9,7 @@
 // File header, 32 bytes:
 //   0   u8[8]  magic: 0x89 'S' 'W' 'I' 'S' 'H' 0x0D 0x0A  (0x89 and CR LF catch text-mode mangling)
 //   8   u16    major version = 1. A reader refuses a larger major version.
-//   10  u16    minor version = 4. Minor versions only ADD sections; a reader skips tags it does not
+//   10  u16    minor version = 5. Minor versions only ADD sections; a reader skips tags it does not
 //              know when the file's minor version is newer than its own, and refuses them otherwise.
 //   12  u32    section count
 //   16  u64    total file size in bytes, header included (catches truncation before anything else)
@@ -22,7 +22,7 @@
 //   16  u8[payload size] payload; every payload must be read to its last byte (trailing bytes = error)
 //
 // Sections of version 1.0: each exactly once, all required, any order (the writer uses this one and
-// puts BPRX, NOVG, BCOV, BANC and BAN2 before META).
+// puts BPRX, NOVG, BCOV, BANC, BAN2 and BAN3 before META).
 //   "SKEL" skeleton. u32 J joints, then per joint: u32 name length L, u8[L] UTF-8 name, i32 parent
 //          (-1 for a root, else an earlier joint), f32[4] rest rotation quaternion x y z w, f32[3] rest
 //          translation. Then u32 B (0 or J) inverse bind matrices, each f32[16] column-major 4x4.
@@ -72,6 +72,9 @@
 // Added in version 1.4 (required in 1.4 files; older files load without second anchors):
 //   "BAN2" second body anchors (BodyAnchors::second, applied after BANC's): u32 A2 (0, or N when
 //          BANC's A is N), then the same arrays as BANC's after its margin, for A2 anchors.
+// Added in version 1.5 (required in 1.5 files; older files load without third anchors):
+//   "BAN3" third (cover) body anchors (BodyAnchors::third, applied after BAN2's): u32 A3 (0, or N when
+//          BAN2's A2 is N), then the same arrays as BANC's after its margin, for A3 anchors.
 // After parsing, Model::validate checks every index and size the run time relies on.
 // =====================================================================================================
 #include <array>
@@ -86,7 +89,7 @@
 namespace swish {
 
 constexpr uint16_t kModelFileMajorVersion = 1;
-constexpr uint16_t kModelFileMinorVersion = 4;
+constexpr uint16_t kModelFileMinorVersion = 5;
 constexpr std::array<uint8_t, 8> kModelFileMagic = {0x89, 'S', 'W', 'I', 'S', 'H', 0x0D, 0x0A};
 constexpr size_t kModelFileHeaderBytes = 32;
 constexpr size_t kModelSectionHeaderBytes = 16;

@@ -279,6 +279,7 @@ void readLegacyBodyProxy(ByteReader& r, Model&) {
 
 // ---- BANC (format 1.3) ------------------------------------------------------------------------
 // ---- BAN2 (format 1.4): the second anchors, in BANC's layout after the count (no margin) -------
+// ---- BAN3 (format 1.5): the third (cover) anchors, as BAN2 -------------------------------------
 constexpr uint64_t kAnchorBytes = 12 + 12 + 4 + 4 + 2 * kAnchorInfluences + 4 * kAnchorInfluences;
 
 void writeAnchorList(const std::vector<BodyAnchor>& list, ByteWriter& w) {
@@ -290,18 +291,27 @@ void writeAnchorList(const std::vector<BodyAnchor>& list, ByteWriter& w) {
   for (const BodyAnchor& a : list) w.f32s(a.weights);
 }
 
-void readAnchorList(ByteReader& r, std::vector<BodyAnchor>& list, uint32_t count, bool second) {
-  // (the reader's names are C strings: one set for each list)
-  auto name = [second](const char* first, const char* other) { return second ? other : first; };
-  list.resize(r.checkCount(count, kAnchorBytes, name("body anchor", "second body anchor")));
-  for (BodyAnchor& a : list) r.f32s(a.position.data(), 3, name("body anchor position", "second body anchor position"));
-  for (BodyAnchor& a : list) r.f32s(a.normal.data(), 3, name("body anchor normal", "second body anchor normal"));
-  for (BodyAnchor& a : list) a.radius = r.f32(name("body anchor radius", "second body anchor radius"));
-  for (BodyAnchor& a : list) a.clearance = r.f32(name("body anchor clearance", "second body anchor clearance"));
+void readAnchorList(ByteReader& r, std::vector<BodyAnchor>& list, uint32_t count, uint32_t slot) {
+  // (the reader's names are C strings: one for each set)
+  auto name = [slot](const char* first, const char* second, const char* third) {
+    return slot == 0 ? first : slot == 1 ? second : third;
+  };
+  list.resize(r.checkCount(count, kAnchorBytes, name("body anchor", "second body anchor", "third body anchor")));
   for (BodyAnchor& a : list)
-    r.u16s(a.joints.data(), a.joints.size(), name("body anchor joint", "second body anchor joint"));
+    r.f32s(a.position.data(), 3,
+           name("body anchor position", "second body anchor position", "third body anchor position"));
   for (BodyAnchor& a : list)
-    r.f32s(a.weights.data(), a.weights.size(), name("body anchor weight", "second body anchor weight"));
+    r.f32s(a.normal.data(), 3, name("body anchor normal", "second body anchor normal", "third body anchor normal"));
+  for (BodyAnchor& a : list)
+    a.radius = r.f32(name("body anchor radius", "second body anchor radius", "third body anchor radius"));
+  for (BodyAnchor& a : list)
+    a.clearance = r.f32(name("body anchor clearance", "second body anchor clearance", "third body anchor clearance"));
+  for (BodyAnchor& a : list)
+    r.u16s(a.joints.data(), a.joints.size(),
+           name("body anchor joint", "second body anchor joint", "third body anchor joint"));
+  for (BodyAnchor& a : list)
+    r.f32s(a.weights.data(), a.weights.size(),
+           name("body anchor weight", "second body anchor weight", "third body anchor weight"));
 }
 
 void writeBodyAnchors(const Model& m, ByteWriter& w) {
@@ -314,7 +324,7 @@ void writeBodyAnchors(const Model& m, ByteWriter& w) {
 void readBodyAnchors(ByteReader& r, Model& m) {
   const uint32_t count = r.u32("body anchor count");
   m.bodyAnchors.margin = r.f32("body anchor margin");
-  readAnchorList(r, m.bodyAnchors.anchors, count, false);
+  readAnchorList(r, m.bodyAnchors.anchors, count, 0);
 }
 
 void writeSecondAnchors(const Model& m, ByteWriter& w) {
@@ -323,7 +333,16 @@ void writeSecondAnchors(const Model& m, ByteWriter& w) {
 }
 
 void readSecondAnchors(ByteReader& r, Model& m) {
-  readAnchorList(r, m.bodyAnchors.second, r.u32("second body anchor count"), true);
+  readAnchorList(r, m.bodyAnchors.second, r.u32("second body anchor count"), 1);
+}
+
+void writeThirdAnchors(const Model& m, ByteWriter& w) {
+  w.u32(count32(m.bodyAnchors.third.size(), "third body anchor"));
+  writeAnchorList(m.bodyAnchors.third, w);
+}
+
+void readThirdAnchors(ByteReader& r, Model& m) {
+  readAnchorList(r, m.bodyAnchors.third, r.u32("third body anchor count"), 2);
 }
 
 // ---- NOVG (format 1.2) ------------------------------------------------------------------------
@@ -403,6 +422,7 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {"BCOV", writeBodyCoverage, readBodyCoverage, 2},
       {"BANC", writeBodyAnchors, readBodyAnchors, 3},
       {"BAN2", writeSecondAnchors, readSecondAnchors, 4},
+      {"BAN3", writeThirdAnchors, readThirdAnchors, 5},
       {"META", writeMetadata, readMetadata},
   };
   return codecs;

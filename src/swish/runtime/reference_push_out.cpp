@@ -36,8 +36,9 @@ size_t referencePushOut(Points3f& positions, const BodyAnchors& anchors, std::sp
   const size_t n = size_t(positions.rows());
   for (uint32_t s = 0; s < anchors.slots(); ++s)
     if (anchors.slot(s).size() != n)
-      throw Error("push-out: " + std::to_string(anchors.slot(s).size()) + (s ? " second" : "") + " body anchors for " +
-                  std::to_string(n) + " vertices");
+      throw Error("push-out: " + std::to_string(anchors.slot(s).size()) +
+                  (s ? std::string(" ") + anchorSlotName(s) : "") + " body anchors for " + std::to_string(n) +
+                  " vertices");
   size_t moved = 0;
   for (size_t v = 0; v < n; ++v) {
     const Vec3f x = positions.row(Eigen::Index(v)).transpose();

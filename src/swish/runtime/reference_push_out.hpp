@@ -16,7 +16,8 @@
 // differs near the sphere differs by rounding only. A vertex without an anchor has r = 0 and stays, as
 // does one whose anchor matrices are not finite (s is NaN) or that sits on the centre (no direction).
 // A model with second anchors (BodyAnchors::second, format 1.4) then does the same for the vertex's
-// second anchor, starting from where the first left it: two pushes in that order, each as above.
+// second anchor, starting from where the first left it, and one with third (cover) anchors (format 1.5)
+// for its third: up to three pushes in that order, each as above.
 //
 // Why per-vertex anchors and not a proxy of the whole body (capsules, formats 1.1 and 1.2): a vertex
 // pushed out of the nearest of several overlapping shapes can land inside another, or inside the real

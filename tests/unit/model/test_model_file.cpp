@@ -389,14 +389,14 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
   auto u16 = [&](size_t at) { return uint32_t(bytes[at] | bytes[at + 1] << 8); };
   auto u32 = [&](size_t at) { return u16(at) | u16(at + 2) << 16; };
   EXPECT_EQ(u16(8), 1u);
-  EXPECT_EQ(u16(10), 4u);
-  EXPECT_EQ(u32(12), 16u);
+  EXPECT_EQ(u16(10), 5u);
+  EXPECT_EQ(u32(12), 17u);
   EXPECT_EQ(uint64_t(u32(16)) | uint64_t(u32(20)) << 32, bytes.size());
   EXPECT_EQ(u32(24), 0u);
   EXPECT_EQ(u32(28), swish::crc32(std::span<const uint8_t>(bytes.data(), 28)));
   // Walk the sections by hand, as a reader written from the comment in model_file.hpp would.
-  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN",
-                                "NMDB", "TFLT", "BPRX", "NOVG", "BCOV", "BANC", "BAN2", "META"};
+  const char* expectedTags[] = {"SKEL", "INPJ", "NRMI", "NRMO", "MLP ", "MPCA", "MESH", "SKIN", "NMDB",
+                                "TFLT", "BPRX", "NOVG", "BCOV", "BANC", "BAN2", "BAN3", "META"};
   size_t at = 32;
   for (const char* tag : expectedTags) {
     ASSERT_LE(at + 16, bytes.size());
@@ -421,8 +421,8 @@ TEST(ModelFile, HeaderAndSectionsFollowTheDocumentedLayout) {
       EXPECT_EQ(size, 8u) << "no anchors: the count and the margin";
       EXPECT_EQ(u32(at + 16), 0u);
     }
-    if (std::string(tag) == "BAN2") {
-      EXPECT_EQ(size, 4u) << "no second anchors: the count";
+    if (std::string(tag) == "BAN2" || std::string(tag) == "BAN3") {
+      EXPECT_EQ(size, 4u) << "no second or third anchors: the count";
       EXPECT_EQ(u32(at + 16), 0u);
     }
     if (std::string(tag) == "META") {
@@ -518,7 +518,7 @@ TEST(ModelFile, WrongMagicAndVersionsAreClearErrors) {
   const auto info = swish::readModelFileInfo(assemble(extended, 1, 7), "newer.swish");
   EXPECT_FALSE(info.sections[3].known);
   // The same unknown section in a file claiming the current version is corruption.
-  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.4 file");
+  EXPECT_CONTAINS(loadError(assemble(extended)), "unknown section 'FUTR' in a version 1.5 file");
 }
 
 // Format 1.1 added the capsule proxy (BPRX), legacy since 1.3: a 1.0 file (no BPRX) still loads; a 1.1
@@ -532,7 +532,7 @@ TEST(ModelFile, LegacyCapsuleSectionOfVersion11) {
   const Model m = swish::test::makeRandomModel(rng, spec);
   auto sections = splitSections(swish::serializeModel(m));
   // A 1.2 file as 1.2 wrote it: no BANC (nor BAN2), two capsules in BPRX.
-  auto v12 = withoutSections(sections, {"BANC", "BAN2"});
+  auto v12 = withoutSections(sections, {"BANC", "BAN2", "BAN3"});
   swish::ByteWriter capsules;
   capsules.u32(2);
   for (int c = 0; c < 2; ++c) {
@@ -573,7 +573,7 @@ TEST(ModelFile, BodyAnchorSectionOfVersion13) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
   EXPECT_EQ(sectionOf(sections, "BANC").payload.size(), 8u + 9u * (12 + 12 + 4 + 4 + 8 + 16));
 
-  const auto without = withoutSections(sections, {"BANC", "BAN2"});
+  const auto without = withoutSections(sections, {"BANC", "BAN2", "BAN3"});
   Model old = m;
   old.bodyAnchors = {};
   expectBitwiseEqual(swish::deserializeModel(assemble(without, 1, 2), "old.swish"), old);
@@ -658,7 +658,7 @@ TEST(ModelFile, SecondAnchorSectionOfVersion14) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
   EXPECT_EQ(sectionOf(sections, "BAN2").payload.size(), 4u + 9u * (12 + 12 + 4 + 4 + 8 + 16));
 
-  const auto v13 = withoutSections(sections, {"BAN2"});
+  const auto v13 = withoutSections(sections, {"BAN2", "BAN3"});
   Model old = m;
   old.bodyAnchors.second.clear();
   expectBitwiseEqual(swish::deserializeModel(assemble(v13, 1, 3), "v13.swish"), old);
@@ -696,6 +696,58 @@ TEST(ModelFile, SecondAnchorSectionOfVersion14) {
   }
 }
 
+// Format 1.5 added the third (cover) body anchors (BAN3): round trip; a 1.4 file (no BAN3) loads without
+// them; a 1.5 file without the section, or a 1.4 file with it, is refused; third anchors that do not fit
+// the model, or that come without second ones, are refused naming them.
+TEST(ModelFile, ThirdAnchorSectionOfVersion15) {
+  swish::Rng rng(15);
+  RandomModelSpec spec;
+  spec.vertices = 9;
+  spec.bodyAnchors = true;
+  spec.secondAnchors = true;
+  spec.thirdAnchors = true;
+  const Model m = swish::test::makeRandomModel(rng, spec);
+  ASSERT_EQ(m.bodyAnchors.third.size(), 9u);
+  ASSERT_EQ(m.bodyAnchors.slots(), 3u);
+  ASSERT_FALSE(m.bodyAnchors.third[2].present());  // (every 3rd from 2 has none)
+  ASSERT_TRUE(m.bodyAnchors.third[0].present());
+  auto sections = splitSections(swish::serializeModel(m));
+  expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
+  EXPECT_EQ(sectionOf(sections, "BAN3").payload.size(), 4u + 9u * (12 + 12 + 4 + 4 + 8 + 16));
+
+  const auto v14 = withoutSections(sections, {"BAN3"});
+  Model old = m;
+  old.bodyAnchors.third.clear();
+  expectBitwiseEqual(swish::deserializeModel(assemble(v14, 1, 4), "v14.swish"), old);
+  EXPECT_EQ(old.bodyAnchors.slots(), 2u);
+  EXPECT_CONTAINS(loadError(assemble(v14)), "section 'BAN3' is missing");
+  EXPECT_CONTAINS(loadError(assemble(sections, 1, 4)), "a section of format 1.5 in a version 1.4 file");
+  auto twoSets = splitSections(swish::serializeModel(old));
+  EXPECT_EQ(sectionOf(twoSets, "BAN3").payload.size(), 4u);
+
+  auto edited = sections;
+  const size_t radii = 4 + 24 * 9;
+  std::memcpy(&sectionOf(edited, "BAN3").payload[radii + 4 * 3], "\0\0\0\0", 4);  // radius 0
+  EXPECT_CONTAINS(loadError(assemble(edited), "three.swish"),
+                  "three.swish: body anchors: third anchor of vertex 3 has");
+  Model bad = m;
+  bad.bodyAnchors.third.pop_back();
+  try {
+    bad.validate("m");
+    ADD_FAILURE() << "third anchors for another vertex count were accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "m: body anchors: 8 third anchors for 9 game-mesh vertices");
+  }
+  bad = m;
+  bad.bodyAnchors.second.clear();
+  try {
+    bad.validate("m");
+    ADD_FAILURE() << "third anchors without second ones were accepted";
+  } catch (const swish::Error& e) {
+    EXPECT_CONTAINS(e.what(), "m: body anchors: third anchors without second ones");
+  }
+}
+
 // Format 1.2 added the novelty guard: older files load without one; a 1.2 file without it, or a 1.1
 // file with it, is refused; a guard that does not fit the model is refused naming the part.
 TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
@@ -709,7 +761,7 @@ TEST(ModelFile, NoveltyGuardSectionOfVersion12) {
   expectBitwiseEqual(swish::deserializeModel(assemble(sections), "new.swish"), m);
 
   auto without = sections;
-  for (const char* tag : {"NOVG", "BCOV", "BANC", "BAN2"})
+  for (const char* tag : {"NOVG", "BCOV", "BANC", "BAN2", "BAN3"})
     without.erase(std::find_if(without.begin(), without.end(), [&](const RawSection& s) { return s.tag == tag; }));
   Model old = m;
   old.noveltyGuard = {};

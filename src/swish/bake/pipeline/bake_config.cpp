@@ -391,6 +391,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "input_joints",
                                                   "anchor_calibration",
                                                   "anchor_margin_mm",
+                                                  "cover_anchors",
                                                   "root_gravity"});
   BakeTrainSettings& t = cfg.train;
   t.meshComponents = int(train.wholeNumber("mesh_components", 1, 4096, t.meshComponents));
@@ -438,6 +439,7 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
     t.calibrateAnchors = v == "strict";
   }
   t.anchorMargin = float(train.number("anchor_margin_mm", 0, 50, 1000.0 * t.anchorMargin) / 1000.0);
+  t.coverAnchors = train.boolean("cover_anchors", t.coverAnchors);
   return cfg;
 }
 

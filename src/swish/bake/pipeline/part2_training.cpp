@@ -46,6 +46,7 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (rootGravity) j["root_gravity"] = true;                       // likewise
   if (anchorMargin != BodyAnchorFitSettings{}.margin)  // likewise; in micrometres' steps, as the recipe writes it
     j["anchor_margin_mm"] = std::round(1e6 * double(anchorMargin)) / 1e3;
+  if (coverAnchors) j["cover_anchors"] = true;  // likewise
   return j;
 }
 
@@ -266,6 +267,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     report("body anchors", 0.92);
     BodyAnchorFitSettings fitSettings;
     fitSettings.margin = st.anchorMargin;
+    fitSettings.coverAnchors = st.coverAnchors;
     // The training poses' simulated garments show where the cloth slides over the body (the slide anchors).
     std::vector<BodyAnchorSlidePose> slidePoses(out.trainingPoses.size());
     for (size_t i = 0; i < out.trainingPoses.size(); ++i) {

@@ -62,6 +62,12 @@ struct BakeTrainSettings {
   // network's garment dips into it, for a little more error against the truth (docs/baking.md, "The
   // margin, measured").
   float anchorMargin = 0.002f;
+  // The third anchor set, the cover anchors (train.cover_anchors; BodyAnchorFitSettings::coverAnchors,
+  // `swish body-proxy --no-cover-anchors`): the ball per vertex that covers most of the skin the first
+  // two sets leave outside theirs over the training poses (docs/baking.md, "A third set: cover anchors").
+  // Off unless the recipe asks (then recorded; absent when off, so that earlier bakes' fingerprints stay):
+  // the committed default model was baked before it.
+  bool coverAnchors = false;
 
   nlohmann::json toJson() const;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -133,6 +134,109 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
   fit.slideGapMedianMm = percentile(gaps, 0.5);
 }
 
+// The cover anchors (BodyAnchorFitSettings::coverAnchors): per vertex with a first anchor, the poses' misses
+// (the posed skin under the cloth that both sets so far leave slideMinGap or more outside their balls), then
+// of up to coverCandidates balls under those misses, the one covering the largest summed gap. Each vertex
+// writes its own entries only; poses in order, candidates in ascending miss order and the strict "larger"
+// keep it deterministic.
+template <class AnchorAt>
+void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
+                     const std::vector<BodyAnchorSlidePose>& poses, const BodyAnchorFitSettings& s,
+                     const AnchorAt& anchorAt) {
+  const size_t n = firstPart.size();
+  struct Miss {
+    size_t pose;
+    Vec3f skin;  // posed
+    Vec3f rest;  // the same point on the rest body
+    int triangle;
+    float gap;
+  };
+  std::vector<std::vector<Miss>> misses(n);
+  BodyCollider posed = rest;
+  const Triangles& tris = rest.triangles();
+  const Points3f& restPos = rest.positions();
+  auto distanceOff = [](const BodyAnchor& a, const Vec3f& skin, std::span<const Mat4f> mats) {
+    return (skin - runtime::skinAnchorCentre(a, mats)).norm() - a.radius;
+  };
+  const size_t step =
+      std::max<size_t>(1, (poses.size() + std::max<size_t>(1, s.slidePoses) - 1) / std::max<size_t>(1, s.slidePoses));
+  for (size_t p = 0; p < poses.size(); p += step) {
+    posed.pose(poses[p].skinMatrices);
+    const Points3f& g = *poses[p].garment;
+    const Points3f& pos = posed.positions();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t v = range.begin(); v < range.end(); ++v) {
+        if (firstPart[v] < 0) continue;
+        const Vec3f x = g.row(Eigen::Index(v)).transpose();
+        if (!x.allFinite()) continue;
+        const BodyCollider::Hit h = posed.closest(x, s.slideContact, firstPart[v]);
+        if (!h.found || h.triangle < 0) continue;
+        float gap = distanceOff(fit.anchors.anchors[v], h.point, poses[p].skinMatrices);
+        if (!fit.anchors.second.empty() && fit.anchors.second[v].present())
+          gap = std::min(gap, distanceOff(fit.anchors.second[v], h.point, poses[p].skinMatrices));
+        if (!(gap >= s.slideMinGap)) continue;
+        const uint32_t c[3] = {tris(h.triangle, 0), tris(h.triangle, 1), tris(h.triangle, 2)};
+        const Vec3f bc =
+            barycentric(h.point, pos.row(c[0]).transpose(), pos.row(c[1]).transpose(), pos.row(c[2]).transpose());
+        const Vec3f r = bc[0] * restPos.row(c[0]).transpose() + bc[1] * restPos.row(c[1]).transpose() +
+                        bc[2] * restPos.row(c[2]).transpose();
+        misses[v].push_back({p, h.point, r, h.triangle, gap});
+      }
+    });
+  }
+  fit.anchors.third.assign(n, BodyAnchor{});
+  std::vector<size_t> covered(n, 0);
+  const size_t most = std::max<size_t>(1, s.coverCandidates);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<size_t> candidates;
+    for (size_t v = range.begin(); v < range.end(); ++v) {
+      const std::vector<Miss>& m = misses[v];
+      if (m.empty()) continue;
+      // The largest miss, and misses spread evenly over the poses.
+      candidates.clear();
+      size_t largest = 0;
+      for (size_t i = 1; i < m.size(); ++i)
+        if (m[i].gap > m[largest].gap) largest = i;
+      candidates.push_back(largest);
+      const size_t spread = std::min(m.size(), most > 1 ? most - 1 : size_t(0));
+      for (size_t k = 0; k < spread; ++k) candidates.push_back(k * m.size() / spread);
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      double best = 0;
+      size_t bestCovered = 0;
+      BodyAnchor chosen;
+      for (const size_t i : candidates) {
+        // The rest body's own answer at that point, from just outside it along the triangle's face normal
+        // (as the slide anchors).
+        const int t = m[i].triangle;
+        const Vec3f a = restPos.row(tris(t, 0)).transpose(), b = restPos.row(tris(t, 1)).transpose(),
+                    c = restPos.row(tris(t, 2)).transpose();
+        const Vec3f fn = (b - a).cross(c - a);
+        if (!(fn.norm() > 0.f)) continue;
+        const BodyCollider::Hit h = rest.closest(m[i].rest + 0.001f * fn.normalized(), 0.01f, firstPart[v]);
+        if (!h.found || h.triangle < 0) continue;
+        bool flipped = false;
+        const BodyAnchor candidate = anchorAt(h, flipped);
+        if (!candidate.present()) continue;
+        double weight = 0;
+        size_t count = 0;
+        for (const Miss& q : m)
+          if (distanceOff(candidate, q.skin, poses[q.pose].skinMatrices) <= s.coverReach)
+            weight += double(q.gap), ++count;
+        if (weight > best) best = weight, bestCovered = count, chosen = candidate;
+      }
+      if (!(best > 0)) continue;
+      fit.anchors.third[v] = chosen;
+      covered[v] = bestCovered;
+    }
+  });
+  for (size_t v = 0; v < n; ++v) {
+    fit.coverMisses += misses[v].size();
+    fit.coverCovered += covered[v];
+    fit.coverAnchored += fit.anchors.third[v].present() ? 1 : 0;
+  }
+}
+
 }  // namespace
 
 BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const Mesh& garment,
@@ -249,7 +353,11 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     ++fit.secondAnchored;
   }
   if (s.secondAnchors && !poses.empty()) fitSlideAnchors(fit, collider, firstPart, poses, s, anchorAt);
-  if (fit.secondAnchored == 0) fit.anchors.second.clear();  // a model without them, not N empty ones
+  if (s.secondAnchors && s.coverAnchors && !poses.empty())
+    fitCoverAnchors(fit, collider, firstPart, poses, s, anchorAt);
+  // A model without them, not N empty ones (a third set needs a second one before it, empty or not).
+  if (fit.coverAnchored == 0) fit.anchors.third.clear();
+  if (fit.secondAnchored == 0 && fit.coverAnchored == 0) fit.anchors.second.clear();
   fit.medianMm = percentile(distances, 0.5);
   fit.p95Mm = percentile(distances, 0.95);
   fit.maxMm = distances.empty() ? 0.f : *std::max_element(distances.begin(), distances.end());
@@ -264,9 +372,10 @@ BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vect
   if (!(s.tolerance >= 0.f) || !std::isfinite(s.tolerance))
     throw Error("body anchor calibration: the tolerance must be >= 0 metres");
   const size_t n = anchors.anchors.size();
-  if (!anchors.second.empty() && anchors.second.size() != n)
-    throw Error("body anchor calibration: " + std::to_string(anchors.second.size()) + " second anchors for " +
-                std::to_string(n) + " anchors");
+  for (uint32_t slot = 1; slot < anchors.slots(); ++slot)
+    if (anchors.slot(slot).size() != n)
+      throw Error("body anchor calibration: " + std::to_string(anchors.slot(slot).size()) + " " + anchorSlotName(slot) +
+                  " anchors for " + std::to_string(n) + " anchors");
   for (size_t p = 0; p < poses.size(); ++p) {
     const BodyAnchorCalibrationPose& cp = poses[p];
     for (const Points3f* g : {cp.truth, cp.predicted})
@@ -380,6 +489,9 @@ nlohmann::json toJson(const BodyAnchorFit& f) {
           {"slide_median_mm", f.slideMedianMm},
           {"slide_max_mm", f.slideMaxMm},
           {"slide_gap_median_mm", f.slideGapMedianMm},
+          {"cover_anchored", f.coverAnchored},
+          {"cover_misses", f.coverMisses},
+          {"cover_covered", f.coverCovered},
           {"too_far", f.tooFar},
           {"margin_mm", std::round(1e6 * double(f.anchors.margin)) / 1e3},  // in micrometre steps: 6, not 6.000000052
           {"max_distance_mm", f.maxDistanceMm},

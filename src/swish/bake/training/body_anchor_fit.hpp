@@ -49,6 +49,18 @@ struct BodyAnchorFitSettings {
   float slideContact = 0.01f;  // metres from the posed body
   float slideMinGap = 0.003f;  // metres
   size_t slidePoses = 400;     // at most this many of the poses given, evenly spread
+  // Cover anchors (BodyAnchors::third, format 1.5; with poses): one slide slot holds one place the cloth
+  // slides to, the pose of the largest miss (the T-pose's belly, rare and large), and leaves the frequent
+  // ones (the skin of a bent elbow under its sleeve end, in every pose the arm bends). So each anchored
+  // vertex also gets, as its third, the ball that covers most of what the first two sets still miss: over
+  // the same poses, the posed skin under the cloth (within slideContact, on the first anchor's part) that
+  // lies slideMinGap or more outside both balls is a miss, weighted by that gap; of up to
+  // coverCandidates balls (under the largest miss and under misses spread evenly over the poses, taken back
+  // to the rest body as the slide anchors are), the one whose posed ball reaches most of that weight (each
+  // pose's skin within coverReach of its surface) is kept.
+  bool coverAnchors = true;
+  float coverReach = 0.003f;    // metres
+  size_t coverCandidates = 16;  // at least 1
 };
 
 // A pose to find the slide anchors in (see the settings): the body's skinning matrices and the
@@ -66,7 +78,10 @@ struct BodyAnchorFit {
   size_t slidePoses = 0;      // poses searched for them
   float slideMedianMm = 0, slideMaxMm = 0;  // of the slide anchors: distance of their contact from the first's (rest)
   float slideGapMedianMm = 0;               // of the slide anchors: how far the first ball missed the skin there
-  size_t tooFar = 0;                        // vertices beyond maxDistance (no anchor)
+  size_t coverAnchored = 0;                 // vertices with a third (cover) anchor
+  size_t coverMisses = 0;     // (pose, vertex) pairs whose skin the first two sets miss by slideMinGap or more
+  size_t coverCovered = 0;    // of them, those within coverReach of the vertex's cover ball
+  size_t tooFar = 0;          // vertices beyond maxDistance (no anchor)
   size_t insideAtRest = 0;    // anchored vertices inside the body at rest (the push-out moves them at rest)
   size_t withinMargin = 0;    // anchored vertices nearer their ball than the margin at rest (pushed at rest)
   size_t flippedNormals = 0;  // interpolated normals turned to agree with the pseudo-normal
@@ -99,12 +114,12 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
 // its ball's radius or kMaxAnchorDepth; such an anchor is dropped. The push-out then removes what it can
 // without making any vertex worse on the calibration poses. Second anchors (BodyAnchors::second) are
 // calibrated the same way after the first, on where the first anchor's push leaves each vertex, as the
-// run time applies them.
+// run time applies them, and the third (cover) anchors after the second.
 struct BodyAnchorCalibrationSettings {
   float step = 0.001f;  // metres between the clearances tried
   // Metres of mean distance to the truth per calibration pose that pushing a vertex may add (0: none).
   float tolerance = 0.f;
-  bool second = true;  // calibrate the second anchors too (false: they keep the margin)
+  bool second = true;  // calibrate the second and third anchors too (false: they keep the margin)
 };
 
 struct BodyAnchorCalibrationPose {
@@ -117,7 +132,7 @@ struct BodyAnchorCalibration {
   size_t poses = 0;
   size_t lowered = 0;         // anchors whose clearance went below the margin
   size_t dropped = 0;         // anchors dropped (see above), second anchors included
-  size_t secondDropped = 0;   // of them, second anchors
+  size_t secondDropped = 0;   // of them, second and third anchors
   float medianLoweredMm = 0;  // median clearance of the lowered anchors (mm, negative: inside the ball)
   // Over the calibration poses and every vertex: mean distance to the truth (mm) without and with the
   // calibrated push-out, and the share of (pose, vertex) pairs it moves.

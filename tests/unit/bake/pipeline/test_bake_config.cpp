@@ -70,6 +70,13 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_NE(
       errorOf({{"output", "o"}, {"train", {{"anchor_margin_mm", 60}}}}).find("train.anchor_margin_mm: 60 is outside"),
       std::string::npos);
+  // The third anchor set (cover anchors): off unless the recipe asks, and then recorded.
+  EXPECT_FALSE(w.train.coverAnchors);
+  EXPECT_FALSE(w.train.toJson().contains("cover_anchors"));
+  const BakeConfig c3 =
+      parseBakeConfig({{"output", "out"}, {"train", {{"cover_anchors", true}}}}, "recipe.json", "/base");
+  EXPECT_TRUE(c3.train.coverAnchors);
+  EXPECT_EQ(c3.train.toJson()["cover_anchors"], true);
   // The gravity values in Theta: off unless asked for (and then recorded; absent by default, so that the
   // fingerprints of earlier bakes stay).
   EXPECT_FALSE(w.train.rootGravity);

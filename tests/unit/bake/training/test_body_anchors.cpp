@@ -303,6 +303,73 @@ TEST(BodyAnchorFit, SlideAnchorsCoverTheSkinTheClothSlidOnto) {
   }
 }
 
+// Cloth that slides to two places: once 10 cm up (the largest miss, which the slide anchor takes) and,
+// in three poses, 4.5 cm down, where both the first ball and the slide anchor's miss the skin by 8 mm.
+// The cover anchor, the third set, is the ball under the frequent slide: with it the cloth slid down
+// and 3 mm under the skin is pushed out; without it (the first two sets) it stays inside.
+TEST(BodyAnchorFit, CoverAnchorsHoldTheFrequentSlideTheSlideAnchorLeaves) {
+  const test::CapsuleSpec spec;
+  const Character ch = test::capsuleCharacter(spec);
+  const std::vector<Mat4f> rest = identities(ch.skeleton.size());
+  auto onSkin = [&](float up, float off) {  // the garment moved `up`, `off` from the (analytic) skin
+    Points3f g = ch.garment.positions;
+    for (Eigen::Index v = 0; v < g.rows(); ++v) {
+      const Vec3f p = g.row(v).transpose();
+      const Vec3f radial = Vec3f(p.x(), 0.f, p.z()).normalized();
+      const float y = std::clamp(p.y() + up, spec.axisLow, spec.axisHigh);
+      g.row(v) = (radial * (spec.radius + off) + Vec3f(0.f, y, 0.f)).transpose();
+    }
+    return g;
+  };
+  const Points3f up = onSkin(0.1f, 0.004f), down = onSkin(-0.045f, 0.004f);
+  const std::vector<bake::BodyAnchorSlidePose> poses = {{rest, &up}, {rest, &down}, {rest, &down}, {rest, &down}};
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment, {}, poses);
+  const size_t n = ch.garment.vertexCount();
+  EXPECT_EQ(fit.slideAnchored, n);
+  EXPECT_EQ(fit.coverAnchored, n);
+  EXPECT_EQ(fit.coverMisses, 3 * n) << "the three poses slid down, each vertex";
+  EXPECT_EQ(fit.coverCovered, 3 * n);
+  ASSERT_EQ(fit.anchors.slots(), 3u);
+  ASSERT_EQ(fit.anchors.third.size(), n);
+  for (size_t v = 0; v < n; ++v) {
+    const BodyAnchor& a = fit.anchors.anchors[v];
+    const BodyAnchor& b = fit.anchors.second[v];
+    const BodyAnchor& c = fit.anchors.third[v];
+    ASSERT_TRUE(c.present()) << v;
+    EXPECT_NEAR(b.position.y(), std::min(a.position.y() + 0.1f, spec.axisHigh), 0.012f) << v << ": the largest miss";
+    EXPECT_NEAR(c.position.y(), a.position.y() - 0.045f, 0.012f) << v << ": the frequent slide";
+    EXPECT_NEAR(test::capsuleSignedDistance(spec, c.position), 0.f, 0.001f) << v;
+    EXPECT_NEAR(c.radius, spec.radius, 0.003f) << v;
+  }
+  // Off: the first two sets only, as format 1.4 had them.
+  bake::BodyAnchorFitSettings off;
+  off.coverAnchors = false;
+  const bake::BodyAnchorFit two = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment, off, poses);
+  EXPECT_EQ(two.anchors.slots(), 2u);
+  EXPECT_EQ(two.coverAnchored, 0u);
+  for (size_t v = 0; v < n; ++v) EXPECT_EQ(two.anchors.second[v].position, fit.anchors.second[v].position) << v;
+  // The cloth slid down and 3 mm under the skin: the first two sets leave it there, the third pushes it out.
+  const Points3f inside = onSkin(-0.045f, -0.003f);
+  bake::BodyCollider collider(ch.body, 0.05f);
+  collider.pose(rest);
+  EXPECT_GT(bake::measurePenetration(collider, inside).inside, uint32_t(n) * 9 / 10);
+  Points3f p = inside;
+  runtime::referencePushOut(p, two.anchors, rest);
+  EXPECT_GT(bake::measurePenetration(collider, p).inside, uint32_t(n) * 9 / 10);
+  p = inside;
+  runtime::referencePushOut(p, fit.anchors, rest);
+  EXPECT_EQ(bake::measurePenetration(collider, p).inside, 0u);
+  // Calibrated like the other sets: against a truth that lies inside there, pushing would move the
+  // network's garment away from it, so the third set's clearances go down (or the anchors are dropped).
+  BodyAnchors calibrated = fit.anchors;
+  const bake::BodyAnchorCalibration cal = bake::calibrateBodyAnchors(calibrated, {{rest, &inside, &inside}});
+  EXPECT_EQ(cal.meanMmWith, cal.meanMmWithout) << "no vertex moved away from the truth";
+  size_t thirdChanged = 0;
+  for (size_t v = 0; v < n; ++v)
+    thirdChanged += !calibrated.third[v].present() || calibrated.third[v].clearance < fit.anchors.margin ? 1 : 0;
+  EXPECT_EQ(thirdChanged, n);
+}
+
 // On the analytic capsule body every garment vertex (a tube 12 mm off it) is anchored on the surface
 // straight under it, with the radial normal and the body's own weights there.
 TEST(BodyAnchorFit, AnalyticCapsule) {
@@ -503,7 +570,7 @@ TEST(PushOutReference, KnownAnswersAndContinuity) {
     Points3f x(1, 3);
     x << 0.f, 1.f, -0.04f + 0.00015f * float(s);
     Points3f y = x;
-    runtime::referencePushOut(y, BodyAnchors{0.002f, {a}, {}}, mats);
+    runtime::referencePushOut(y, BodyAnchors{0.002f, {a}, {}, {}}, mats);
     EXPECT_GE(y(0, 2), x(0, 2) - 1e-7f);
     EXPECT_GE(y(0, 2), 0.002f - 1e-6f);
     if (s > 0) {
@@ -514,7 +581,7 @@ TEST(PushOutReference, KnownAnswersAndContinuity) {
   // On the centre there is no direction: the vertex stays.
   Points3f centre(1, 3);
   centre << 0.f, 1.f, -0.05f;
-  EXPECT_EQ(runtime::referencePushOut(centre, BodyAnchors{0.002f, {a}, {}}, mats), 0u);
+  EXPECT_EQ(runtime::referencePushOut(centre, BodyAnchors{0.002f, {a}, {}, {}}, mats), 0u);
 
   // Errors: anchors for another vertex count, a weighted joint without a matrix.
   Points3f two = p.topRows(2);
