@@ -73,6 +73,11 @@ json truthJson(const TruthSummary& t) {
     j["meanMm"] = t.meanMm, j["p95Mm"] = t.p95Mm, j["maxMm"] = t.maxMm;
     if (t.comparedWithout)
       j["withoutPushOut"] = {{"meanMm", t.meanMmWithout}, {"p95Mm", t.p95MmWithout}, {"maxMm", t.maxMmWithout}};
+    if (t.comparedWithout && t.splitByTruth)
+      j["withoutPushOut"]["byTruth"] = {
+          {"truthInsideShare", t.truthInsideShare},
+          {"truthOutside", {{"meanMm", t.meanMmTruthOutside}, {"meanMmWithout", t.meanMmWithoutTruthOutside}}},
+          {"truthInside", {{"meanMm", t.meanMmTruthInside}, {"meanMmWithout", t.meanMmWithoutTruthInside}}}};
     if (t.normalMaps) j["normalMeanDeg"] = t.meanDeg, j["normalP95Deg"] = t.p95Deg, j["normalMaxDeg"] = t.maxDeg;
   }
   return j;
@@ -437,7 +442,21 @@ std::string reportMarkdown(const json& j) {
         s << "The same truth frames without the push-out (the CPU reference's positions): vertex error mean "
           << fmt(num(w["meanMm"])) << " mm, p95 " << fmt(num(w["p95Mm"])) << " mm, max " << fmt(num(w["maxMm"]))
           << " mm: the push-out changes the mean by " << fmt(num(t["meanMm"]) - num(w["meanMm"]), "%+.3f")
-          << " mm and the p95 by " << fmt(num(t["p95Mm"]) - num(w["p95Mm"]), "%+.3f") << " mm.\n\n";
+          << " mm and the p95 by " << fmt(num(t["p95Mm"]) - num(w["p95Mm"]), "%+.3f") << " mm.";
+        if (w.contains("byTruth")) {
+          const json& b = w["byTruth"];
+          const json &out = b["truthOutside"], &in = b["truthInside"];
+          s << " Split by where the truth lies: where it is outside the body ("
+            << fmt(100.0 * (1.0 - num(b["truthInsideShare"])), "%.1f") << " % of the vertices) the mean goes from "
+            << fmt(num(out["meanMmWithout"])) << " to " << fmt(num(out["meanMm"])) << " mm ("
+            << fmt(num(out["meanMm"]) - num(out["meanMmWithout"]), "%+.3f")
+            << "); where the truth itself is inside the body (" << fmt(100.0 * num(b["truthInsideShare"]), "%.1f")
+            << " %: the source simulation's cloth inside an arm or the trunk, which a garment kept off the body "
+               "cannot match) from "
+            << fmt(num(in["meanMmWithout"])) << " to " << fmt(num(in["meanMm"])) << " mm ("
+            << fmt(num(in["meanMm"]) - num(in["meanMmWithout"]), "%+.3f") << ").";
+        }
+        s << "\n\n";
       }
       s << "![error against ground truth per truth frame](plots/truth_error_per_frame.svg)\n\n";
     }

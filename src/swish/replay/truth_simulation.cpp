@@ -12,6 +12,7 @@
 #include "swish/bake/pipeline/baked_character.hpp"
 #include "swish/bake/pipeline/part1_dataset.hpp"
 #include "swish/bake/report/bake_evaluation.hpp"
+#include "swish/bake/report/penetration.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 #include "swish/model/model_file.hpp"
@@ -241,6 +242,14 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
       const bake::DistanceStats w = bake::distanceStats(m.vertexMmWithout);
       m.summary.comparedWithout = true;
       m.summary.meanMmWithout = w.mean, m.summary.p95MmWithout = w.p95, m.summary.maxMmWithout = w.max;
+      // Where the truth itself lies inside the body (the bake's body, posed as the run time posed it).
+      if (character_ && character_->body.triangleCount() > 0) {
+        bake::BodyCollider body(character_->body, 0.05f, "truth body");
+        body.pose(model_->skeleton.skinningMatrices(pose));
+        m.truthInside.resize(size_t(truth.rows()));
+        for (Eigen::Index v = 0; v < truth.rows(); ++v)
+          m.truthInside[size_t(v)] = bake::penetrationDepth(body, truth.row(v).transpose()) > 0.f ? 1 : 0;
+      }
     }
     if (normalMaps_ && normalMap && normalMap->width == shape.normalMap.width &&
         normalMap->height == shape.normalMap.height) {
@@ -268,6 +277,8 @@ void TruthPool::add(const TruthMeasurement& m) {
   vertexMm_.insert(vertexMm_.end(), m.vertexMm.begin(), m.vertexMm.end());
   if (m.vertexMmWithout.empty()) allWithout_ = false;
   vertexMmWithout_.insert(vertexMmWithout_.end(), m.vertexMmWithout.begin(), m.vertexMmWithout.end());
+  if (m.truthInside.size() != m.vertexMm.size()) allSplit_ = false;
+  truthInside_.insert(truthInside_.end(), m.truthInside.begin(), m.truthInside.end());
   if (m.angles) {
     if (!angles_) angles_ = std::make_unique<bake::AngularErrorAccumulator>();
     angles_->merge(*m.angles);
@@ -284,6 +295,19 @@ TruthSummary TruthPool::summary() const {
       const bake::DistanceStats w = bake::distanceStats(vertexMmWithout_);
       s.comparedWithout = true;
       s.meanMmWithout = w.mean, s.p95MmWithout = w.p95, s.maxMmWithout = w.max;
+      if (allSplit_ && truthInside_.size() == vertexMm_.size()) {
+        double with[2] = {0, 0}, without[2] = {0, 0};
+        size_t count[2] = {0, 0};
+        for (size_t e = 0; e < vertexMm_.size(); ++e) {
+          const int side = truthInside_[e] ? 1 : 0;
+          with[side] += vertexMm_[e], without[side] += vertexMmWithout_[e], ++count[side];
+        }
+        auto mean = [&](const double* sum, int side) { return count[side] ? sum[side] / double(count[side]) : 0.0; };
+        s.splitByTruth = true;
+        s.truthInsideShare = double(count[1]) / double(vertexMm_.size());
+        s.meanMmTruthOutside = mean(with, 0), s.meanMmWithoutTruthOutside = mean(without, 0);
+        s.meanMmTruthInside = mean(with, 1), s.meanMmWithoutTruthInside = mean(without, 1);
+      }
     }
   }
   if (angles_) {

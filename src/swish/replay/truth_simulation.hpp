@@ -65,6 +65,9 @@ struct TruthMeasurement {
   std::vector<double> vertexMm;
   Points3f truthPositions;              // the truth's game mesh, skinned as the run time skins (when ok)
   std::vector<double> vertexMmWithout;  // empty unless compared without the push-out
+  // With vertexMmWithout and a body: per vertex 1 where the truth itself lies inside the posed body (the
+  // source simulation's cloth inside the arm or trunk, which no push-out can match), else 0.
+  std::vector<uint8_t> truthInside;
   std::unique_ptr<bake::AngularErrorAccumulator> angles;  // null without a normal map
 };
 
@@ -75,6 +78,13 @@ struct TruthSummary {
   double meanMm = 0, p95Mm = 0, maxMm = 0;  // over every vertex of every measured pair
   bool comparedWithout = false;             // every measured pair also measured without the push-out
   double meanMmWithout = 0, p95MmWithout = 0, maxMmWithout = 0;
+  // The push-out's change split by where the truth lies (every measured pair has truthInside): does it
+  // take the garment away from a truth that is outside the body (a fault of the push-out), or only from
+  // one inside it (a fault of the truth)? Mean vertex error with and without the push-out, each side.
+  bool splitByTruth = false;
+  double truthInsideShare = 0;  // of the vertices measured
+  double meanMmTruthOutside = 0, meanMmWithoutTruthOutside = 0;
+  double meanMmTruthInside = 0, meanMmWithoutTruthInside = 0;
   bool normalMaps = false;
   double meanDeg = 0, p95Deg = 0, maxDeg = 0;  // over every texel of every measured map
   double seconds = 0, cpuSeconds = 0;          // summed per-pose seconds (CharacterTruth), failed poses too
@@ -89,7 +99,8 @@ class TruthPool {
   uint32_t samples_ = 0, failed_ = 0;
   double seconds_ = 0, cpuSeconds_ = 0;
   std::vector<double> vertexMm_, vertexMmWithout_;
-  bool allWithout_ = true;
+  std::vector<uint8_t> truthInside_;
+  bool allWithout_ = true, allSplit_ = true;
   std::unique_ptr<bake::AngularErrorAccumulator> angles_;
 };
 

@@ -225,10 +225,53 @@ TEST_F(ReplayTruth, EveryNthFrameIsMeasuredAgainstTheSourceSimulation) {
     EXPECT_LE(r.penetrationOverall.pushed.deepestMm, r.penetrationOverall.model.deepestMm + 1e-9);
     EXPECT_TRUE(r.truthOverall.comparedWithout);
     EXPECT_TRUE(rep["truth"]["overall"]["withoutPushOut"]["meanMm"].is_number());
+    // Split by where the truth lies: the two sides partition the vertices, so their means mix back to the whole.
+    const replay::TruthSummary& t = r.truthOverall;
+    ASSERT_TRUE(t.splitByTruth);
+    EXPECT_GE(t.truthInsideShare, 0.0);
+    EXPECT_LE(t.truthInsideShare, 1.0);
+    const double q = t.truthInsideShare;
+    EXPECT_NEAR((1 - q) * t.meanMmTruthOutside + q * t.meanMmTruthInside, t.meanMm, 1e-6 * t.meanMm);
+    EXPECT_NEAR((1 - q) * t.meanMmWithoutTruthOutside + q * t.meanMmWithoutTruthInside, t.meanMmWithout,
+                1e-6 * t.meanMmWithout);
+    EXPECT_TRUE(rep["truth"]["overall"]["withoutPushOut"]["byTruth"]["truthOutside"]["meanMm"].is_number());
+    EXPECT_NE(text.find("Split by where the truth lies"), std::string::npos);
   }
   EXPECT_NE(text.find("Garment inside the body"), std::string::npos);
   EXPECT_TRUE(fs::exists(job.directory / "plots/penetration_per_frame.svg"));
   EXPECT_EQ(ctx().validationMessageCount(), 0u);
+}
+
+// The pool splits the push-out's change by where the truth lies, vertex by vertex, only when every
+// measured pose says where (a pose without a body says nothing, and then no split is claimed).
+TEST(ReplayTruthPool, SplitsThePushOutsChangeByWhereTheTruthLies) {
+  replay::TruthMeasurement a;
+  a.summary.ok = true;
+  a.vertexMm = {1, 2, 10, 20};
+  a.vertexMmWithout = {1, 2, 4, 8};
+  a.truthInside = {0, 0, 1, 1};
+  replay::TruthMeasurement b = {};
+  b.summary.ok = true;
+  b.vertexMm = {3, 5};
+  b.vertexMmWithout = {4, 5};
+  b.truthInside = {0, 1};
+  replay::TruthPool pool;
+  pool.add(a);
+  pool.add(b);
+  const replay::TruthSummary s = pool.summary();
+  ASSERT_TRUE(s.splitByTruth);
+  EXPECT_DOUBLE_EQ(s.truthInsideShare, 0.5);
+  EXPECT_DOUBLE_EQ(s.meanMmTruthOutside, 2.0);             // 1, 2, 3
+  EXPECT_DOUBLE_EQ(s.meanMmWithoutTruthOutside, 7.0 / 3);  // 1, 2, 4
+  EXPECT_DOUBLE_EQ(s.meanMmTruthInside, 35.0 / 3);         // 10, 20, 5
+  EXPECT_DOUBLE_EQ(s.meanMmWithoutTruthInside, 17.0 / 3);  // 4, 8, 5
+  replay::TruthMeasurement c;
+  c.summary.ok = true;
+  c.vertexMm = {1};
+  c.vertexMmWithout = {1};  // no body: no truthInside
+  pool.add(c);
+  EXPECT_TRUE(pool.summary().comparedWithout);
+  EXPECT_FALSE(pool.summary().splitByTruth);
 }
 
 // `swish replay --render` on the default model draws the mannequin, and measures on each picture the skin

@@ -5,18 +5,22 @@
 
 namespace swish::bake {
 
+float penetrationDepth(const BodyCollider& collider, const Vec3f& p) {
+  if (!p.allFinite()) return 0.f;
+  // Most garment vertices lie within a couple of centimetres of the body: a small search ball
+  // answers them from a few grid cells; only the rest pay for the full depth.
+  BodyCollider::Hit h = collider.closest(p, kPenetrationNearSearch);
+  if (!h.found) h = collider.closest(p, kPenetrationSearch);
+  return h.found && h.signedDistance < 0.f ? -h.signedDistance : 0.f;
+}
+
 PenetrationStats measurePenetration(const BodyCollider& collider, const Points3f& garment) {
   PenetrationStats s;
   s.vertices = uint32_t(garment.rows());
   for (Eigen::Index v = 0; v < garment.rows(); ++v) {
-    const Vec3f p = garment.row(v).transpose();
-    if (!p.allFinite()) continue;
-    // Most garment vertices lie within a couple of centimetres of the body: a small search ball
-    // answers them from a few grid cells; only the rest pay for the full depth.
-    BodyCollider::Hit h = collider.closest(p, kPenetrationNearSearch);
-    if (!h.found) h = collider.closest(p, kPenetrationSearch);
-    if (!h.found || !(h.signedDistance < 0.f)) continue;
-    const double mm = -1000.0 * double(h.signedDistance);
+    const float depth = penetrationDepth(collider, garment.row(v).transpose());
+    if (!(depth > 0.f)) continue;
+    const double mm = 1000.0 * double(depth);
     ++s.inside;
     if (mm > kVisiblePenetrationMm) ++s.visible;
     s.deepestMm = std::max(s.deepestMm, mm);

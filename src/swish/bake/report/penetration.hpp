@@ -30,6 +30,10 @@ struct PenetrationStats {
 // in the same space. Thread-safe (const).
 PenetrationStats measurePenetration(const BodyCollider& collider, const Points3f& garment);
 
+// How deep (metres, > 0) a point lies inside the posed body; 0 outside it, beyond kPenetrationSearch or
+// not finite. What measurePenetration counts, per point. Thread-safe (const).
+float penetrationDepth(const BodyCollider& collider, const Vec3f& p);
+
 // Pools frames or poses: sums of counts, the deepest of all; `frames` counts the pooled measurements
 // and `framesVisible` those with at least one visible penetration.
 struct PenetrationPool {
