@@ -20,6 +20,19 @@ namespace {
 
 std::vector<Mat4f> identities(size_t joints) { return std::vector<Mat4f>(joints, Mat4f::Identity()); }
 
+// The capsule character's garment moved `up` along the axis (kept on the cylinder) and `off` from the
+// (analytic) skin: cloth slid over the body.
+Points3f slidOnCapsule(const Character& ch, const test::CapsuleSpec& spec, float up, float off) {
+  Points3f g = ch.garment.positions;
+  for (Eigen::Index v = 0; v < g.rows(); ++v) {
+    const Vec3f p = g.row(v).transpose();
+    const Vec3f radial = Vec3f(p.x(), 0.f, p.z()).normalized();
+    const float y = std::clamp(p.y() + up, spec.axisLow, spec.axisHigh);
+    g.row(v) = (radial * (spec.radius + off) + Vec3f(0.f, y, 0.f)).transpose();
+  }
+  return g;
+}
+
 float weightSum(const BodyAnchor& a) { return a.weights[0] + a.weights[1] + a.weights[2] + a.weights[3]; }
 
 TEST(Penetration, CountsAndDepthOnAnAnalyticBody) {
@@ -250,15 +263,7 @@ TEST(BodyAnchorFit, SlideAnchorsCoverTheSkinTheClothSlidOnto) {
   const test::CapsuleSpec spec;
   const Character ch = test::capsuleCharacter(spec);
   const std::vector<Mat4f> rest = identities(ch.skeleton.size());
-  auto onSkin = [&](float up, float off) {  // the garment moved `up`, `off` from the (analytic) skin
-    Points3f g = ch.garment.positions;
-    for (Eigen::Index v = 0; v < g.rows(); ++v) {
-      const Vec3f p = g.row(v).transpose();
-      const Vec3f radial = Vec3f(p.x(), 0.f, p.z()).normalized();
-      g.row(v) = (radial * (spec.radius + off) + Vec3f(0.f, std::min(p.y() + up, spec.axisHigh), 0.f)).transpose();
-    }
-    return g;
-  };
+  auto onSkin = [&](float up, float off) { return slidOnCapsule(ch, spec, up, off); };
   const Points3f slid = onSkin(0.1f, 0.004f), unslid = onSkin(0.f, 0.004f), away = onSkin(0.1f, 0.03f);
   const bake::BodyAnchorFit plain = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment);
   EXPECT_EQ(plain.slideAnchored, 0u);
@@ -311,16 +316,7 @@ TEST(BodyAnchorFit, CoverAnchorsHoldTheFrequentSlideTheSlideAnchorLeaves) {
   const test::CapsuleSpec spec;
   const Character ch = test::capsuleCharacter(spec);
   const std::vector<Mat4f> rest = identities(ch.skeleton.size());
-  auto onSkin = [&](float up, float off) {  // the garment moved `up`, `off` from the (analytic) skin
-    Points3f g = ch.garment.positions;
-    for (Eigen::Index v = 0; v < g.rows(); ++v) {
-      const Vec3f p = g.row(v).transpose();
-      const Vec3f radial = Vec3f(p.x(), 0.f, p.z()).normalized();
-      const float y = std::clamp(p.y() + up, spec.axisLow, spec.axisHigh);
-      g.row(v) = (radial * (spec.radius + off) + Vec3f(0.f, y, 0.f)).transpose();
-    }
-    return g;
-  };
+  auto onSkin = [&](float up, float off) { return slidOnCapsule(ch, spec, up, off); };
   const Points3f up = onSkin(0.1f, 0.004f), down = onSkin(-0.045f, 0.004f);
   const std::vector<bake::BodyAnchorSlidePose> poses = {{rest, &up}, {rest, &down}, {rest, &down}, {rest, &down}};
   const bake::BodyAnchorFit fit = bake::fitBodyAnchors(ch.body, ch.skeleton, ch.garment, {}, poses);
