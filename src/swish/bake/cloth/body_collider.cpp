@@ -263,6 +263,20 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
   // far above float rounding (kSlack), so a triangle at the bound is visited.
   constexpr float kSlack = 1e-4f;  // metres, and a relative 1e-4 on squared distances
   const float reachSq = (maxDistance + kSlack) * (maxDistance + kSlack);
+  // Each triangle is binned in every cell its box overlaps, so a query meets most of its near ones in
+  // several cells: the exact closest point is computed once per triangle and query (a later visit would
+  // compute the same answer, which the tie rule below keeps as it is). The marks are per thread (queries
+  // run in parallel on a const collider) and per query: a mark equal to this query's number is this
+  // query's own, whichever collider set it before.
+  thread_local std::vector<uint32_t> visited;
+  thread_local uint32_t queryNumber = 0;
+  if (visited.size() < size_t(triangles_.rows())) visited.resize(size_t(triangles_.rows()), 0);
+  if (++queryNumber == 0) {  // wrapped: no old mark may equal the numbers from here on
+    std::fill(visited.begin(), visited.end(), 0u);
+    queryNumber = 1;
+  }
+  const uint32_t query = queryNumber;
+  uint32_t* const mark = visited.data();
   // Squared distance from p to a slab of cells along one axis (0 inside it).
   auto slabSq = [&](int k, int i) {
     const float lo = gridOrigin_[k] + float(i) * cellSize_, hi = lo + cellSize_;
@@ -283,6 +297,8 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
       size_t slot = 0;
       while (slot < partCount && parts[slot].key != key) ++slot;
       if (slot < partCount && std::sqrt(centreSq) - s[3] > parts[slot].distance) continue;
+      if (mark[t] == query) continue;  // computed from another cell already
+      mark[t] = query;
       const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
                                                     positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
       const float d = (p - q.point).norm();
@@ -300,8 +316,8 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
         parts[partCount++] = {key, part, d, int(t), q};
         continue;
       }
-      // Ties (a triangle seen from two cells, or two triangles sharing the closest feature) keep
-      // the lowest triangle index, so the answer does not depend on the visiting order.
+      // Ties (two triangles sharing the closest feature) keep the lowest triangle index, so the answer
+      // does not depend on the visiting order.
       PartBest& pb = parts[slot];
       if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {key, part, d, int(t), q};
     }

@@ -478,7 +478,9 @@ TEST(ClothBodyCollider, GridQueriesAnswerAsIfEveryTriangleWereVisited) {
   // rejects triangles by bounds: none of that may change an answer. Against a collider of one cell
   // (every triangle visited, in index order), bit for bit, on the default mannequin with an arm
   // raised through its shoulder (overlapping parts) and its elbows bent, at the solver's contact reach,
-  // the band's anchor reach and the final projection's widest search.
+  // the band's anchor reach and the final projection's widest search. Each query computes a triangle's
+  // closest point once however many of its cells hold it (marks per thread and query): a third collider
+  // of another size, queried between them on the same thread, must not change either's answers.
   const Character ch = makeDefaultCharacter();
   Pose pose = ch.skeleton.restPose();
   auto turn = [&](const char* joint, float radians, const Vec3f& axis) {
@@ -495,9 +497,18 @@ TEST(ClothBodyCollider, GridQueriesAnswerAsIfEveryTriangleWereVisited) {
   whole.pose(m);
   const Vec3f lo = grid.positions().colwise().minCoeff().transpose().array() - 0.05f;
   const Vec3f hi = grid.positions().colwise().maxCoeff().transpose().array() + 0.05f;
+  const Character capsule = test::capsuleCharacter(test::CapsuleSpec{});
+  BodyCollider small(capsule.body, 0.02f, "capsule"), smallWhole(capsule.body, 100.f, "capsule");
+  small.pose(std::vector<Mat4f>(capsule.skeleton.size(), Mat4f::Identity()));
+  smallWhole.pose(std::vector<Mat4f>(capsule.skeleton.size(), Mat4f::Identity()));
   Rng rng(test::testSeed(59));
   size_t answered = 0, twoParts = 0;
   for (int i = 0; i < 3000; ++i) {
+    const Vec3f c(rng.uniformf(-0.15f, 0.15f), rng.uniformf(-0.1f, 0.8f), rng.uniformf(-0.15f, 0.15f));
+    const BodyCollider::Hit cs = small.closest(c, 0.05f), cw = smallWhole.closest(c, 0.05f);
+    ASSERT_EQ(cs.found, cw.found) << "capsule point " << c.transpose();
+    ASSERT_EQ(cs.triangle, cw.triangle) << "capsule point " << c.transpose();
+    EXPECT_EQ(cs.point, cw.point);
     // Half the points near the surface (where the solver asks), half anywhere in the body's box.
     Vec3f p(rng.uniformf(lo.x(), hi.x()), rng.uniformf(lo.y(), hi.y()), rng.uniformf(lo.z(), hi.z()));
     if (i % 2 == 0) {
