@@ -60,6 +60,28 @@ float percentile(std::vector<float> v, double q) {
   return v[i];
 }
 
+// The point `p` of the posed body's triangle t (posed corner positions `posed`) taken back to the rest body by
+// its barycentric coordinates.
+Vec3f restPointOf(const BodyCollider& rest, const Points3f& posed, int t, const Vec3f& p) {
+  const Triangles& tris = rest.triangles();
+  const Points3f& r = rest.positions();
+  const uint32_t c[3] = {tris(t, 0), tris(t, 1), tris(t, 2)};
+  const Vec3f bc =
+      barycentric(p, posed.row(c[0]).transpose(), posed.row(c[1]).transpose(), posed.row(c[2]).transpose());
+  return bc[0] * r.row(c[0]).transpose() + bc[1] * r.row(c[1]).transpose() + bc[2] * r.row(c[2]).transpose();
+}
+
+// The rest body's own answer at such a point of triangle t (its pseudo-normal, as the first anchors have), on
+// `part`, from just outside it along the triangle's face normal; not found for a degenerate triangle.
+BodyCollider::Hit restHitAt(const BodyCollider& rest, int t, const Vec3f& point, int part) {
+  const Triangles& tris = rest.triangles();
+  const Points3f& r = rest.positions();
+  const Vec3f a = r.row(tris(t, 0)).transpose(), b = r.row(tris(t, 1)).transpose(), c = r.row(tris(t, 2)).transpose();
+  const Vec3f fn = (b - a).cross(c - a);
+  if (!(fn.norm() > 0.f)) return {};
+  return rest.closest(point + 0.001f * fn.normalized(), 0.01f, part);
+}
+
 // The slide anchors (BodyAnchorFitSettings::slideMinGap): per vertex with a first anchor and no second,
 // over the poses (evenly spread, at most slidePoses) where the garment vertex lies within slideContact
 // of its first anchor's part of the POSED body, how far that body's closest point lies outside the
@@ -76,8 +98,6 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
   std::vector<Vec3f> worstPoint(n, Vec3f::Zero());
   std::vector<int> worstTriangle(n, -1);
   BodyCollider posed = rest;
-  const Triangles& tris = rest.triangles();
-  const Points3f& restPos = rest.positions();
   const size_t step =
       std::max<size_t>(1, (poses.size() + std::max<size_t>(1, s.slidePoses) - 1) / std::max<size_t>(1, s.slidePoses));
   for (size_t p = 0; p < poses.size(); p += step) {
@@ -97,13 +117,8 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
         const BodyAnchor& first = fit.anchors.anchors[v];
         const float gap = (h.point - runtime::skinAnchorCentre(first, poses[p].skinMatrices)).norm() - first.radius;
         if (!(gap > worstGap[v])) continue;
-        const uint32_t c[3] = {tris(h.triangle, 0), tris(h.triangle, 1), tris(h.triangle, 2)};
-        const Vec3f bc =
-            barycentric(h.point, pos.row(c[0]).transpose(), pos.row(c[1]).transpose(), pos.row(c[2]).transpose());
-        const Vec3f r = bc[0] * restPos.row(c[0]).transpose() + bc[1] * restPos.row(c[1]).transpose() +
-                        bc[2] * restPos.row(c[2]).transpose();
         worstGap[v] = gap;
-        worstPoint[v] = r;
+        worstPoint[v] = restPointOf(rest, pos, h.triangle, h.point);
         worstTriangle[v] = h.triangle;
       }
     });
@@ -111,14 +126,7 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
   std::vector<float> slides, gaps;
   for (size_t v = 0; v < n; ++v) {
     if (worstTriangle[v] < 0 || worstGap[v] < s.slideMinGap) continue;
-    // The rest body's own answer at that point (its pseudo-normal, as the first anchors have), from
-    // just outside it along the triangle's face normal.
-    const int t = worstTriangle[v];
-    const Vec3f a = restPos.row(tris(t, 0)).transpose(), b = restPos.row(tris(t, 1)).transpose(),
-                c = restPos.row(tris(t, 2)).transpose();
-    const Vec3f fn = (b - a).cross(c - a);
-    if (!(fn.norm() > 0.f)) continue;
-    const BodyCollider::Hit h = rest.closest(worstPoint[v] + 0.001f * fn.normalized(), 0.01f, firstPart[v]);
+    const BodyCollider::Hit h = restHitAt(rest, worstTriangle[v], worstPoint[v], firstPart[v]);
     if (!h.found || h.triangle < 0) continue;
     bool flipped = false;
     const BodyAnchor anchor = anchorAt(h, flipped);
@@ -153,8 +161,6 @@ void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
   };
   std::vector<std::vector<Miss>> misses(n);
   BodyCollider posed = rest;
-  const Triangles& tris = rest.triangles();
-  const Points3f& restPos = rest.positions();
   auto distanceOff = [](const BodyAnchor& a, const Vec3f& skin, std::span<const Mat4f> mats) {
     return (skin - runtime::skinAnchorCentre(a, mats)).norm() - a.radius;
   };
@@ -175,12 +181,7 @@ void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
         if (!fit.anchors.second.empty() && fit.anchors.second[v].present())
           gap = std::min(gap, distanceOff(fit.anchors.second[v], h.point, poses[p].skinMatrices));
         if (!(gap >= s.slideMinGap)) continue;
-        const uint32_t c[3] = {tris(h.triangle, 0), tris(h.triangle, 1), tris(h.triangle, 2)};
-        const Vec3f bc =
-            barycentric(h.point, pos.row(c[0]).transpose(), pos.row(c[1]).transpose(), pos.row(c[2]).transpose());
-        const Vec3f r = bc[0] * restPos.row(c[0]).transpose() + bc[1] * restPos.row(c[1]).transpose() +
-                        bc[2] * restPos.row(c[2]).transpose();
-        misses[v].push_back({p, h.point, r, h.triangle, gap});
+        misses[v].push_back({p, h.point, restPointOf(rest, pos, h.triangle, h.point), h.triangle, gap});
       }
     });
   }
@@ -206,14 +207,7 @@ void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
       size_t bestCovered = 0;
       BodyAnchor chosen;
       for (const size_t i : candidates) {
-        // The rest body's own answer at that point, from just outside it along the triangle's face normal
-        // (as the slide anchors).
-        const int t = m[i].triangle;
-        const Vec3f a = restPos.row(tris(t, 0)).transpose(), b = restPos.row(tris(t, 1)).transpose(),
-                    c = restPos.row(tris(t, 2)).transpose();
-        const Vec3f fn = (b - a).cross(c - a);
-        if (!(fn.norm() > 0.f)) continue;
-        const BodyCollider::Hit h = rest.closest(m[i].rest + 0.001f * fn.normalized(), 0.01f, firstPart[v]);
+        const BodyCollider::Hit h = restHitAt(rest, m[i].triangle, m[i].rest, firstPart[v]);
         if (!h.found || h.triangle < 0) continue;
         bool flipped = false;
         const BodyAnchor candidate = anchorAt(h, flipped);
