@@ -317,7 +317,8 @@ TEST(BakePart2, NetworkInputJointsReplaceTheDatasets) {
 }
 
 // train.anchor_margin_mm: uncalibrated anchors keep the recipe's margin, which the model carries through
-// its file (the run-time push-out reads it per anchor as the clearance) and its metadata records.
+// its file (the run-time push-out reads it per anchor as the clearance) and its metadata records; with
+// train.cover_anchors the third set is fitted on the training poses too, at the same margin.
 TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
   const uint64_t seed = test::testSeed(504);
   SCOPED_TRACE("seed " + std::to_string(seed));
@@ -327,6 +328,7 @@ TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
   st.mlp.maxEpochs = 20;
   st.calibrateAnchors = false;
   st.anchorMargin = 0.006f;
+  st.coverAnchors = true;
   const BakeTrainOutput out = trainBake(ds, st);
   const test::TempDir tmp("bake_part2_margin_" + std::to_string(seed));
   saveModel(out.model, tmp / "m.swish");
@@ -341,6 +343,16 @@ TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
   const auto meta = nlohmann::json::parse(loaded.metadata);
   EXPECT_EQ(meta["settings"]["anchor_margin_mm"].get<double>(), 6.0);
   EXPECT_EQ(meta["body_anchors"]["margin_mm"].get<double>(), 6.0);
+  EXPECT_EQ(meta["settings"]["cover_anchors"], true);
+  EXPECT_GT(loaded.bodyAnchors.anchored(2), 0u) << "the synthetic poses slide the cloth over the body";
+  EXPECT_EQ(loaded.bodyAnchors.anchored(2), meta["body_anchors"]["cover_anchored"].get<size_t>());
+  EXPECT_LE(meta["body_anchors"]["cover_covered"].get<size_t>(), meta["body_anchors"]["cover_misses"].get<size_t>());
+  for (const BodyAnchor& a : loaded.bodyAnchors.third)
+    if (a.present()) {
+      ASSERT_FLOAT_EQ(a.clearance, 0.006f);
+    }
+  std::printf("cover anchors: %zu of %zu vertices (%zu misses)\n", loaded.bodyAnchors.anchored(2),
+              loaded.gameMesh.vertexCount(), meta["body_anchors"]["cover_misses"].get<size_t>());
 }
 
 // train.root_gravity: a shape that follows the root's lean, which no input joint's local rotation holds,
