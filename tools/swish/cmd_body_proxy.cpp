@@ -238,7 +238,11 @@ swish::cli::CommandRegistration reg{
                      "calibrate on the source simulation of frames of these clips, and take from it where the cloth "
                      "slides over the body (the slide anchors: without --clips there are none) (files or folders of "
                      "BVH/FBX/glTF on the model's skeleton; ideally motion like the model's training clips)");
-      app.add_option("--poses", o->poses, "frames simulated for the calibration, spread over the clips (default 48)")
+      app.add_option(
+             "--poses", o->poses,
+             "frames simulated for the calibration and the slide and cover anchors, spread over the clips "
+             "(default 48, about 2.5 s of CPU each; more frames cover more of the motion: the committed default "
+             "model's anchors were fitted on 400)")
           ->check(CLI::Range(size_t(1), size_t(100000)));
       app.add_option("--tolerance-mm", o->toleranceMm,
                      "with --clips: mean distance to the simulation per pose that pushing a vertex may add (default "
