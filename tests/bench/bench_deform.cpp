@@ -464,6 +464,62 @@ void BM_DeformLevels(benchmark::State& state) {
 }
 BENCHMARK(BM_DeformLevels)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
+// The committed default model's own push-out (its anchor sets, as the scene runs them), arg: instances. The
+// deform pass at full K with and without it, alternating as in BM_DeformPushOut; `pushout_share` its extra
+// time over the plain pass.
+void BM_DeformPushOutDefaultModel(benchmark::State& state) {
+  gpu::Context* ctx = benchContext();
+  if (!ctx) return state.SkipWithError("no Vulkan device");
+  if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
+  const DefaultModel* dm = defaultModel(*ctx);
+  if (!dm) return state.SkipWithError("no committed default model");
+  const gpu::GpuModel& g = *dm->gpu;
+  if (!g.hasBodyAnchors()) return state.SkipWithError("the default model has no body anchors");
+  const uint32_t instances = uint32_t(state.range(0)), k = g.kernelMeshComponents();
+  Rng rng(23);
+  std::vector<float> w(size_t(instances) * k);
+  for (auto& x : w) x = float(rng.normal());
+  std::vector<float> rows(gpu::DeformPass::weightsBytes(instances, k) / 4);
+  gpu::DeformPass::packWeights(w.data(), instances, k, rows.data());
+  gpu::Buffer weights(*ctx, rows.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
+  weights.upload(*ctx, rows.data(), rows.size() * 4);
+  std::vector<Mat4f> mats;
+  for (uint32_t i = 0; i < instances; ++i) {
+    const auto m = dm->model.skeleton.skinningMatrices(test::makeRandomPose(rng, dm->model.skeleton, 0.3f));
+    mats.insert(mats.end(), m.begin(), m.end());
+  }
+  std::vector<float> matrixRows(mats.size() * 12);
+  gpu::DeformPass::packSkinMatrices(mats.data(), mats.size(), matrixRows.data());
+  gpu::Buffer matrices(*ctx, matrixRows.size() * 4, gpu::MemoryKind::DeviceLocal, "matrices");
+  matrices.upload(*ctx, matrixRows.data(), matrixRows.size() * 4);
+  gpu::Buffer positions(*ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal,
+                        "positions");
+  const gpu::DeformPass pass(*ctx, k, g.influences(), true, g.basis.size() / sizeof(float));
+  const gpu::DescriptorBinding inputs = pass.bindInstanceInputs(*ctx, weights, matrices, &g.basis);
+  const gpu::DeformPass::Args a = g.deformArgs(inputs.get(), positions, instances);
+  gpu::DeformPass::Args pushed = a;
+  pushed.anchors = g.anchors.address();
+  pushed.anchorSlots = g.anchorSlots();
+  gpu::TimestampQueries ts(*ctx, 2);
+  const auto withPush = [&](VkCommandBuffer cmd) { pass.record(cmd, pushed); };
+  const auto plain = [&](VkCommandBuffer cmd) { pass.record(cmd, a); };
+  gpuSeconds(*ctx, ts, withPush);  // warm-up
+  const uint32_t reps = repsFor(*ctx, ts, plain);
+  double with = 0, without = 0;
+  for (auto _ : state) {
+    const double t = gpuSeconds(*ctx, ts, withPush, reps);
+    without += gpuSeconds(*ctx, ts, plain, reps);
+    state.SetIterationTime(t);
+    with += t;
+  }
+  const double passes = double(state.iterations()) * reps;
+  state.counters["pass_us"] = 1e6 * with / passes;
+  state.counters["plain_us"] = 1e6 * without / passes;
+  state.counters["pushout_share"] = (with - without) / without;
+  state.counters["anchor_sets"] = g.anchorSlots();
+}
+BENCHMARK(BM_DeformPushOutDefaultModel)->Arg(22)->Arg(1)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+
 // Whole frames (FrameRecorder: deform, normals + tangents, VQ decode, blend; two frames in flight) of
 // 22 characters of the default model, one recorder per configuration (levelConfigs), a frame of each in
 // turn per iteration, from GPU timestamps. Every character with maps selects a random database map
