@@ -83,6 +83,8 @@ int main(int argc, char** argv) {
     shapes.push_back({"body_anchors", s});
     s.secondAnchors = true;
     shapes.push_back({"second_anchors", s});
+    s.thirdAnchors = true;
+    shapes.push_back({"third_anchors", s});
     s = small();
     s.noveltyCentres = 3;
     shapes.push_back({"novelty_guard", s});
