@@ -376,7 +376,8 @@ uint64_t DatasetPosePlan::fingerprint() const {
   return f.h;
 }
 
-DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::function<void(const std::string&)>& logFn) {
+DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::function<void(const std::string&)>& logFn,
+                                 const std::function<std::vector<uint32_t>(size_t)>& clearOnly) {
   auto log = [&](const std::string& line) {
     if (logFn) logFn(line);
   };
@@ -527,8 +528,20 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
     t = Clock::now();
     const LimbClearance& clearance = *shapes.clearance();
     std::vector<std::vector<LimbCorrection>> corrections(poses.size());
-    tbb::parallel_for(size_t(0), poses.size(),
-                      [&](size_t i) { poses[i] = shapes.poseToSimulate(recorded[i], &corrections[i]); });
+    std::vector<uint32_t> cleared;
+    if (clearOnly) {
+      cleared = clearOnly(poses.size());
+      for (const uint32_t i : cleared)
+        if (i >= poses.size())
+          throw Error("bake part 1: pose " + std::to_string(i) + " to clear of " + std::to_string(poses.size()));
+    } else {
+      cleared.resize(poses.size());
+      for (uint32_t i = 0; i < cleared.size(); ++i) cleared[i] = i;
+    }
+    tbb::parallel_for(size_t(0), cleared.size(), [&](size_t k) {
+      const uint32_t i = cleared[k];
+      poses[i] = shapes.poseToSimulate(recorded[i], &corrections[i]);
+    });
     size_t stillInside = 0, neckPoses = 0;
     double neckMean = 0.0, neckMax = 0.0;
     for (const auto& c : corrections) {
@@ -564,7 +577,7 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
           "part 1: limb clearance %.0f mm: %zu of %zu poses had a limb in the trunk where the garment is (%zu "
           "limbs of the body checked%s, %zu of the trunk's %zu triangles within %.0f mm of the garment); "
           "turned out by up to %.0f degrees, %zu limbs still inside, in %.2f s",
-          1000.0 * s.limbClearance.clearance, res.posesCorrected, poses.size(), clearance.limbCount(),
+          1000.0 * s.limbClearance.clearance, res.posesCorrected, cleared.size(), clearance.limbCount(),
           clearance.limbsAreRegions() ? ": skin regions of a body that is one surface" : "",
           clearance.guardedTriangles(), clearance.trunkTriangles(), 1000.0 * s.limbClearance.garmentReach,
           double(res.maxCorrectionDegrees), stillInside, since(t));
@@ -595,7 +608,7 @@ DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& s, const std::funct
                     "part 1: head clearance (one-surface body, %zu head vertices checked): %zu of %zu poses had the "
                     "head inside the body; neck turned back towards rest by up to %.0f %% (%.0f degrees), %zu still "
                     "inside, in %.2f s",
-                    clearance.headVertexCount(), headPoses, poses.size(), 100.0 * res.maxTowardsRest,
+                    clearance.headVertexCount(), headPoses, cleared.size(), 100.0 * res.maxTowardsRest,
                     double(headDegrees), headInside, since(t));
       log(line);
       for (size_t i = 0; i < corrections.size(); ++i)
@@ -965,12 +978,16 @@ nlohmann::json checkSimulation(const DatasetBuildSettings& s, size_t poseCount, 
   const auto start = Clock::now();
   if (s.external.enabled())
     throw Error("simulation check: part1.simulation.source is \"external\": there is no solver to check");
-  const DatasetPosePlan plan = planDatasetPoses(s, log);
+  // The sample depends on the pose count only: limb clearance runs on the sampled poses alone.
+  auto sample = [&](size_t count) {
+    std::vector<uint32_t> every(count);
+    for (uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+    return sampleQualityPoses(every, poseCount, seed);
+  };
+  const DatasetPosePlan plan = planDatasetPoses(s, log, sample);
   const Character& character = *plan.character;
-  const std::vector<Pose>& poses = plan.toSimulate;  // limbs already out of the trunk, as the bake simulates
-  std::vector<uint32_t> every(poses.size());
-  for (uint32_t i = 0; i < every.size(); ++i) every[i] = i;
-  const std::vector<uint32_t> ids = sampleQualityPoses(every, poseCount, seed);
+  const std::vector<Pose>& poses = plan.toSimulate;  // the sample's limbs out of the trunk, as the bake simulates
+  const std::vector<uint32_t> ids = sample(poses.size());
   const ClothSolver& solver = plan.shapes->solver();
   log("simulation check: " + std::to_string(ids.size()) + " of the " + std::to_string(poses.size()) +
       " thinned poses (seed " + std::to_string(seed) + "), " + std::to_string(solver.mesh().vertexCount()) +

@@ -220,9 +220,12 @@ struct DatasetPosePlan {
   uint64_t fingerprint() const;
 };
 
-// Throws Error as buildDataset does for bad input, before any simulation.
+// Throws Error as buildDataset does for bad input, before any simulation. `clearOnly` (optional), given the
+// thinned pose count, names the poses that limb clearance is run on (the others are simulated as recorded):
+// for a tool that simulates a sample of them only (checkSimulation); a bake clears every pose.
 DatasetPosePlan planDatasetPoses(const DatasetBuildSettings& settings,
-                                 const std::function<void(const std::string&)>& log = {});
+                                 const std::function<void(const std::string&)>& log = {},
+                                 const std::function<std::vector<uint32_t>(size_t)>& clearOnly = {});
 
 // The poses part 1 simulates, before any simulation: the character, its clips sampled and thinned,
 // the rest pose added, limb clearance applied. `swish bake --export-poses` writes these out for an
