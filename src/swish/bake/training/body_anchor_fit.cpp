@@ -82,92 +82,37 @@ BodyCollider::Hit restHitAt(const BodyCollider& rest, int t, const Vec3f& point,
   return rest.closest(point + 0.001f * fn.normalized(), 0.01f, part);
 }
 
-// The slide anchors (BodyAnchorFitSettings::slideMinGap): per vertex with a first anchor and no second,
-// over the poses (evenly spread, at most slidePoses) where the garment vertex lies within slideContact
-// of its first anchor's part of the POSED body, how far that body's closest point lies outside the
-// first anchor's posed ball (the skin the ball misses under the cloth). The pose where that gap is
-// largest gives the second anchor: its closest point taken back to the rest body by its triangle's
-// barycentric coordinates, when the gap is slideMinGap or more. Poses in order and the strict "larger"
-// keep it deterministic.
-template <class AnchorAt>
-void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
-                     const std::vector<BodyAnchorSlidePose>& poses, const BodyAnchorFitSettings& s,
-                     const AnchorAt& anchorAt) {
+// Where the first balls miss the skin under the cloth, found once for the slide and the cover anchors:
+// over the poses (evenly spread, at most slidePoses), per vertex with a first anchor whose garment vertex
+// lies within slideContact of its first anchor's part of the POSED body, that body's closest point (the
+// skin under the cloth) when it lies slideMinGap or more outside the first anchor's posed ball, with the
+// same point on the rest body (by its triangle's barycentric coordinates) and that gap. Each vertex writes
+// its own entries only, in pose order: the same answer on any thread count.
+struct SkinMiss {
+  size_t pose;
+  Vec3f skin;  // posed
+  Vec3f rest;  // the same point on the rest body
+  int triangle;
+  float gap;  // metres outside the ball(s)
+};
+
+// How far `skin` lies outside the anchor's ball in the pose of `mats` (its skinned centre).
+float distanceOff(const BodyAnchor& a, const Vec3f& skin, std::span<const Mat4f> mats) {
+  return (skin - runtime::skinAnchorCentre(a, mats)).norm() - a.radius;
+}
+
+std::vector<std::vector<SkinMiss>> firstBallMisses(BodyAnchorFit& fit, const BodyCollider& rest,
+                                                   const std::vector<int>& firstPart,
+                                                   const std::vector<BodyAnchorSlidePose>& poses,
+                                                   const BodyAnchorFitSettings& s) {
   const size_t n = firstPart.size();
-  std::vector<float> worstGap(n, 0.f);
-  std::vector<Vec3f> worstPoint(n, Vec3f::Zero());
-  std::vector<int> worstTriangle(n, -1);
+  std::vector<std::vector<SkinMiss>> misses(n);
   BodyCollider posed = rest;
   const size_t step =
       std::max<size_t>(1, (poses.size() + std::max<size_t>(1, s.slidePoses) - 1) / std::max<size_t>(1, s.slidePoses));
   for (size_t p = 0; p < poses.size(); p += step) {
     posed.pose(poses[p].skinMatrices);
     ++fit.slidePoses;
-    const Points3f& g = *poses[p].garment;
-    const Points3f& pos = posed.positions();
-    // Each vertex writes its own entries only: the same answer on any thread count.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t v = range.begin(); v < range.end(); ++v) {
-        if (firstPart[v] < 0 || fit.anchors.second[v].present()) continue;
-        const Vec3f x = g.row(Eigen::Index(v)).transpose();
-        if (!x.allFinite()) continue;
-        const BodyCollider::Hit h = posed.closest(x, s.slideContact, firstPart[v]);
-        if (!h.found || h.triangle < 0) continue;
-        // How far under the skin the cloth lies on the first ball's surface there (its skinned centre).
-        const BodyAnchor& first = fit.anchors.anchors[v];
-        const float gap = (h.point - runtime::skinAnchorCentre(first, poses[p].skinMatrices)).norm() - first.radius;
-        if (!(gap > worstGap[v])) continue;
-        worstGap[v] = gap;
-        worstPoint[v] = restPointOf(rest, pos, h.triangle, h.point);
-        worstTriangle[v] = h.triangle;
-      }
-    });
-  }
-  std::vector<float> slides, gaps;
-  for (size_t v = 0; v < n; ++v) {
-    if (worstTriangle[v] < 0 || worstGap[v] < s.slideMinGap) continue;
-    const BodyCollider::Hit h = restHitAt(rest, worstTriangle[v], worstPoint[v], firstPart[v]);
-    if (!h.found || h.triangle < 0) continue;
-    bool flipped = false;
-    const BodyAnchor anchor = anchorAt(h, flipped);
-    if (!anchor.present()) continue;
-    fit.anchors.second[v] = anchor;
-    ++fit.secondAnchored;
-    ++fit.slideAnchored;
-    slides.push_back(1000.f * (worstPoint[v] - fit.anchors.anchors[v].position).norm());
-    gaps.push_back(1000.f * worstGap[v]);
-  }
-  fit.slideMedianMm = percentile(slides, 0.5);
-  fit.slideMaxMm = slides.empty() ? 0.f : *std::max_element(slides.begin(), slides.end());
-  fit.slideGapMedianMm = percentile(gaps, 0.5);
-}
-
-// The cover anchors (BodyAnchorFitSettings::coverAnchors): per vertex with a first anchor, the poses' misses
-// (the posed skin under the cloth that both sets so far leave slideMinGap or more outside their balls), then
-// of up to coverCandidates balls under those misses, the one covering the largest summed gap. Each vertex
-// writes its own entries only; poses in order, candidates in ascending miss order and the strict "larger"
-// keep it deterministic.
-template <class AnchorAt>
-void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
-                     const std::vector<BodyAnchorSlidePose>& poses, const BodyAnchorFitSettings& s,
-                     const AnchorAt& anchorAt) {
-  const size_t n = firstPart.size();
-  struct Miss {
-    size_t pose;
-    Vec3f skin;  // posed
-    Vec3f rest;  // the same point on the rest body
-    int triangle;
-    float gap;
-  };
-  std::vector<std::vector<Miss>> misses(n);
-  BodyCollider posed = rest;
-  auto distanceOff = [](const BodyAnchor& a, const Vec3f& skin, std::span<const Mat4f> mats) {
-    return (skin - runtime::skinAnchorCentre(a, mats)).norm() - a.radius;
-  };
-  const size_t step =
-      std::max<size_t>(1, (poses.size() + std::max<size_t>(1, s.slidePoses) - 1) / std::max<size_t>(1, s.slidePoses));
-  for (size_t p = 0; p < poses.size(); p += step) {
-    posed.pose(poses[p].skinMatrices);
     const Points3f& g = *poses[p].garment;
     const Points3f& pos = posed.positions();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
@@ -177,21 +122,68 @@ void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
         if (!x.allFinite()) continue;
         const BodyCollider::Hit h = posed.closest(x, s.slideContact, firstPart[v]);
         if (!h.found || h.triangle < 0) continue;
-        float gap = distanceOff(fit.anchors.anchors[v], h.point, poses[p].skinMatrices);
-        if (!fit.anchors.second.empty() && fit.anchors.second[v].present())
-          gap = std::min(gap, distanceOff(fit.anchors.second[v], h.point, poses[p].skinMatrices));
+        const float gap = distanceOff(fit.anchors.anchors[v], h.point, poses[p].skinMatrices);
         if (!(gap >= s.slideMinGap)) continue;
         misses[v].push_back({p, h.point, restPointOf(rest, pos, h.triangle, h.point), h.triangle, gap});
       }
     });
   }
+  return misses;
+}
+
+// The slide anchors (BodyAnchorFitSettings::slideMinGap): per vertex with a first anchor and no second, the
+// first ball's largest miss (the first pose of it: the strict "larger", poses in order) gives the second
+// anchor, the rest body's ball at that point.
+template <class AnchorAt>
+void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
+                     const std::vector<std::vector<SkinMiss>>& misses, const AnchorAt& anchorAt) {
+  std::vector<float> slides, gaps;
+  for (size_t v = 0; v < firstPart.size(); ++v) {
+    if (firstPart[v] < 0 || fit.anchors.second[v].present()) continue;
+    const SkinMiss* worst = nullptr;
+    for (const SkinMiss& m : misses[v])
+      if (m.gap > (worst ? worst->gap : 0.f)) worst = &m;
+    if (!worst) continue;
+    const BodyCollider::Hit h = restHitAt(rest, worst->triangle, worst->rest, firstPart[v]);
+    if (!h.found || h.triangle < 0) continue;
+    bool flipped = false;
+    const BodyAnchor anchor = anchorAt(h, flipped);
+    if (!anchor.present()) continue;
+    fit.anchors.second[v] = anchor;
+    ++fit.secondAnchored;
+    ++fit.slideAnchored;
+    slides.push_back(1000.f * (worst->rest - fit.anchors.anchors[v].position).norm());
+    gaps.push_back(1000.f * worst->gap);
+  }
+  fit.slideMedianMm = percentile(slides, 0.5);
+  fit.slideMaxMm = slides.empty() ? 0.f : *std::max_element(slides.begin(), slides.end());
+  fit.slideGapMedianMm = percentile(gaps, 0.5);
+}
+
+// The cover anchors (BodyAnchorFitSettings::coverAnchors): per vertex, the first ball's misses that the
+// second ball (where there is one) misses too, by slideMinGap or more (the gap then the smaller of the two);
+// of up to coverCandidates balls under those misses, the one covering the largest summed gap. Each vertex
+// writes its own entries only; candidates in ascending miss order and the strict "larger" keep it
+// deterministic.
+template <class AnchorAt>
+void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
+                     const std::vector<BodyAnchorSlidePose>& poses, const std::vector<std::vector<SkinMiss>>& first,
+                     const BodyAnchorFitSettings& s, const AnchorAt& anchorAt) {
+  const size_t n = firstPart.size();
   fit.anchors.third.assign(n, BodyAnchor{});
-  std::vector<size_t> covered(n, 0);
+  std::vector<size_t> missed(n, 0), covered(n, 0);
   const size_t most = std::max<size_t>(1, s.coverCandidates);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<SkinMiss> m;
     std::vector<size_t> candidates;
     for (size_t v = range.begin(); v < range.end(); ++v) {
-      const std::vector<Miss>& m = misses[v];
+      m.clear();
+      const BodyAnchor* second = fit.anchors.second[v].present() ? &fit.anchors.second[v] : nullptr;
+      for (SkinMiss q : first[v]) {
+        if (second) q.gap = std::min(q.gap, distanceOff(*second, q.skin, poses[q.pose].skinMatrices));
+        if (q.gap >= s.slideMinGap) m.push_back(q);
+      }
+      missed[v] = m.size();
       if (m.empty()) continue;
       // The largest miss, and misses spread evenly over the poses.
       candidates.clear();
@@ -214,7 +206,7 @@ void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
         if (!candidate.present()) continue;
         double weight = 0;
         size_t count = 0;
-        for (const Miss& q : m)
+        for (const SkinMiss& q : m)
           if (distanceOff(candidate, q.skin, poses[q.pose].skinMatrices) <= s.coverReach)
             weight += double(q.gap), ++count;
         if (weight > best) best = weight, bestCovered = count, chosen = candidate;
@@ -225,7 +217,7 @@ void fitCoverAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
     }
   });
   for (size_t v = 0; v < n; ++v) {
-    fit.coverMisses += misses[v].size();
+    fit.coverMisses += missed[v];
     fit.coverCovered += covered[v];
     fit.coverAnchored += fit.anchors.third[v].present() ? 1 : 0;
   }
@@ -346,9 +338,11 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     fit.anchors.second[v] = b;
     ++fit.secondAnchored;
   }
-  if (s.secondAnchors && !poses.empty()) fitSlideAnchors(fit, collider, firstPart, poses, s, anchorAt);
-  if (s.secondAnchors && s.coverAnchors && !poses.empty())
-    fitCoverAnchors(fit, collider, firstPart, poses, s, anchorAt);
+  if (s.secondAnchors && !poses.empty()) {
+    const std::vector<std::vector<SkinMiss>> misses = firstBallMisses(fit, collider, firstPart, poses, s);
+    fitSlideAnchors(fit, collider, firstPart, misses, anchorAt);
+    if (s.coverAnchors) fitCoverAnchors(fit, collider, firstPart, poses, misses, s, anchorAt);
+  }
   // A model without them, not N empty ones (a third set needs a second one before it, empty or not).
   if (fit.coverAnchored == 0) fit.anchors.third.clear();
   if (fit.secondAnchored == 0 && fit.coverAnchored == 0) fit.anchors.second.clear();
