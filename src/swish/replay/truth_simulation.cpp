@@ -172,6 +172,8 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     note_ = std::string("the source simulation cannot be set up: ") + e.what();
     return;
   }
+  if (character_->body.triangleCount() > 0)
+    body_ = std::make_unique<const bake::BodyCollider>(character_->body, 0.05f, "truth body");
   std::string mapNote;
   normalMaps_ = options.normalMaps && !entry.model.normalMaps.empty();
   if (normalMaps_ && (ps.transfer.normalMap.width != entry.model.normalMaps.width ||
@@ -243,8 +245,8 @@ TruthMeasurement ModelTruth::measure(const Pose& pose, const Points3f& positions
       m.summary.comparedWithout = true;
       m.summary.meanMmWithout = w.mean, m.summary.p95MmWithout = w.p95, m.summary.maxMmWithout = w.max;
       // Where the truth itself lies inside the body (the bake's body, posed as the run time posed it).
-      if (character_ && character_->body.triangleCount() > 0) {
-        bake::BodyCollider body(character_->body, 0.05f, "truth body");
+      if (body_) {
+        bake::BodyCollider body = *body_;
         body.pose(model_->skeleton.skinningMatrices(pose));
         m.truthInside.resize(size_t(truth.rows()));
         for (Eigen::Index v = 0; v < truth.rows(); ++v)

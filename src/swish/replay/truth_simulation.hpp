@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/compression/normal_map_metrics.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/replay/model_library.hpp"
@@ -136,6 +137,8 @@ class ModelTruth {
   bool normalMaps_ = false;
   std::unique_ptr<Character> character_;
   std::unique_ptr<bake::PoseShapeSimulator> simulator_;
+  // The character's body at rest, built once; each measurement poses a copy (where the truth lies inside it).
+  std::unique_ptr<const bake::BodyCollider> body_;
 };
 
 // The character a model was baked on, rebuilt as its bake built it (the embedded default by code, a
