@@ -182,6 +182,34 @@ BENCHMARK(BM_Deform)
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(0.5);
 
+// Times `pass` with `plain` (no push-out) and with the model's push-out added, alternating each iteration
+// so that drift of a shared machine hits both alike. Time: the region with the push-out; counters
+// `pass_us` and `plain_us` one pass each, `pushout_share` the extra time over the plain pass.
+void timePushOut(benchmark::State& state, gpu::Context& ctx, const gpu::DeformPass& pass, const gpu::GpuModel& model,
+                 const gpu::DeformPass::Args& plainArgs) {
+  gpu::DeformPass::Args pushed = plainArgs;
+  pushed.anchors = model.anchors.address();
+  pushed.anchorSlots = model.anchorSlots();
+  gpu::TimestampQueries ts(ctx, 2);
+  const auto withPush = [&](VkCommandBuffer cmd) { pass.record(cmd, pushed); };
+  const auto plain = [&](VkCommandBuffer cmd) { pass.record(cmd, plainArgs); };
+  gpuSeconds(ctx, ts, withPush);  // warm-up
+  const uint32_t reps = repsFor(ctx, ts, plain);
+  double with = 0, without = 0;
+  for (auto _ : state) {
+    const double t = gpuSeconds(ctx, ts, withPush, reps);
+    without += gpuSeconds(ctx, ts, plain, reps);
+    state.SetIterationTime(t);
+    with += t;
+  }
+  const double passes = double(state.iterations()) * reps;
+  state.counters["pass_us"] = 1e6 * with / passes;
+  state.counters["plain_us"] = 1e6 * without / passes;
+  state.counters["pushout_share"] = (with - without) / without;
+  state.counters["reps"] = reps;
+  state.counters["anchor_sets"] = model.anchorSlots();
+}
+
 // The deform pass with and without its push-out step: args instances, K, anchor sets (1: BodyAnchors::
 // anchors, 2: and BodyAnchors::second, 3: and BodyAnchors::third; the random model leaves every 7th vertex
 // without a first anchor, every 5th without a second, every 3rd without a third). Each iteration times both
@@ -193,27 +221,8 @@ void BM_DeformPushOut(benchmark::State& state) {
   if (!ctx->supportsTimestamps()) return state.SkipWithError("device has no timestamps");
   const uint32_t instances = uint32_t(state.range(0)), k = uint32_t(state.range(1));
   DeformSetup s = makeSetup(*ctx, instances, true, k, uint32_t(state.range(2)));
-  gpu::TimestampQueries ts(*ctx, 2);
-  gpu::DeformPass::Args a = s.gpuModel->deformArgs(s.instanceInputs.get(), s.positions, instances);
-  gpu::DeformPass::Args pushed = a;
-  pushed.anchors = s.gpuModel->anchors.address();
-  pushed.anchorSlots = s.gpuModel->anchorSlots();
-  const auto withPush = [&](VkCommandBuffer cmd) { s.pass->record(cmd, pushed); };
-  const auto plain = [&](VkCommandBuffer cmd) { s.pass->record(cmd, a); };
-  gpuSeconds(*ctx, ts, withPush);  // warm-up
-  const uint32_t reps = repsFor(*ctx, ts, plain);
-  double with = 0, without = 0;
-  for (auto _ : state) {
-    const double t = gpuSeconds(*ctx, ts, withPush, reps);
-    without += gpuSeconds(*ctx, ts, plain, reps);
-    state.SetIterationTime(t);
-    with += t;
-  }
-  const double passes = double(state.iterations()) * reps;
-  state.counters["pass_us"] = 1e6 * with / passes;
-  state.counters["plain_us"] = 1e6 * without / passes;
-  state.counters["pushout_share"] = (with - without) / without;
-  state.counters["reps"] = reps;
+  timePushOut(state, *ctx, *s.pass, *s.gpuModel,
+              s.gpuModel->deformArgs(s.instanceInputs.get(), s.positions, instances));
 }
 // Args: instances, K, anchor sets. K = 128 is the default model's.
 BENCHMARK(BM_DeformPushOut)
@@ -367,6 +376,20 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The skinning matrix rows of `instances` random poses of `skeleton` (0.3 rad per joint), on the device.
+gpu::Buffer randomPoseMatrices(gpu::Context& ctx, const Skeleton& skeleton, uint32_t instances, Rng& rng) {
+  std::vector<Mat4f> mats;
+  for (uint32_t i = 0; i < instances; ++i) {
+    const auto m = skeleton.skinningMatrices(test::makeRandomPose(rng, skeleton, 0.3f));
+    mats.insert(mats.end(), m.begin(), m.end());
+  }
+  std::vector<float> matrixRows(mats.size() * 12);
+  gpu::DeformPass::packSkinMatrices(mats.data(), mats.size(), matrixRows.data());
+  gpu::Buffer matrices(ctx, matrixRows.size() * 4, gpu::MemoryKind::DeviceLocal, "matrices");
+  matrices.upload(ctx, matrixRows.data(), matrixRows.size() * 4);
+  return matrices;
+}
+
 // The configurations timed against each other: "full_nobands" (the pipeline without bands: every
 // instance reads all K, the pass as it was before levels and as FrameRecorder runs a frame without
 // levels), then each ladder level for all 22 characters (the pipeline with bands), then the mix.
@@ -400,15 +423,7 @@ void BM_DeformLevels(benchmark::State& state) {
   Rng rng(21);
   std::vector<float> w(size_t(instances) * k);
   for (auto& x : w) x = float(rng.normal());
-  std::vector<Mat4f> mats;
-  for (uint32_t i = 0; i < instances; ++i) {
-    const auto m = dm->model.skeleton.skinningMatrices(test::makeRandomPose(rng, dm->model.skeleton, 0.3f));
-    mats.insert(mats.end(), m.begin(), m.end());
-  }
-  std::vector<float> matrixRows(mats.size() * 12);
-  gpu::DeformPass::packSkinMatrices(mats.data(), mats.size(), matrixRows.data());
-  gpu::Buffer matrices(*ctx, matrixRows.size() * 4, gpu::MemoryKind::DeviceLocal, "matrices");
-  matrices.upload(*ctx, matrixRows.data(), matrixRows.size() * 4);
+  const gpu::Buffer matrices = randomPoseMatrices(*ctx, dm->model.skeleton, instances, rng);
   gpu::Buffer positions(*ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal,
                         "positions");
   // As FrameRecorder makes it: the basis as texels where the device allows.
@@ -483,40 +498,12 @@ void BM_DeformPushOutDefaultModel(benchmark::State& state) {
   gpu::DeformPass::packWeights(w.data(), instances, k, rows.data());
   gpu::Buffer weights(*ctx, rows.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
   weights.upload(*ctx, rows.data(), rows.size() * 4);
-  std::vector<Mat4f> mats;
-  for (uint32_t i = 0; i < instances; ++i) {
-    const auto m = dm->model.skeleton.skinningMatrices(test::makeRandomPose(rng, dm->model.skeleton, 0.3f));
-    mats.insert(mats.end(), m.begin(), m.end());
-  }
-  std::vector<float> matrixRows(mats.size() * 12);
-  gpu::DeformPass::packSkinMatrices(mats.data(), mats.size(), matrixRows.data());
-  gpu::Buffer matrices(*ctx, matrixRows.size() * 4, gpu::MemoryKind::DeviceLocal, "matrices");
-  matrices.upload(*ctx, matrixRows.data(), matrixRows.size() * 4);
+  const gpu::Buffer matrices = randomPoseMatrices(*ctx, dm->model.skeleton, instances, rng);
   gpu::Buffer positions(*ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal,
                         "positions");
   const gpu::DeformPass pass(*ctx, k, g.influences(), true, g.basis.size() / sizeof(float));
   const gpu::DescriptorBinding inputs = pass.bindInstanceInputs(*ctx, weights, matrices, &g.basis);
-  const gpu::DeformPass::Args a = g.deformArgs(inputs.get(), positions, instances);
-  gpu::DeformPass::Args pushed = a;
-  pushed.anchors = g.anchors.address();
-  pushed.anchorSlots = g.anchorSlots();
-  gpu::TimestampQueries ts(*ctx, 2);
-  const auto withPush = [&](VkCommandBuffer cmd) { pass.record(cmd, pushed); };
-  const auto plain = [&](VkCommandBuffer cmd) { pass.record(cmd, a); };
-  gpuSeconds(*ctx, ts, withPush);  // warm-up
-  const uint32_t reps = repsFor(*ctx, ts, plain);
-  double with = 0, without = 0;
-  for (auto _ : state) {
-    const double t = gpuSeconds(*ctx, ts, withPush, reps);
-    without += gpuSeconds(*ctx, ts, plain, reps);
-    state.SetIterationTime(t);
-    with += t;
-  }
-  const double passes = double(state.iterations()) * reps;
-  state.counters["pass_us"] = 1e6 * with / passes;
-  state.counters["plain_us"] = 1e6 * without / passes;
-  state.counters["pushout_share"] = (with - without) / without;
-  state.counters["anchor_sets"] = g.anchorSlots();
+  timePushOut(state, *ctx, pass, g, g.deformArgs(inputs.get(), positions, instances));
 }
 BENCHMARK(BM_DeformPushOutDefaultModel)->Arg(22)->Arg(1)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.5);
 
