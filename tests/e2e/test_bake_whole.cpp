@@ -10,6 +10,7 @@
 // pose failed and these tests were disabled.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -109,10 +110,9 @@ TEST(BakeWhole, TheSimulationCheckClearsAndSimulatesItsSampleOnly) {
   const nlohmann::json& sim = r.at("simulation");
   EXPECT_EQ(sim.at("poses").get<size_t>(), 3u);
   EXPECT_GT(sim.at("seconds_per_pose_per_core").get<double>(), 0.0);
-  bool clearedThree = false;
-  for (const std::string& l : lines)
-    clearedThree |= l.find("poses had a limb in the trunk") != std::string::npos &&
-                    l.find(" of 3 poses had a limb") != std::string::npos;
+  const bool clearedThree = std::any_of(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.find(" of 3 poses had a limb in the trunk") != std::string::npos;
+  });
   EXPECT_TRUE(clearedThree) << "the clearance line names the 3 sampled poses";
   // The same sample and figures as with every pose cleared first (a pose's clearance is its own).
   const DatasetPosePlan all = planDatasetPoses(s, {});

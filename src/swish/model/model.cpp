@@ -108,10 +108,9 @@ void Model::validate(const std::string& what) const {
     for (size_t e = 0; e < ba.slots() * n; ++e) {
       const size_t v = e % n;
       const BodyAnchor& a = ba.slot(uint32_t(e / n))[v];
-      const std::string which = std::string(e < n       ? "anchor"
-                                            : e < 2 * n ? "second anchor"
-                                                        : "third anchor") +
-                                " of vertex " + n2s(v);
+      const std::string which =
+          (e < n ? std::string("anchor") : std::string(anchorSlotName(uint32_t(e / n))) + " anchor") + " of vertex " +
+          n2s(v);
       if (!a.present()) {
         if (a.position != Vec3f::Zero() || a.normal != Vec3f::Zero() || a.radius != 0.f || a.clearance != 0.f)
           fail("body anchors", which + " has no weights (no anchor) but a position, normal, radius or clearance");
