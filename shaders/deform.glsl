@@ -30,7 +30,14 @@
 // per thread with the rest of the vertex, and its centre skinned per instance with the instance's
 // matrix rows like the vertex itself: 12 more texel fetches and a 3x4 blend per anchor, vertex and
 // instance, no per-frame input. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
-// uniform, so a frame without the push-out skips it in uniform branches.
+// uniform, so a frame without the push-out skips it in uniform branches on a GPU. Lavapipe runs uniform
+// branches masked, i.e. pays for the push-out in every frame, so the code exists only in the pipelines
+// made for it: ANCHOR_SETS (a specialisation constant, the model's sets) bounds the unrolled loops, and
+// DeformPass records a frame without the push-out with the pipeline of ANCHOR_SETS 0, the kernel without
+// it (the honest baseline of its cost, too). deform_basis_texels.comp
+// loads each anchor as three uvec4 texels (binding 3; the floats' bits through uintBitsToFloat, exact):
+// through the address the 12 words were 12 scalar loads, lane by lane on lavapipe, and those 36 loads
+// a vertex were most of the push-out's cost there (docs/performance.md, "Deform").
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
@@ -63,12 +70,14 @@ layout(constant_id = 5) const uint BAND1 = 0;           // weight groups of band
 layout(constant_id = 6) const uint BAND2 = 0;           //  band 0 reads all K4; those from BANDS on
 layout(constant_id = 7) const uint BAND3 = 0;           //  are unused)
 layout(constant_id = 8) const uint BAND4 = 0;
+layout(constant_id = 9) const uint ANCHOR_SETS = 0;     // anchor sets the kernel can push out of, 0..3
 
 layout(push_constant) uniform Push { DeformParams p; };
 layout(set = 0, binding = 0) uniform samplerBuffer weightTexels;  // vec4[instance][K4 / 4]
 layout(set = 0, binding = 1) uniform samplerBuffer matrixRows;  // vec4[instance][joint][3] (rows 0..2)
 #ifdef SWISH_DEFORM_BASIS_TEXELS
 layout(set = 0, binding = 2) uniform samplerBuffer basisTexels;  // float[K][3N]
+layout(set = 0, binding = 3) uniform usamplerBuffer anchorTexels;  // uvec4[set][N][SWISH_ANCHOR_WORDS / 4]
 #endif
 const uint K4 = (K + 3u) / 4u;
 
@@ -123,7 +132,7 @@ void deformInstance(const uint instance, const uint groups) {
     y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
   }
   if (APPLY_SKINNING) {  // (character space: after skinning only)
-    [[unroll]] for (uint a = 0u; a < SWISH_MAX_ANCHOR_SLOTS; ++a) {
+    [[unroll]] for (uint a = 0u; a < ANCHOR_SETS; ++a) {
       // p.pushOut is uniform; a vertex without an anchor in this set (reach 0: 89 of the default jersey's
       // 3213 in the second set, which holds its slide anchors too) skips the blend, which could not move it. On a GPU whole subgroups of
       // such vertices do; lavapipe runs it masked as before.
@@ -181,10 +190,23 @@ void main() {
     joints[i] = jointBuf.v[v * INFLUENCES + i];
     skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
   }
+#ifndef SWISH_DEFORM_BASIS_TEXELS
   FloatsIn anchorF = FloatsIn(p.anchors);
   UintsIn anchorU = UintsIn(p.anchors);
-  [[unroll]] for (uint a = 0u; a < SWISH_MAX_ANCHOR_SLOTS; ++a) {
+#endif
+  [[unroll]] for (uint a = 0u; a < ANCHOR_SETS; ++a) {
     if (a < p.pushOut) {
+#ifdef SWISH_DEFORM_BASIS_TEXELS
+      // Three whole texels per anchor (the words' bits, floats through uintBitsToFloat: exact).
+      const int t = int((a * p.vertexCount + v) * (SWISH_ANCHOR_WORDS / 4u));
+      const uvec4 c4 = texelFetch(anchorTexels, t), w4 = texelFetch(anchorTexels, t + 1), j4 = texelFetch(anchorTexels, t + 2);
+      anchorC[a] = uintBitsToFloat(c4.xyz);
+      anchorR[a] = uintBitsToFloat(c4.w);
+      [[unroll]] for (uint i = 0u; i < 4u; ++i) {
+        anchorW[a][i] = uintBitsToFloat(w4[i]);
+        anchorJ[a][i] = j4[i];
+      }
+#else
       const uint o = (a * p.vertexCount + v) * SWISH_ANCHOR_WORDS;
       anchorC[a] = vec3(anchorF.v[o], anchorF.v[o + 1u], anchorF.v[o + 2u]);
       anchorR[a] = anchorF.v[o + 3u];
@@ -192,6 +214,7 @@ void main() {
         anchorW[a][i] = anchorF.v[o + 4u + i];
         anchorJ[a][i] = anchorU.v[o + 8u + i];
       }
+#endif
     } else {
       anchorC[a] = vec3(0.0);
       anchorR[a] = 0.0;

@@ -108,12 +108,13 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
 
   const uint64_t basisFloats = uint64_t(m.meshPca.basis.size());
   const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), skinning, basisTexels ? basisFloats : 0);
-  EXPECT_EQ(pass.basisTexels(), basisTexels && basisFloats <= ctx.properties().limits.maxTexelBufferElements);
+  const uint64_t limit = ctx.properties().limits.maxTexelBufferElements;
+  EXPECT_EQ(pass.basisTexels(), basisTexels && basisFloats <= limit && gpu::DeformPass::anchorTexelsOf(n) <= limit);
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
   const gpu::DescriptorBinding instanceInputs =
-      pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
+      pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer(), nullptr);
   a.instanceInputs = instanceInputs.get();
   a.skinJoints = skinJoints.address();
   a.skinWeights = skinWeights.address();
@@ -424,7 +425,21 @@ TEST_F(DeformLevels, BadLevelsAreRejectedWithAReason) {
   EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("band 1 ends at 1, out of order"), std::string::npos);
   a.bandEnd = {0, 3, 3, 3};
   EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("band 1 ends at 3"), std::string::npos);
+  // The push-out's code is only in the pipelines made for it: a pass made for no anchor sets (or for
+  // fewer than the frame asks) refuses a frame with them, and one without skinning takes none.
+  a.instanceOrder = 0;
+  a.anchors = 4096;
+  a.anchorSlots = 1;
+  EXPECT_NE(test::errorOf([&] { pass.record(cmd, a); }).find("made without the push-out"), std::string::npos);
+  const gpu::DeformPass twoSets(ctx(), 6, 4, true, 0, 2);
+  a.anchorSlots = 3;
+  EXPECT_NE(test::errorOf([&] { twoSets.record(cmd, a); }).find("3 body anchor sets, made for 1 to 2"),
+            std::string::npos);
   ctx().abandonOneTime(cmd);
+  EXPECT_NE(test::errorOf([&] { gpu::DeformPass(ctx(), 6, 4, true, 0, 4); }).find("4 body anchor sets"),
+            std::string::npos);
+  EXPECT_NE(test::errorOf([&] { gpu::DeformPass(ctx(), 6, 4, false, 0, 1); }).find("the push-out follows the skinning"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -116,7 +116,10 @@ struct GpuResult {
   std::vector<std::string> problems;
 };
 
-GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut) {
+// modelTexels: the kernel that reads the basis and the anchors as texels (deform_basis_texels.comp, as
+// FrameRecorder runs it where the device allows), else the one reading them through their addresses
+// (deform.comp).
+GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut, bool modelTexels = true) {
   const Model& m = in.model;
   const uint32_t n = uint32_t(m.gameMesh.vertexCount()), k = uint32_t(m.meshComponents());
   const std::vector<uint32_t> joints(m.gameMesh.skin.joints.begin(), m.gameMesh.skin.joints.end());
@@ -134,12 +137,14 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut) {
   CheckedInput anchors(ctx, std::span<const uint32_t>(anchorWords), "body anchors");
   GuardedOutput out(ctx, size_t(in.instances) * n * 3 * sizeof(float), "deformed positions");
 
-  const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), true, uint64_t(m.meshPca.basis.size()));
+  const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), true,
+                             modelTexels ? uint64_t(m.meshPca.basis.size()) : 0, m.bodyAnchors.slots());
+  EXPECT_EQ(pass.basisTexels(), modelTexels) << "this device cannot hold the test's basis and anchors as texels";
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
   const gpu::DescriptorBinding instanceInputs =
-      pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer());
+      pass.bindInstanceInputs(ctx, weights.buffer(), matrices.buffer(), &basis.buffer(), &anchors.buffer());
   a.instanceInputs = instanceInputs.get();
   a.skinJoints = skinJoints.address();
   a.skinWeights = skinWeights.address();
@@ -183,13 +188,17 @@ TEST_P(PushOutConformance, PushedPositionsMatchReference) {
     EXPECT_GT(largest, 1e-3) << "the pushes move vertices by millimetres at least";
   }
 
-  const auto gpu = runDeform(ctx(), in, true);
-  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-  test::CompareReport rep;
-  EXPECT_TRUE(test::matchesReference(
-      "pushed positions", gpu.positions, ref.positions, [&](size_t e) { return ref.tolerance[e]; }, &rep));
-  std::printf("%zu of %zu vertices pushed (largest move %.3g m); max |gpu - reference| = %.3g m over %zu values\n",
-              ref.moved, total, largest, rep.maxAbsError, rep.compared);
+  for (const bool texels : {true, false}) {
+    SCOPED_TRACE(texels ? "basis and anchors as texels" : "basis and anchors through their addresses");
+    const auto gpu = runDeform(ctx(), in, true, texels);
+    for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+    test::CompareReport rep;
+    EXPECT_TRUE(test::matchesReference(
+        "pushed positions", gpu.positions, ref.positions, [&](size_t e) { return ref.tolerance[e]; }, &rep));
+    std::printf(
+        "%s: %zu of %zu vertices pushed (largest move %.3g m); max |gpu - reference| = %.3g m over %zu values\n",
+        texels ? "texels" : "addresses", ref.moved, total, largest, rep.maxAbsError, rep.compared);
+  }
 }
 
 // No anchor buffer (a frame with the push-out off) is the plain deform.
@@ -255,9 +264,16 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
   EXPECT_TRUE(
       test::matchesReference("reference on known answers", ref.positions, expected, [](size_t) { return 1e-6; }));
   EXPECT_EQ(ref.moved, 2u);
-  const auto gpu = runDeform(ctx(), in, true);
-  for (const auto& p : gpu.problems) ADD_FAILURE() << p;
-  EXPECT_TRUE(test::matchesReference("kernel on known answers", gpu.positions, expected, [](size_t) { return 1e-6; }));
+  // Both kernels (the anchors as texels and through their address) on every case.
+  const auto kernelsMatch = [&](const char* what, const std::vector<float>& want) {
+    for (const bool texels : {true, false}) {
+      SCOPED_TRACE(texels ? "texels" : "addresses");
+      const auto gpu = runDeform(ctx(), in, true, texels);
+      for (const auto& p : gpu.problems) ADD_FAILURE() << p;
+      EXPECT_TRUE(test::matchesReference(what, gpu.positions, want, [](size_t) { return 1e-6; }));
+    }
+  };
+  kernelsMatch("kernel on known answers", expected);
 
   // A second anchor set, applied after the first: vertex 0's second ball (radius 4 cm, centre at z = 0.04,
   // reach 4.2 cm) holds where the first ball puts it (z = 0.002, 3.8 cm off its centre) but not where it
@@ -276,10 +292,7 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
   EXPECT_TRUE(
       test::matchesReference("reference, two anchor sets", ref2.positions, expected2, [](size_t) { return 1e-6; }));
   EXPECT_EQ(ref2.moved, 3u);
-  const auto gpu2 = runDeform(ctx(), in, true);
-  for (const auto& p : gpu2.problems) ADD_FAILURE() << p;
-  EXPECT_TRUE(
-      test::matchesReference("kernel, two anchor sets", gpu2.positions, expected2, [](size_t) { return 1e-6; }));
+  kernelsMatch("kernel, two anchor sets", expected2);
 
   // A third set, after the second: vertex 0's third ball (radius 3.1 cm, centre at z = -0.03, reach 3.3 cm)
   // takes it from the second's z = -0.002 (2.8 cm off its centre) up to -0.03 + 0.033 = 0.003. Applied
@@ -294,10 +307,7 @@ TEST_F(PushOutSpecialCases, KnownAnswers) {
   EXPECT_TRUE(
       test::matchesReference("reference, three anchor sets", ref3.positions, expected3, [](size_t) { return 1e-6; }));
   EXPECT_EQ(ref3.moved, 3u);
-  const auto gpu3 = runDeform(ctx(), in, true);
-  for (const auto& p : gpu3.problems) ADD_FAILURE() << p;
-  EXPECT_TRUE(
-      test::matchesReference("kernel, three anchor sets", gpu3.positions, expected3, [](size_t) { return 1e-6; }));
+  kernelsMatch("kernel, three anchor sets", expected3);
 }
 
 }  // namespace

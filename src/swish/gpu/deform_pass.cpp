@@ -7,6 +7,7 @@
 #include "shaders/swish_layouts.h"
 #include "swish/core/error.hpp"
 #include "swish/core/mesh.hpp"
+#include "swish/gpu/buffer.hpp"
 #include "swish/gpu/context.hpp"
 
 namespace swish::gpu {
@@ -74,6 +75,7 @@ void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
 
 static_assert(SWISH_ANCHOR_WORDS == 4 + 2 * kAnchorInfluences, "shaders/swish_layouts.h: body anchor layout");
 static_assert(SWISH_MAX_ANCHOR_SLOTS == kMaxAnchorSlots, "shaders/swish_layouts.h: body anchor sets");
+static_assert(SWISH_ANCHOR_WORDS == 4 * DeformPass::kAnchorTexels, "shaders/swish_layouts.h: body anchor texels");
 
 std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32_t jointCount) {
   const size_t n = anchors.anchors.size();
@@ -97,34 +99,53 @@ std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32
   return out;
 }
 
-DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats)
-    : basisTexels_(basisFloats > 0 && basisFloats <= ctx.properties().limits.maxTexelBufferElements),
-      meshComponents_(k) {
+DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats,
+                       uint32_t anchorSets)
+    : basisTexels_(basisFloats > 0 &&
+                   std::max(basisFloats, anchorTexelsOf(basisFloats / (3 * uint64_t(std::max(k, 1u))))) <=
+                       ctx.properties().limits.maxTexelBufferElements),
+      meshComponents_(k),
+      anchorSets_(anchorSets) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
     throw Error("deform pass: " + std::to_string(k) + " mesh components; the kernel supports 1.." +
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
   if (influences < 1 || influences > uint32_t(kMaxInfluences))
     throw Error("deform pass: " + std::to_string(influences) + " skin influences; supported: 1..8");
+  if (anchorSets > kMaxAnchorSlots)
+    throw Error("deform pass: " + std::to_string(anchorSets) + " body anchor sets; supported: 0.." +
+                std::to_string(kMaxAnchorSlots));
+  if (anchorSets > 0 && !applySkinning)
+    throw Error("deform pass: the push-out follows the skinning; a pass without skinning takes no anchor sets");
   inputsLayout_ = DescriptorLayout(
-      ctx, std::vector<VkDescriptorType>(basisTexels_ ? 3 : 2, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
+      ctx, std::vector<VkDescriptorType>(basisTexels_ ? 4 : 2, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER));
   bands_ = bandsOf(k);
   const char* shader = basisTexels_ ? "deform_basis_texels.comp" : "deform.comp";
-  // Specialisation constants: workgroup size, K, influences, skinning, bands and their groups (band 0: K).
-  std::vector<uint32_t> spec = {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u};
-  pipeline_ = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
-  spec[4] = uint32_t(bands_.size());
-  for (size_t b = 1; b < bands_.size(); ++b) spec[4 + b] = bands_[b];
-  bandedPipeline_ = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
+  // Specialisation constants: workgroup size, K, influences, skinning, bands and their groups (band 0: K),
+  // anchor sets.
+  for (const uint32_t sets : {0u, anchorSets}) {
+    const size_t i = sets > 0 ? 1 : 0;
+    if (i == 1 && sets == 0) break;
+    std::vector<uint32_t> spec = {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u, sets};
+    pipeline_[i] = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
+    spec[4] = uint32_t(bands_.size());
+    for (size_t b = 1; b < bands_.size(); ++b) spec[4 + b] = bands_[b];
+    bandedPipeline_[i] = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
+  }
 }
 
 DescriptorBinding DeformPass::bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
-                                                 const Buffer* basis, VkDeviceSize weightsOffset,
+                                                 const Buffer* basis, const Buffer* anchors, VkDeviceSize weightsOffset,
                                                  VkDeviceSize matricesOffset) const {
   std::vector<BoundResource> r = {BoundResource::texels(weights, VK_FORMAT_R32G32B32A32_SFLOAT, weightsOffset),
                                   BoundResource::texels(skinMatrices, VK_FORMAT_R32G32B32A32_SFLOAT, matricesOffset)};
   if (basisTexels_) {
     if (!basis) throw Error("deform pass: reads the basis as texels, but no basis buffer was bound");
     r.push_back(BoundResource::texels(*basis, VK_FORMAT_R32_SFLOAT));
+    // Without anchors (none in the model, or an empty buffer) the weights (whole texels) stand in: no
+    // frame pushes out then, so the kernel never reads them.
+    const bool anchorsBound = anchors && anchors->size() > 0;
+    r.push_back(anchorsBound ? BoundResource::texels(*anchors, VK_FORMAT_R32G32B32A32_UINT)
+                             : BoundResource::texels(weights, VK_FORMAT_R32G32B32A32_UINT, weightsOffset));
   }
   return DescriptorBinding(ctx, inputsLayout_, r);
 }
@@ -139,9 +160,9 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
   p.skinWeights = layout::Address::of(a.skinWeights);
   p.positionsOut = layout::Address::of(a.positionsOut);
   p.anchors = layout::Address::of(a.anchors);
-  if (a.anchors && (a.anchorSlots < 1 || a.anchorSlots > kMaxAnchorSlots))
-    throw Error("deform pass: " + std::to_string(a.anchorSlots) + " body anchor sets (1 to " +
-                std::to_string(kMaxAnchorSlots) + ")");
+  if (a.anchors && (a.anchorSlots < 1 || a.anchorSlots > anchorSets_))
+    throw Error("deform pass: " + std::to_string(a.anchorSlots) + " body anchor sets, made for 1 to " +
+                std::to_string(anchorSets_) + (anchorSets_ == 0 ? " (made without the push-out)" : ""));
   p.pushOut = a.anchors ? a.anchorSlots : 0u;
   p.vertexCount = a.vertexCount;
   p.instanceCount = a.instanceCount;
@@ -162,7 +183,8 @@ uint32_t DeformPass::record(VkCommandBuffer cmd, const Args& a) const {
     }
   }
   p.pad0 = 0;
-  (a.instanceOrder ? bandedPipeline_ : pipeline_).bind(cmd, &p, sizeof(p), a.instanceInputs);
+  const size_t withPush = a.anchors ? 1 : 0;
+  (a.instanceOrder ? bandedPipeline_ : pipeline_)[withPush].bind(cmd, &p, sizeof(p), a.instanceInputs);
   vkCmdDispatch(cmd, groupCount(a.vertexCount, kWorkgroupSize), 1, 1);
   return 1;
 }

@@ -100,22 +100,33 @@ class DeformPass {
   // naming the vertex for a joint
   // >= jointCount (the kernel fetches every influence's matrix, even at weight 0).
   static std::vector<uint32_t> packAnchors(const BodyAnchors& anchors, uint32_t jointCount);
+  // The texels (uvec4) of the most anchors `vertices` vertices can have: every set's, kAnchorTexels each
+  // (SWISH_ANCHOR_WORDS / 4, asserted in the .cpp).
+  static constexpr uint32_t kAnchorTexels = 3;
+  static uint64_t anchorTexelsOf(uint64_t vertices) { return vertices * kMaxAnchorSlots * kAnchorTexels; }
 
   DeformPass() = default;
   // meshComponents (K) in 1..SWISH_MAX_MESH_COMPONENTS; influences in 1..8. applySkinning = false writes
-  // the pre-skinning shape (used to check the PCA reconstruction on its own). basisFloats: 3N x K, the
-  // basis read as texels when it is > 0 and within the device's maxTexelBufferElements; 0: through
-  // Args::basis.
+  // the pre-skinning shape (used to check the PCA reconstruction on its own). basisFloats: 3N x K. The
+  // model's streams, the basis and the body anchors, are read as texels (deform_basis_texels.comp) when
+  // basisFloats is > 0 and both fit in the device's maxTexelBufferElements (the anchors as
+  // anchorTexelsOf(N)); else through Args::basis and Args::anchors (deform.comp). anchorSets (0 to
+  // kMaxAnchorSlots): the most body anchor sets a frame pushes out of (the model's BodyAnchors::slots()).
+  // The push-out's code is in the pipelines made for it only: a frame without it (Args::anchors 0) runs
+  // the kernel without it, which lavapipe would otherwise run masked (deform.glsl).
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
-             uint64_t basisFloats = 0);
+             uint64_t basisFloats = 0, uint32_t anchorSets = 0);
   bool basisTexels() const { return basisTexels_; }
   uint32_t meshComponents() const { return meshComponents_; }    // K of the pipeline
+  uint32_t anchorSets() const { return anchorSets_; }            // the most anchor sets a frame may apply
   const std::vector<uint32_t>& bands() const { return bands_; }  // bandsOf(K)
 
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
-  // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise).
+  // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise) and
+  // body anchors (packAnchors' words, the buffer Args::anchors points into; null or empty for a model
+  // without them: no push-out then). Without basisTexels() the anchors are read through Args::anchors.
   DescriptorBinding bindInstanceInputs(Context& ctx, const Buffer& weights, const Buffer& skinMatrices,
-                                       const Buffer* basis, VkDeviceSize weightsOffset = 0,
+                                       const Buffer* basis, const Buffer* anchors, VkDeviceSize weightsOffset = 0,
                                        VkDeviceSize matricesOffset = 0) const;
   // Returns the dispatches recorded (1; 0 for an empty input).
   uint32_t record(VkCommandBuffer cmd, const Args& args) const;
@@ -123,10 +134,12 @@ class DeformPass {
  private:
   bool basisTexels_ = false;
   uint32_t meshComponents_ = 0;
+  uint32_t anchorSets_ = 0;
   std::vector<uint32_t> bands_;  // bandsOf(K)
   DescriptorLayout inputsLayout_;
-  ComputePipeline pipeline_;        // one band: every instance at K (Args::instanceOrder 0)
-  ComputePipeline bandedPipeline_;  // bands_
+  // [0]: without the push-out; [1]: with anchorSets_ sets (made where anchorSets_ > 0).
+  std::array<ComputePipeline, 2> pipeline_;        // one band: every instance at K (Args::instanceOrder 0)
+  std::array<ComputePipeline, 2> bandedPipeline_;  // bands_
 };
 
 }  // namespace swish::gpu

@@ -22,7 +22,8 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
       capacity_(capacity),
       tangentFrames_(o.tangentFrames),
       normalMaps_(o.normalMaps && model.hasNormalMaps()),
-      deform_(ctx, model.kernelMeshComponents(), model.influences(), true, model.basis.size() / sizeof(float)) {
+      deform_(ctx, model.kernelMeshComponents(), model.influences(), true, model.basis.size() / sizeof(float),
+              model.anchorSlots()) {
   if (o.framesInFlight < 1 || o.framesInFlight > 8)
     throw Error("frame recorder: " + std::to_string(o.framesInFlight) + " frames in flight; supported: 1..8");
   if (capacity == 0) throw Error("frame recorder: the instance capacity must be at least 1");
@@ -36,7 +37,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
   mapVersion_.assign(capacity, 0);  // every slot's layers start as version 0 (zeros)
   for (uint32_t s = 0; s < o.framesInFlight; ++s) {
     FrameResources& f = frames_[s];
-    f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices, &model.basis);
+    f.deformInputs = deform_.bindInstanceInputs(ctx, f.meshWeights, f.skinMatrices, &model.basis, &model.anchors);
     if (tangentFrames_) {
       TangentFramesPass::TwoPassBuffers b;
       b.positions = &f.positions;
