@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -9,6 +10,10 @@
 
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace swish::bake {
 namespace {
@@ -204,7 +209,7 @@ void BodyCollider::rebuild() {
     if (pass == 1) {
       for (size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
       cellTriangles_.resize(cellStart_[cells]);
-      cellSpheres_.resize(cellStart_[cells]);
+      for (auto& a : cellSpheres_) a.assign(cellStart_[cells] + kSpherePadding, 0.f);
       fill.assign(cellStart_.begin(), cellStart_.end() - 1);
     }
     for (size_t t = 0; t < nt; ++t) {
@@ -216,7 +221,7 @@ void BodyCollider::rebuild() {
             if (pass == 0)
               ++cellStart_[c + 1];
             else {
-              cellSpheres_[fill[c]] = spheres[t];
+              for (int k = 0; k < 4; ++k) cellSpheres_[size_t(k)][fill[c]] = spheres[t][k];
               cellTriangles_[fill[c]++] = uint32_t(t);
             }
           }
@@ -283,43 +288,83 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
     const float d = p[k] < lo ? lo - p[k] : (p[k] > hi ? p[k] - hi : 0.f);
     return d * d;
   };
+  // Sphere reject on squared distances (no square root): |p - centre| > maxDistance + r. Bit j of the
+  // answer: sphere i0 + j passes (is not rejected); kSphereLanes at a time, each lane computing what the
+  // scalar expression does, in the same order (the arrays are padded, the caller masks the lanes past a
+  // cell's end).
+  const float* const sx = cellSpheres_[0].data();
+  const float* const sy = cellSpheres_[1].data();
+  const float* const sz = cellSpheres_[2].data();
+  const float* const sr = cellSpheres_[3].data();
+  auto centreSqOf = [&](uint32_t i) { return (p - Vec3f(sx[i], sy[i], sz[i])).squaredNorm(); };
+#if defined(__SSE2__)
+  const __m128 px = _mm_set1_ps(p.x()), py = _mm_set1_ps(p.y()), pz = _mm_set1_ps(p.z());
+  const __m128 maxD = _mm_set1_ps(maxDistance), onePlusSlack = _mm_set1_ps(1.f + kSlack),
+               slackSq = _mm_set1_ps(kSlack * kSlack);
+  auto passing = [&](uint32_t i0) -> uint32_t {
+    const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(sx + i0)), dy = _mm_sub_ps(py, _mm_loadu_ps(sy + i0)),
+                 dz = _mm_sub_ps(pz, _mm_loadu_ps(sz + i0));
+    const __m128 centreSq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 reach = _mm_add_ps(maxD, _mm_loadu_ps(sr + i0));
+    const __m128 bound = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(reach, reach), onePlusSlack), slackSq);
+    return uint32_t(_mm_movemask_ps(_mm_cmpngt_ps(centreSq, bound)));
+  };
+#else
+  auto passing = [&](uint32_t i0) -> uint32_t {
+    uint32_t bits = 0;
+    for (uint32_t j = 0; j < kSphereLanes; ++j) {
+      const float reach = maxDistance + sr[i0 + j];
+      if (!(centreSqOf(i0 + j) > reach * reach * (1.f + kSlack) + kSlack * kSlack)) bits |= 1u << j;
+    }
+    return bits;
+  };
+#endif
   // The triangles binned in cell c (rejects, then the exact closest point).
   auto visitCell = [&](size_t c) {
-    for (uint32_t i = cellStart_[c]; i < cellStart_[c + 1]; ++i) {
-      // Sphere reject on squared distances (no square root): |p - centre| > maxDistance + r.
-      const Vec4f& s = cellSpheres_[i];
-      const float reach = maxDistance + s[3], centreSq = (p - s.head<3>()).squaredNorm();
-      if (centreSq > reach * reach * (1.f + kSlack) + kSlack * kSlack) continue;
-      const uint32_t t = cellTriangles_[i];
-      const uint32_t part = triangleComponent_[t];
-      if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
-      const uint32_t key = byRegion ? triangleRegion_[t] : part;
-      size_t slot = 0;
-      while (slot < partCount && parts[slot].key != key) ++slot;
-      if (slot < partCount && std::sqrt(centreSq) - s[3] > parts[slot].distance) continue;
-      if (mark[t] == query) continue;  // computed from another cell already
-      mark[t] = query;
-      const ClosestOnTriangle q = closestOnTriangle(p, positions_.row(triangles_(t, 0)),
-                                                    positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
-      const float d = (p - q.point).norm();
-      if (!(d <= maxDistance)) continue;
-      if (slot == partCount) {
-        if (partCount == kMaxParts) {
-          // More parts within reach than kept: replace the farthest answer if this is nearer.
-          size_t worst = 0;
-          for (size_t k = 1; k < partCount; ++k)
-            if (parts[k].distance > parts[worst].distance) worst = k;
-          if (!(d < parts[worst].distance)) continue;
-          parts[worst] = {key, part, d, int(t), q};
+    const uint32_t begin = cellStart_[c], end = cellStart_[c + 1];
+    for (uint32_t i0 = begin; i0 < end; i0 += kSphereLanes) {
+      uint32_t bits = passing(i0);
+      if (end - i0 < kSphereLanes) bits &= (1u << (end - i0)) - 1u;
+      for (; bits != 0; bits &= bits - 1u) {
+        const uint32_t i = i0 + uint32_t(std::countr_zero(bits));
+        const float centreSq = centreSqOf(i), radius = sr[i];
+        const uint32_t t = cellTriangles_[i];
+        // Met in another cell already: computed, or rejected below by what stays true for this query (the
+        // part filters, and a part's best answer, which only shrinks).
+        if (mark[t] == query) continue;
+        mark[t] = query;
+        const uint32_t part = triangleComponent_[t];
+        if ((onlyPart >= 0 && part != uint32_t(onlyPart)) || (skipPart >= 0 && part == uint32_t(skipPart))) continue;
+        const uint32_t key = byRegion ? triangleRegion_[t] : part;
+        size_t slot = 0;
+        while (slot < partCount && parts[slot].key != key) ++slot;
+        // (|p - centre| - r > best, on squares and with the same slack as the sphere reject: no square root.)
+        if (slot < partCount) {
+          const float bound = parts[slot].distance + radius;
+          if (centreSq > bound * bound * (1.f + kSlack) + kSlack * kSlack) continue;
+        }
+        const ClosestOnTriangle q = closestOnTriangle(
+            p, positions_.row(triangles_(t, 0)), positions_.row(triangles_(t, 1)), positions_.row(triangles_(t, 2)));
+        const float d = (p - q.point).norm();
+        if (!(d <= maxDistance)) continue;
+        if (slot == partCount) {
+          if (partCount == kMaxParts) {
+            // More parts within reach than kept: replace the farthest answer if this is nearer.
+            size_t worst = 0;
+            for (size_t k = 1; k < partCount; ++k)
+              if (parts[k].distance > parts[worst].distance) worst = k;
+            if (!(d < parts[worst].distance)) continue;
+            parts[worst] = {key, part, d, int(t), q};
+            continue;
+          }
+          parts[partCount++] = {key, part, d, int(t), q};
           continue;
         }
-        parts[partCount++] = {key, part, d, int(t), q};
-        continue;
+        // Ties (two triangles sharing the closest feature) keep the lowest triangle index, so the answer
+        // does not depend on the visiting order.
+        PartBest& pb = parts[slot];
+        if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {key, part, d, int(t), q};
       }
-      // Ties (two triangles sharing the closest feature) keep the lowest triangle index, so the answer
-      // does not depend on the visiting order.
-      PartBest& pb = parts[slot];
-      if (d < pb.distance || (d == pb.distance && int(t) < pb.tri)) pb = {key, part, d, int(t), q};
     }
   };
   // The cell holding p first: its triangles are usually the nearest, and once a part has an answer the

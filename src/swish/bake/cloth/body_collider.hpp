@@ -125,9 +125,11 @@ class BodyCollider {
 
   Points3f positions_;
   std::vector<Vec3f> faceNormals_, vertexNormals_, edgeNormals_;
-  // The bounding sphere (centre + radius) of each of a cell's triangles, in cellTriangles_' order: a
-  // cheap reject before the exact test, read in a row instead of one cache line per triangle.
-  std::vector<Vec4f> cellSpheres_;
+  // The bounding sphere (centre xyz, radius) of each of a cell's triangles, in cellTriangles_' order: a
+  // cheap reject before the exact test, read in a row instead of one cache line per triangle. Stored
+  // as four arrays (kSpherePadding floats longer) so that a query rejects kSphereLanes at a time.
+  static constexpr uint32_t kSphereLanes = 4, kSpherePadding = kSphereLanes;
+  std::array<std::vector<float>, 4> cellSpheres_;
   Vec3f gridOrigin_ = Vec3f::Zero();
   Eigen::Vector3i gridDims_ = Eigen::Vector3i::Zero();
   std::vector<uint32_t> cellStart_, cellTriangles_;  // compressed rows: cell -> triangles
