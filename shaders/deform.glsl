@@ -34,7 +34,10 @@
 // branches masked, i.e. pays for the push-out in every frame, so the code exists only in the pipelines
 // made for it: ANCHOR_SETS (a specialisation constant, the model's sets) bounds the unrolled loops, and
 // DeformPass records a frame without the push-out with the pipeline of ANCHOR_SETS 0, the kernel without
-// it (the honest baseline of its cost, too). deform_basis_texels.comp
+// it (the honest baseline of its cost, too). An anchor's influences come ranked, and the fit gives none
+// more than three (most one or two): ANCHOR_INFLUENCES, the most any anchor of the model uses
+// (DeformPass::anchorInfluencesOf), bounds the blend, whose later weights are all zero and which the
+// reference skips, so the result is the same. deform_basis_texels.comp
 // loads each anchor as three uvec4 texels (binding 3; the floats' bits through uintBitsToFloat, exact):
 // through the address the 12 words were 12 scalar loads, lane by lane on lavapipe, and those 36 loads
 // a vertex were most of the push-out's cost there (docs/performance.md, "Deform").
@@ -71,6 +74,7 @@ layout(constant_id = 6) const uint BAND2 = 0;           //  band 0 reads all K4;
 layout(constant_id = 7) const uint BAND3 = 0;           //  are unused)
 layout(constant_id = 8) const uint BAND4 = 0;
 layout(constant_id = 9) const uint ANCHOR_SETS = 0;     // anchor sets the kernel can push out of, 0..3
+layout(constant_id = 10) const uint ANCHOR_INFLUENCES = 4;  // leading anchor influences any anchor uses, 1..4
 
 layout(push_constant) uniform Push { DeformParams p; };
 layout(set = 0, binding = 0) uniform samplerBuffer weightTexels;  // vec4[instance][K4 / 4]
@@ -138,7 +142,7 @@ void deformInstance(const uint instance, const uint groups) {
       // such vertices do; lavapipe runs it masked as before.
       if (a < p.pushOut && anchorR[a] != 0.0) {
         precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
-        SWISH_BLEND_MATRICES(4u, anchorJ[a], anchorW[a], a0, a1, a2, a3)
+        SWISH_BLEND_MATRICES(ANCHOR_INFLUENCES, anchorJ[a], anchorW[a], a0, a1, a2, a3)
         precise const vec3 c = ((a0 * anchorC[a].x + a1 * anchorC[a].y) + a2 * anchorC[a].z) + a3;
         precise const vec3 e = y - c;
         precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;

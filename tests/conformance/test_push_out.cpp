@@ -28,10 +28,14 @@ using test::GuardedOutput;
 struct PushCase {
   uint32_t vertices, influences, instances;
   uint32_t sets = 1;  // anchor sets: 1, 2 (BodyAnchors::second too) or 3 (and BodyAnchors::third)
+  // Influences the anchors keep (the rest zeroed, the kept renormalised; the fit gives at most three):
+  // the kernel blends that many (DeformPass::anchorInfluencesOf).
+  uint32_t anchorInfluences = 4;
 };
 void PrintTo(const PushCase& c, std::ostream* os) {
   *os << c.vertices << " vertices, " << c.influences << " influences, " << c.instances << " instances"
-      << ", " << c.sets << " anchor set" << (c.sets > 1 ? "s" : "");
+      << ", " << c.sets << " anchor set" << (c.sets > 1 ? "s" : "") << ", " << c.anchorInfluences
+      << " anchor influences";
 }
 
 struct PushInputs {
@@ -53,6 +57,15 @@ PushInputs randomInputs(uint64_t seed, const PushCase& c) {
   spec.thirdAnchors = c.sets >= 3;
   PushInputs in;
   in.model = test::makeRandomModel(rng, spec);
+  for (uint32_t s = 0; c.anchorInfluences < uint32_t(kAnchorInfluences) && s < in.model.bodyAnchors.slots(); ++s)
+    for (BodyAnchor& a : in.model.bodyAnchors.slot(s)) {
+      if (!a.present()) continue;
+      for (uint32_t i = c.anchorInfluences; i < uint32_t(kAnchorInfluences); ++i) a.weights[i] = 0.f;
+      float sum = 0.f;
+      for (const float w : a.weights) sum += w;
+      if (!(sum > 0.f)) a.weights[0] = sum = 1.f;
+      for (float& w : a.weights) w /= sum;
+    }
   in.instances = c.instances;
   for (uint32_t i = 0; i < c.instances * 5; ++i) in.weights.push_back(float(rng.normal(0, 2)));
   for (uint32_t i = 0; i < c.instances; ++i) {
@@ -138,7 +151,8 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut, bool 
   GuardedOutput out(ctx, size_t(in.instances) * n * 3 * sizeof(float), "deformed positions");
 
   const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), true,
-                             modelTexels ? uint64_t(m.meshPca.basis.size()) : 0, m.bodyAnchors.slots());
+                             modelTexels ? uint64_t(m.meshPca.basis.size()) : 0, m.bodyAnchors.slots(),
+                             gpu::DeformPass::anchorInfluencesOf(m.bodyAnchors));
   EXPECT_EQ(pass.basisTexels(), modelTexels) << "this device cannot hold the test's basis and anchors as texels";
   gpu::DeformPass::Args a;
   a.mean = mean.address();
@@ -167,7 +181,8 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut, bool 
 std::string caseName(const ::testing::TestParamInfo<PushCase>& info) {
   const auto& c = info.param;
   return "V" + std::to_string(c.vertices) + "_I" + std::to_string(c.influences) + "_N" + std::to_string(c.instances) +
-         (c.sets > 1 ? "_Sets" + std::to_string(c.sets) : "");
+         (c.sets > 1 ? "_Sets" + std::to_string(c.sets) : "") +
+         (c.anchorInfluences < 4 ? "_Anchor" + std::to_string(c.anchorInfluences) : "");
 }
 
 class PushOutConformance : public test::GpuTest, public ::testing::WithParamInterface<PushCase> {};
@@ -188,6 +203,8 @@ TEST_P(PushOutConformance, PushedPositionsMatchReference) {
     EXPECT_GT(largest, 1e-3) << "the pushes move vertices by millimetres at least";
   }
 
+  // The kernel blends as many anchor influences as the anchors use.
+  EXPECT_EQ(gpu::DeformPass::anchorInfluencesOf(in.model.bodyAnchors), GetParam().anchorInfluences);
   for (const bool texels : {true, false}) {
     SCOPED_TRACE(texels ? "basis and anchors as texels" : "basis and anchors through their addresses");
     const auto gpu = runDeform(ctx(), in, true, texels);
@@ -213,12 +230,14 @@ TEST_P(PushOutConformance, OffIsThePlainDeform) {
 }
 
 // 1 vertex; a prime vertex count with the 22 instances of the default scene; 1 and 8 skin influences
-// (the anchors have 4 whatever the garment has); one anchor set, two and three.
+// (the anchors have 4 whatever the garment has); one anchor set, two and three; anchors of 3, 2 and 1
+// influences (the kernel's blend specialised to them).
 INSTANTIATE_TEST_SUITE_P(Sizes, PushOutConformance,
                          ::testing::Values(PushCase{1, 4, 1}, PushCase{97, 1, 3}, PushCase{997, 4, 22},
                                            PushCase{401, 8, 4}, PushCase{1, 4, 1, 2}, PushCase{97, 1, 3, 2},
                                            PushCase{997, 4, 22, 2}, PushCase{1, 4, 1, 3}, PushCase{97, 1, 3, 3},
-                                           PushCase{997, 4, 22, 3}, PushCase{401, 8, 4, 3}),
+                                           PushCase{997, 4, 22, 3}, PushCase{401, 8, 4, 3}, PushCase{997, 4, 22, 3, 3},
+                                           PushCase{401, 8, 4, 3, 2}, PushCase{97, 1, 3, 2, 1}),
                          caseName);
 
 class PushOutSpecialCases : public test::GpuTest {};

@@ -77,6 +77,15 @@ static_assert(SWISH_ANCHOR_WORDS == 4 + 2 * kAnchorInfluences, "shaders/swish_la
 static_assert(SWISH_MAX_ANCHOR_SLOTS == kMaxAnchorSlots, "shaders/swish_layouts.h: body anchor sets");
 static_assert(SWISH_ANCHOR_WORDS == 4 * DeformPass::kAnchorTexels, "shaders/swish_layouts.h: body anchor texels");
 
+uint32_t DeformPass::anchorInfluencesOf(const BodyAnchors& anchors) {
+  uint32_t used = 1;
+  for (uint32_t s = 0; s < anchors.slots(); ++s)
+    for (const BodyAnchor& a : anchors.slot(s))
+      for (uint32_t i = used; i < uint32_t(kAnchorInfluences); ++i)
+        if (a.weights[i] != 0.f) used = i + 1;
+  return used;
+}
+
 std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32_t jointCount) {
   const size_t n = anchors.anchors.size();
   std::vector<uint32_t> out(anchors.slots() * n * SWISH_ANCHOR_WORDS);
@@ -100,12 +109,13 @@ std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32
 }
 
 DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats,
-                       uint32_t anchorSets)
+                       uint32_t anchorSets, uint32_t anchorInfluences)
     : basisTexels_(basisFloats > 0 &&
                    std::max(basisFloats, anchorTexelsOf(basisFloats / (3 * uint64_t(std::max(k, 1u))))) <=
                        ctx.properties().limits.maxTexelBufferElements),
       meshComponents_(k),
-      anchorSets_(anchorSets) {
+      anchorSets_(anchorSets),
+      anchorInfluences_(anchorInfluences) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
     throw Error("deform pass: " + std::to_string(k) + " mesh components; the kernel supports 1.." +
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
@@ -114,6 +124,9 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
   if (anchorSets > kMaxAnchorSlots)
     throw Error("deform pass: " + std::to_string(anchorSets) + " body anchor sets; supported: 0.." +
                 std::to_string(kMaxAnchorSlots));
+  if (anchorInfluences < 1 || anchorInfluences > uint32_t(kAnchorInfluences))
+    throw Error("deform pass: " + std::to_string(anchorInfluences) + " anchor influences; supported: 1.." +
+                std::to_string(kAnchorInfluences));
   if (anchorSets > 0 && !applySkinning)
     throw Error("deform pass: the push-out follows the skinning; a pass without skinning takes no anchor sets");
   inputsLayout_ = DescriptorLayout(
@@ -125,7 +138,8 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
   for (const uint32_t sets : {0u, anchorSets}) {
     const size_t i = sets > 0 ? 1 : 0;
     if (i == 1 && sets == 0) break;
-    std::vector<uint32_t> spec = {kWorkgroupSize, k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u, sets};
+    std::vector<uint32_t> spec = {kWorkgroupSize,  k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u, sets,
+                                  anchorInfluences};
     pipeline_[i] = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
     spec[4] = uint32_t(bands_.size());
     for (size_t b = 1; b < bands_.size(); ++b) spec[4 + b] = bands_[b];

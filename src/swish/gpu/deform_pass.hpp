@@ -104,6 +104,8 @@ class DeformPass {
   // (SWISH_ANCHOR_WORDS / 4, asserted in the .cpp).
   static constexpr uint32_t kAnchorTexels = 3;
   static uint64_t anchorTexelsOf(uint64_t vertices) { return vertices * kMaxAnchorSlots * kAnchorTexels; }
+  // The leading influences any anchor of every set gives a non-zero weight (1 to 4; 1 without anchors).
+  static uint32_t anchorInfluencesOf(const BodyAnchors& anchors);
 
   DeformPass() = default;
   // meshComponents (K) in 1..SWISH_MAX_MESH_COMPONENTS; influences in 1..8. applySkinning = false writes
@@ -114,12 +116,15 @@ class DeformPass {
   // kMaxAnchorSlots): the most body anchor sets a frame pushes out of (the model's BodyAnchors::slots()).
   // The push-out's code is in the pipelines made for it only: a frame without it (Args::anchors 0) runs
   // the kernel without it, which lavapipe would otherwise run masked (deform.glsl).
+  // anchorInfluences (1 to 4): the leading influences the anchors use (anchorInfluencesOf); the blend of
+  // an anchor's matrices stops there, so an anchor with a non-zero weight beyond it would be wrong.
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
-             uint64_t basisFloats = 0, uint32_t anchorSets = 0);
+             uint64_t basisFloats = 0, uint32_t anchorSets = 0, uint32_t anchorInfluences = 4);
   bool basisTexels() const { return basisTexels_; }
-  uint32_t meshComponents() const { return meshComponents_; }    // K of the pipeline
-  uint32_t anchorSets() const { return anchorSets_; }            // the most anchor sets a frame may apply
-  const std::vector<uint32_t>& bands() const { return bands_; }  // bandsOf(K)
+  uint32_t meshComponents() const { return meshComponents_; }      // K of the pipeline
+  uint32_t anchorSets() const { return anchorSets_; }              // the most anchor sets a frame may apply
+  uint32_t anchorInfluences() const { return anchorInfluences_; }  // the anchor influences blended
+  const std::vector<uint32_t>& bands() const { return bands_; }    // bandsOf(K)
 
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
   // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise) and
@@ -134,7 +139,7 @@ class DeformPass {
  private:
   bool basisTexels_ = false;
   uint32_t meshComponents_ = 0;
-  uint32_t anchorSets_ = 0;
+  uint32_t anchorSets_ = 0, anchorInfluences_ = 4;
   std::vector<uint32_t> bands_;  // bandsOf(K)
   DescriptorLayout inputsLayout_;
   // [0]: without the push-out; [1]: with anchorSets_ sets (made where anchorSets_ > 0).

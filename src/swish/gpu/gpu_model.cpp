@@ -143,6 +143,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
                  " is not in the skeleton of " + std::to_string(jointCount_) + " joints");
     }
     anchorSlots_ = m.bodyAnchors.slots();
+    anchorInfluences_ = DeformPass::anchorInfluencesOf(m.bodyAnchors);
   }
 
   const ModelUploads uploads(m, true);

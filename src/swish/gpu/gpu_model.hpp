@@ -37,7 +37,8 @@ class GpuModel {
   uint32_t codebookSize() const { return codebookSize_; }
   // The push-out's body anchors (`anchors`, DeformPass::packAnchors' layout).
   bool hasBodyAnchors() const { return anchorSlots_ > 0; }
-  uint32_t anchorSlots() const { return anchorSlots_; }  // BodyAnchors::slots()
+  uint32_t anchorSlots() const { return anchorSlots_; }            // BodyAnchors::slots()
+  uint32_t anchorInfluences() const { return anchorInfluences_; }  // DeformPass::anchorInfluencesOf
 
   // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
   // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
@@ -51,7 +52,7 @@ class GpuModel {
 
  private:
   std::string name_;
-  uint32_t anchorSlots_ = 0;
+  uint32_t anchorSlots_ = 0, anchorInfluences_ = 1;
   uint32_t vertexCount_ = 0, triangleCount_ = 0, jointCount_ = 0, meshComponents_ = 0, kernelComponents_ = 1;
   uint32_t influences_ = 1;
   bool hasUvs_ = false;
