@@ -28,8 +28,8 @@
 // vertex is kept outside its body anchors' balls, one after the other (the first anchor, then the
 // second and the third where the model has them). Each anchor (rest centre, reach, four influences) is loaded once
 // per thread with the rest of the vertex, and its centre skinned per instance with the instance's
-// matrix rows like the vertex itself: 12 more texel fetches and a 3x4 blend per anchor, vertex and
-// instance, no per-frame input. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
+// matrix rows like the vertex itself: 3 more texel fetches per influence and a 3x4 blend per anchor,
+// vertex and instance, no per-frame input. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
 // uniform, so a frame without the push-out skips it in uniform branches on a GPU. Lavapipe runs uniform
 // branches masked, i.e. pays for the push-out in every frame, so the code exists only in the pipelines
 // made for it: ANCHOR_SETS (a specialisation constant, the model's sets) bounds the unrolled loops, and

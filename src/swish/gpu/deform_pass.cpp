@@ -135,9 +135,9 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
   const char* shader = basisTexels_ ? "deform_basis_texels.comp" : "deform.comp";
   // Specialisation constants: workgroup size, K, influences, skinning, bands and their groups (band 0: K),
   // anchor sets.
-  for (const uint32_t sets : {0u, anchorSets}) {
-    const size_t i = sets > 0 ? 1 : 0;
-    if (i == 1 && sets == 0) break;
+  const std::array<uint32_t, 2> setsOf = {0u, anchorSets};  // pipelines [0] and, with anchor sets, [1]
+  for (size_t i = 0; i < (anchorSets > 0 ? 2u : 1u); ++i) {
+    const uint32_t sets = setsOf[i];
     std::vector<uint32_t> spec = {kWorkgroupSize,  k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u, sets,
                                   anchorInfluences};
     pipeline_[i] = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
