@@ -379,6 +379,18 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// `count` mesh PCA weights drawn from a standard normal (the default model's weights are of that size).
+std::vector<float> randomMeshWeights(size_t count, Rng& rng) {
+  std::vector<float> w(count);
+  for (auto& x : w) x = float(rng.normal());
+  return w;
+}
+
+// The deform's output for `instances` instances of model g.
+gpu::Buffer positionsBuffer(gpu::Context& ctx, const gpu::GpuModel& g, uint32_t instances) {
+  return gpu::Buffer(ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal, "positions");
+}
+
 // The skinning matrix rows of `instances` random poses of `skeleton` (0.3 rad per joint), on the device.
 gpu::Buffer randomPoseMatrices(gpu::Context& ctx, const Skeleton& skeleton, uint32_t instances, Rng& rng) {
   std::vector<Mat4f> mats;
@@ -424,13 +436,11 @@ void BM_DeformLevels(benchmark::State& state) {
   const gpu::GpuModel& g = *dm->gpu;
   const uint32_t instances = 22, k = g.kernelMeshComponents();
   Rng rng(21);
-  std::vector<float> w(size_t(instances) * k);
-  for (auto& x : w) x = float(rng.normal());
+  const std::vector<float> w = randomMeshWeights(instances * k, rng);
   const gpu::Buffer matrices = randomPoseMatrices(*ctx, dm->model.skeleton, instances, rng);
-  gpu::Buffer positions(*ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal,
-                        "positions");
-  // As FrameRecorder makes it: the basis as texels where the device allows.
-  const gpu::DeformPass pass(*ctx, k, g.influences(), true, g.basis.size() / sizeof(float));
+  const gpu::Buffer positions = positionsBuffer(*ctx, g, instances);
+  // As FrameRecorder makes it (the frames here have no push-out).
+  const gpu::DeformPass pass = g.makeDeformPass(*ctx);
   struct Run {
     gpu::Buffer weights, order;
     gpu::DescriptorBinding inputs;
@@ -495,17 +505,14 @@ void BM_DeformPushOutDefaultModel(benchmark::State& state) {
   if (!g.hasBodyAnchors()) return state.SkipWithError("the default model has no body anchors");
   const uint32_t instances = uint32_t(state.range(0)), k = g.kernelMeshComponents();
   Rng rng(23);
-  std::vector<float> w(size_t(instances) * k);
-  for (auto& x : w) x = float(rng.normal());
+  const std::vector<float> w = randomMeshWeights(instances * k, rng);
   std::vector<float> rows(gpu::DeformPass::weightsBytes(instances, k) / 4);
   gpu::DeformPass::packWeights(w.data(), instances, k, rows.data());
   gpu::Buffer weights(*ctx, rows.size() * 4, gpu::MemoryKind::DeviceLocal, "weights");
   weights.upload(*ctx, rows.data(), rows.size() * 4);
   const gpu::Buffer matrices = randomPoseMatrices(*ctx, dm->model.skeleton, instances, rng);
-  gpu::Buffer positions(*ctx, VkDeviceSize(instances) * g.vertexCount() * 12, gpu::MemoryKind::DeviceLocal,
-                        "positions");
-  const gpu::DeformPass pass(*ctx, k, g.influences(), true, g.basis.size() / sizeof(float), g.anchorSlots(),
-                             g.anchorInfluences());
+  const gpu::Buffer positions = positionsBuffer(*ctx, g, instances);
+  const gpu::DeformPass pass = g.makeDeformPass(*ctx);
   const gpu::DescriptorBinding inputs = pass.bindInstanceInputs(*ctx, weights, matrices, &g.basis, &g.anchors);
   timePushOut(state, *ctx, pass, g, g.deformArgs(inputs.get(), positions, instances));
 }

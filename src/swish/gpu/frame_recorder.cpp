@@ -22,8 +22,7 @@ FrameRecorder::FrameRecorder(Context& ctx, const GpuModel& model, uint32_t capac
       capacity_(capacity),
       tangentFrames_(o.tangentFrames),
       normalMaps_(o.normalMaps && model.hasNormalMaps()),
-      deform_(ctx, model.kernelMeshComponents(), model.influences(), true, model.basis.size() / sizeof(float),
-              model.anchorSlots(), model.anchorInfluences()) {
+      deform_(model.makeDeformPass(ctx)) {
   if (o.framesInFlight < 1 || o.framesInFlight > 8)
     throw Error("frame recorder: " + std::to_string(o.framesInFlight) + " frames in flight; supported: 1..8");
   if (capacity == 0) throw Error("frame recorder: the instance capacity must be at least 1");

@@ -154,6 +154,11 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
   }
 }
 
+DeformPass GpuModel::makeDeformPass(Context& ctx) const {
+  return DeformPass(ctx, kernelComponents_, influences_, true, basis.size() / sizeof(float), anchorSlots_,
+                    anchorInfluences_);
+}
+
 DeformPass::Args GpuModel::deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut,
                                       uint32_t instances) const {
   DeformPass::Args a;

@@ -43,6 +43,9 @@ class GpuModel {
   // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
   // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
   DeformPass::Args deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut, uint32_t instances) const;
+  // The deform pass this model runs with (as FrameRecorder makes it): its K and influences, skinning on, the
+  // basis and anchors as texels where the device allows, its anchor sets and anchor influences.
+  DeformPass makeDeformPass(Context& ctx) const;
 
   Buffer mean, basis, skinJoints, skinWeights;
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;

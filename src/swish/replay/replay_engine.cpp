@@ -186,7 +186,8 @@ void ReplayEngine::Impl::setUp() {
         B.bodyCharacter.reset();
       }
       if (B.bodyCharacter) {
-        const bake::BodyCollider prototype(B.bodyCharacter->body, 0.05f, "model '" + B.planned->model + "' body");
+        const bake::BodyCollider prototype(B.bodyCharacter->body, bake::kPenetrationCellSize,
+                                           "model '" + B.planned->model + "' body");
         B.colliders.assign(B.planned->characters.size(), prototype);
       }
     }

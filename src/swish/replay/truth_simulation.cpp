@@ -173,7 +173,7 @@ void ModelTruth::prepare(const ModelEntry& entry, const TruthOptions& options) {
     return;
   }
   if (character_->body.triangleCount() > 0)
-    body_ = std::make_unique<const bake::BodyCollider>(character_->body, 0.05f, "truth body");
+    body_ = std::make_unique<const bake::BodyCollider>(character_->body, bake::kPenetrationCellSize, "truth body");
   std::string mapNote;
   normalMaps_ = options.normalMaps && !entry.model.normalMaps.empty();
   if (normalMaps_ && (ps.transfer.normalMap.width != entry.model.normalMaps.width ||

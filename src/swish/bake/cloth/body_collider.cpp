@@ -209,7 +209,7 @@ void BodyCollider::rebuild() {
     if (pass == 1) {
       for (size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
       cellTriangles_.resize(cellStart_[cells]);
-      for (auto& a : cellSpheres_) a.assign(cellStart_[cells] + kSpherePadding, 0.f);
+      for (auto& a : cellSpheres_) a.assign(cellStart_[cells] + kSphereLanes, 0.f);
       fill.assign(cellStart_.begin(), cellStart_.end() - 1);
     }
     for (size_t t = 0; t < nt; ++t) {
@@ -289,32 +289,34 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
     return d * d;
   };
   // Sphere reject on squared distances (no square root): |p - centre| > maxDistance + r. Bit j of the
-  // answer: sphere i0 + j passes (is not rejected); kSphereLanes at a time, each lane computing what the
-  // scalar expression does, in the same order (the arrays are padded, the caller masks the lanes past a
-  // cell's end).
+  // answer: sphere i0 + j passes (is not rejected), and centreSq[j] is its |p - centre|^2 for the bound
+  // reject below; kSphereLanes at a time, each lane computing what the scalar expression does, in the same
+  // order (the arrays are padded, the caller masks the lanes past a cell's end).
   const float* const sx = cellSpheres_[0].data();
   const float* const sy = cellSpheres_[1].data();
   const float* const sz = cellSpheres_[2].data();
   const float* const sr = cellSpheres_[3].data();
-  auto centreSqOf = [&](uint32_t i) { return (p - Vec3f(sx[i], sy[i], sz[i])).squaredNorm(); };
 #if defined(__SSE2__)
   const __m128 px = _mm_set1_ps(p.x()), py = _mm_set1_ps(p.y()), pz = _mm_set1_ps(p.z());
   const __m128 maxD = _mm_set1_ps(maxDistance), onePlusSlack = _mm_set1_ps(1.f + kSlack),
                slackSq = _mm_set1_ps(kSlack * kSlack);
-  auto passing = [&](uint32_t i0) -> uint32_t {
+  auto passing = [&](uint32_t i0, float* centreSqOut) -> uint32_t {
     const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(sx + i0)), dy = _mm_sub_ps(py, _mm_loadu_ps(sy + i0)),
                  dz = _mm_sub_ps(pz, _mm_loadu_ps(sz + i0));
     const __m128 centreSq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
     const __m128 reach = _mm_add_ps(maxD, _mm_loadu_ps(sr + i0));
     const __m128 bound = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(reach, reach), onePlusSlack), slackSq);
+    _mm_storeu_ps(centreSqOut, centreSq);
     return uint32_t(_mm_movemask_ps(_mm_cmpngt_ps(centreSq, bound)));
   };
 #else
-  auto passing = [&](uint32_t i0) -> uint32_t {
+  auto passing = [&](uint32_t i0, float* centreSqOut) -> uint32_t {
     uint32_t bits = 0;
     for (uint32_t j = 0; j < kSphereLanes; ++j) {
-      const float reach = maxDistance + sr[i0 + j];
-      if (!(centreSqOf(i0 + j) > reach * reach * (1.f + kSlack) + kSlack * kSlack)) bits |= 1u << j;
+      const uint32_t i = i0 + j;
+      const float reach = maxDistance + sr[i];
+      centreSqOut[j] = (p - Vec3f(sx[i], sy[i], sz[i])).squaredNorm();
+      if (!(centreSqOut[j] > reach * reach * (1.f + kSlack) + kSlack * kSlack)) bits |= 1u << j;
     }
     return bits;
   };
@@ -323,11 +325,12 @@ size_t BodyCollider::closestKeyed(const Vec3f& p, float maxDistance, std::span<H
   auto visitCell = [&](size_t c) {
     const uint32_t begin = cellStart_[c], end = cellStart_[c + 1];
     for (uint32_t i0 = begin; i0 < end; i0 += kSphereLanes) {
-      uint32_t bits = passing(i0);
+      float centreSqs[kSphereLanes];
+      uint32_t bits = passing(i0, centreSqs);
       if (end - i0 < kSphereLanes) bits &= (1u << (end - i0)) - 1u;
       for (; bits != 0; bits &= bits - 1u) {
-        const uint32_t i = i0 + uint32_t(std::countr_zero(bits));
-        const float centreSq = centreSqOf(i), radius = sr[i];
+        const uint32_t lane = uint32_t(std::countr_zero(bits)), i = i0 + lane;
+        const float centreSq = centreSqs[lane], radius = sr[i];
         const uint32_t t = cellTriangles_[i];
         // Met in another cell already: computed, or rejected below by what stays true for this query (the
         // part filters, and a part's best answer, which only shrinks).

@@ -127,8 +127,8 @@ class BodyCollider {
   std::vector<Vec3f> faceNormals_, vertexNormals_, edgeNormals_;
   // The bounding sphere (centre xyz, radius) of each of a cell's triangles, in cellTriangles_' order: a
   // cheap reject before the exact test, read in a row instead of one cache line per triangle. Stored
-  // as four arrays (kSpherePadding floats longer) so that a query rejects kSphereLanes at a time.
-  static constexpr uint32_t kSphereLanes = 4, kSpherePadding = kSphereLanes;
+  // as four arrays (kSphereLanes floats longer) so that a query rejects kSphereLanes at a time.
+  static constexpr uint32_t kSphereLanes = 4;
   std::array<std::vector<float>, 4> cellSpheres_;
   Vec3f gridOrigin_ = Vec3f::Zero();
   Eigen::Vector3i gridDims_ = Eigen::Vector3i::Zero();

@@ -83,7 +83,7 @@ BakeEvaluation evaluateModel(const Model& model, const std::vector<const Dataset
   BakeEvaluation ev;
   std::optional<BodyCollider> collider;
   if (body && body->triangleCount() > 0) {
-    collider.emplace(*body, 0.05f, "bake evaluation: body");
+    collider.emplace(*body, kPenetrationCellSize, "bake evaluation: body");
     ev.penetrationMeasured = true;
   }
   ev.pushOut = !model.bodyAnchors.empty();

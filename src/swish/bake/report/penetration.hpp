@@ -17,6 +17,9 @@ inline constexpr double kVisiblePenetrationMm = 2.0;
 // human body's surface, and the grid search stays local.
 inline constexpr float kPenetrationSearch = 0.15f;
 inline constexpr float kPenetrationNearSearch = 0.03f;  // tried first
+// Grid cell (metres) of the body collider the measures above search (the bake's evaluation, the replay's
+// penetration and its truth split).
+inline constexpr float kPenetrationCellSize = 0.05f;
 
 struct PenetrationStats {
   uint32_t vertices = 0;  // garment vertices measured
