@@ -26,21 +26,26 @@
 //
 // The push-out (runtime/reference_push_out.hpp, the specification): after skinning, each instance's
 // vertex is kept outside its body anchors' balls, one after the other (the first anchor, then the
-// second and the third where the model has them). Each anchor (rest centre, reach, four influences) is loaded once
+// second and the third where the model has them). Each anchor (rest centre, reach, weights) is loaded once
 // per thread with the rest of the vertex, and its centre skinned per instance with the instance's
-// matrix rows like the vertex itself: 3 more texel fetches per influence and a 3x4 blend per anchor,
-// vertex and instance, no per-frame input. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
+// matrix rows like the vertex itself, no per-frame input. The matrices come from the vertex's push-out
+// joint table: its own skin joints, whose rows the skinning fetches anyway, then ANCHOR_EXTRA_JOINTS
+// more (a specialisation constant: the most any vertex of the model needs, DeformPass::
+// anchorExtraJointsOf). Each anchor's weights are over the table's slots (DeformPass::packAnchors
+// places them), so a frame fetches 3 texels per extra slot and instance, not 3 per influence of every
+// anchor: on the committed model 6 fetches instead of 27, for a blend over 6 slots instead of 3
+// influences (87 % of its vertices' anchors use only their own skin joints; 2 extra slots at most).
+// The sum runs in slot order, not in the anchor's rank order: within the rounding the conformance
+// test allows. An indexed fetch from the table (a slot number per influence) would keep the order,
+// but lavapipe makes such arrays scratch memory: that measured 3x the push-out's cost. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
 // uniform, so a frame without the push-out skips it in uniform branches on a GPU. Lavapipe runs uniform
 // branches masked, i.e. pays for the push-out in every frame, so the code exists only in the pipelines
 // made for it: ANCHOR_SETS (a specialisation constant, the model's sets) bounds the unrolled loops, and
 // DeformPass records a frame without the push-out with the pipeline of ANCHOR_SETS 0, the kernel without
-// it (the honest baseline of its cost, too). An anchor's influences come ranked, and the fit gives none
-// more than three (most one or two): ANCHOR_INFLUENCES, the most any anchor of the model uses
-// (DeformPass::anchorInfluencesOf), bounds the blend, whose later weights are all zero and which the
-// reference skips, so the result is the same. deform_basis_texels.comp
-// loads each anchor as three uvec4 texels (binding 3; the floats' bits through uintBitsToFloat, exact):
-// through the address the 12 words were 12 scalar loads, lane by lane on lavapipe, and those 36 loads
-// a vertex were most of the push-out's cost there (docs/performance.md, "Deform").
+// it (the honest baseline of its cost, too; made with no extra joints). deform_basis_texels.comp
+// loads the anchors as uvec4 texels (binding 3; the floats' bits through uintBitsToFloat, exact):
+// through the address each word is a scalar load, lane by lane on lavapipe (docs/performance.md,
+// "Deform").
 //
 // Loops over K and the influences are unrolled ([[unroll]]; both are specialisation constants), so
 // that the per-thread basis and skin arrays stay in registers instead of indexed scratch memory.
@@ -74,14 +79,17 @@ layout(constant_id = 6) const uint BAND2 = 0;           //  band 0 reads all K4;
 layout(constant_id = 7) const uint BAND3 = 0;           //  are unused)
 layout(constant_id = 8) const uint BAND4 = 0;
 layout(constant_id = 9) const uint ANCHOR_SETS = 0;     // anchor sets the kernel can push out of, 0..3
-layout(constant_id = 10) const uint ANCHOR_INFLUENCES = 4;  // leading anchor influences any anchor uses, 1..4
+layout(constant_id = 10) const uint ANCHOR_EXTRA_JOINTS = 0;  // push-out table slots after the skin joints
+const uint SLOTS = INFLUENCES + ANCHOR_EXTRA_JOINTS;          // the push-out joint table (the skin's alone: none)
+const uint EXTRA_TEXELS = (ANCHOR_EXTRA_JOINTS + 3u) / 4u;     // per vertex, before the sets (layout: swish_layouts.h)
+const uint SET_TEXELS = 1u + (SLOTS + 3u) / 4u;                // per vertex and set: centre + reach, weights
 
 layout(push_constant) uniform Push { DeformParams p; };
 layout(set = 0, binding = 0) uniform samplerBuffer weightTexels;  // vec4[instance][K4 / 4]
 layout(set = 0, binding = 1) uniform samplerBuffer matrixRows;  // vec4[instance][joint][3] (rows 0..2)
 #ifdef SWISH_DEFORM_BASIS_TEXELS
 layout(set = 0, binding = 2) uniform samplerBuffer basisTexels;  // float[K][3N]
-layout(set = 0, binding = 3) uniform usamplerBuffer anchorTexels;  // uvec4[set][N][SWISH_ANCHOR_WORDS / 4]
+layout(set = 0, binding = 3) uniform usamplerBuffer anchorTexels;  // uvec4: the body anchors' layout
 #endif
 const uint K4 = (K + 3u) / 4u;
 
@@ -89,21 +97,19 @@ const uint K4 = (K + 3u) / 4u;
 uint v;
 vec3 mean;
 float basis[3 * K];
-uint joints[INFLUENCES];
+uint joints[SLOTS];  // its push-out joint table: the skin joints, then the extra ones
 float skinW[INFLUENCES];
 // Its body anchors (p.pushOut of them, at most SWISH_MAX_ANCHOR_SLOTS: the first, the second, the third).
 vec3 anchorC[SWISH_MAX_ANCHOR_SLOTS];   // each ball's centre (rest)
 float anchorR[SWISH_MAX_ANCHOR_SLOTS];  // its reach (radius + clearance; 0: no anchor)
-uint anchorJ[SWISH_MAX_ANCHOR_SLOTS][4];
-float anchorW[SWISH_MAX_ANCHOR_SLOTS][4];
+float anchorW[SWISH_MAX_ANCHOR_SLOTS][SLOTS];  // its weights over the table's slots
 
-// The blend of `count` skinning matrices of `instance` (weights w, joints j; a zero weight is skipped by
-// a select, as in the reference), as the columns b0..b3 of its top three rows.
-#define SWISH_BLEND_MATRICES(count, J, W, b0, b1, b2, b3)                                              \
+// The blend of the first `count` table matrices of this instance (rows r0..r2 per slot; weights W; a
+// zero weight is skipped by a select, as in the reference), as the columns b0..b3 of its top three rows.
+#define SWISH_BLEND_MATRICES(count, W, b0, b1, b2, b3)                                                 \
   [[unroll]] for (uint i = 0u; i < count; ++i) {                                                       \
-    const int m = int((instance * p.jointCount + J[i]) * 3u);                                          \
     const float w = W[i];                                                                              \
-    const vec4 r0 = texelFetch(matrixRows, m), r1 = texelFetch(matrixRows, m + 1), r2 = texelFetch(matrixRows, m + 2); \
+    const vec4 r0 = rows0[i], r1 = rows1[i], r2 = rows2[i];                                            \
     const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w); \
     const bool use = w != 0.0;                                                                         \
     b0 = use ? b0 + w * c0 : b0;                                                                       \
@@ -127,22 +133,28 @@ void deformInstance(const uint instance, const uint groups) {
   }
   precise vec3 y = x;
   if (APPLY_SKINNING) {
-    // Each matrix comes as its top three rows (3 fetches); the columns summed below are their
-    // components. The zero-weight skip is a select, not a branch: every lane runs the same fetches
-    // (lavapipe gathers per lane, masked branches do not save that), and a skipped matrix still
-    // cannot bring its NaN/Inf in.
+    // Each table matrix comes as its top three rows (3 fetches, once per instance for the skinning
+    // and the anchors alike); the columns summed below are their components. The zero-weight skip is
+    // a select, not a branch: every lane runs the same fetches (lavapipe gathers per lane, masked
+    // branches do not save that), and a skipped matrix still cannot bring its NaN/Inf in.
+    vec4 rows0[SLOTS], rows1[SLOTS], rows2[SLOTS];
+    [[unroll]] for (uint i = 0u; i < SLOTS; ++i) {
+      const int m = int((instance * p.jointCount + joints[i]) * 3u);
+      rows0[i] = texelFetch(matrixRows, m);
+      rows1[i] = texelFetch(matrixRows, m + 1);
+      rows2[i] = texelFetch(matrixRows, m + 2);
+    }
     precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
-    SWISH_BLEND_MATRICES(INFLUENCES, joints, skinW, b0, b1, b2, b3)
+    SWISH_BLEND_MATRICES(INFLUENCES, skinW, b0, b1, b2, b3)
     y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
-  }
-  if (APPLY_SKINNING) {  // (character space: after skinning only)
+    // The push-out (character space: after skinning only).
     [[unroll]] for (uint a = 0u; a < ANCHOR_SETS; ++a) {
       // p.pushOut is uniform; a vertex without an anchor in this set (reach 0: 89 of the default jersey's
       // 3213 in the second set, which holds its slide anchors too) skips the blend, which could not move it. On a GPU whole subgroups of
       // such vertices do; lavapipe runs it masked as before.
       if (a < p.pushOut && anchorR[a] != 0.0) {
         precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
-        SWISH_BLEND_MATRICES(ANCHOR_INFLUENCES, anchorJ[a], anchorW[a], a0, a1, a2, a3)
+        SWISH_BLEND_MATRICES(SLOTS, anchorW[a], a0, a1, a2, a3)
         precise const vec3 c = ((a0 * anchorC[a].x + a1 * anchorC[a].y) + a2 * anchorC[a].z) + a3;
         precise const vec3 e = y - c;
         precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;
@@ -194,40 +206,30 @@ void main() {
     joints[i] = jointBuf.v[v * INFLUENCES + i];
     skinW[i] = skinWeightBuf.v[v * INFLUENCES + i];
   }
-#ifndef SWISH_DEFORM_BASIS_TEXELS
-  FloatsIn anchorF = FloatsIn(p.anchors);
-  UintsIn anchorU = UintsIn(p.anchors);
-#endif
-  [[unroll]] for (uint a = 0u; a < ANCHOR_SETS; ++a) {
-    if (a < p.pushOut) {
+  // The anchors (layout: swish_layouts.h): the table's extra joints, then each set's centre, reach and
+  // weights. Texels: the words' bits, floats through uintBitsToFloat (exact).
 #ifdef SWISH_DEFORM_BASIS_TEXELS
-      // Three whole texels per anchor (the words' bits, floats through uintBitsToFloat: exact).
-      const int t = int((a * p.vertexCount + v) * (SWISH_ANCHOR_WORDS / 4u));
-      const uvec4 c4 = texelFetch(anchorTexels, t), w4 = texelFetch(anchorTexels, t + 1), j4 = texelFetch(anchorTexels, t + 2);
-      anchorC[a] = uintBitsToFloat(c4.xyz);
-      anchorR[a] = uintBitsToFloat(c4.w);
-      [[unroll]] for (uint i = 0u; i < 4u; ++i) {
-        anchorW[a][i] = uintBitsToFloat(w4[i]);
-        anchorJ[a][i] = j4[i];
-      }
+#define SWISH_ANCHOR_TEXEL(t) texelFetch(anchorTexels, int(t))
 #else
-      const uint o = (a * p.vertexCount + v) * SWISH_ANCHOR_WORDS;
-      anchorC[a] = vec3(anchorF.v[o], anchorF.v[o + 1u], anchorF.v[o + 2u]);
-      anchorR[a] = anchorF.v[o + 3u];
-      [[unroll]] for (uint i = 0u; i < 4u; ++i) {
-        anchorW[a][i] = anchorF.v[o + 4u + i];
-        anchorJ[a][i] = anchorU.v[o + 8u + i];
-      }
+  UintsIn anchorU = UintsIn(p.anchors);
+#define SWISH_ANCHOR_TEXEL(t) uvec4(anchorU.v[4u * (t)], anchorU.v[4u * (t) + 1u], anchorU.v[4u * (t) + 2u], anchorU.v[4u * (t) + 3u])
 #endif
-    } else {
-      anchorC[a] = vec3(0.0);
-      anchorR[a] = 0.0;
-      [[unroll]] for (uint i = 0u; i < 4u; ++i) {
-        anchorW[a][i] = 0.0;
-        anchorJ[a][i] = 0u;
-      }
-    }
+  // (Every loop below has a constant trip count and constant indices once unrolled: an index the
+  // compiler cannot fold would put these arrays in scratch memory.)
+  if (ANCHOR_EXTRA_JOINTS > 0u) {
+    uvec4 j4[(ANCHOR_EXTRA_JOINTS + 4u) / 4u];  // (EXTRA_TEXELS used; never sized 0, even where unused)
+    [[unroll]] for (uint q = 0u; q < EXTRA_TEXELS; ++q) j4[q] = p.pushOut > 0u ? SWISH_ANCHOR_TEXEL(v * EXTRA_TEXELS + q) : uvec4(0u);
+    [[unroll]] for (uint e = 0u; e < ANCHOR_EXTRA_JOINTS; ++e) joints[INFLUENCES + e] = j4[e / 4u][e % 4u];
   }
+  [[unroll]] for (uint a = 0u; a < ANCHOR_SETS; ++a) {
+    uvec4 t4[SET_TEXELS];  // centre + reach, then the weights
+    const uint t = p.vertexCount * EXTRA_TEXELS + (a * p.vertexCount + v) * SET_TEXELS;
+    [[unroll]] for (uint q = 0u; q < SET_TEXELS; ++q) t4[q] = a < p.pushOut ? SWISH_ANCHOR_TEXEL(t + q) : uvec4(0u);
+    anchorC[a] = uintBitsToFloat(t4[0].xyz);
+    anchorR[a] = uintBitsToFloat(t4[0].w);
+    [[unroll]] for (uint i = 0u; i < SLOTS; ++i) anchorW[a][i] = uintBitsToFloat(t4[1u + i / 4u][i % 4u]);
+  }
+#undef SWISH_ANCHOR_TEXEL
 
   if (BANDS == 1u) {  // every instance at K4 groups, in order
     for (uint instance = 0u; instance < p.instanceCount; ++instance) deformInstance(instance, K4);

@@ -12,8 +12,13 @@
 //   instance order    : uint[instance], the instances band by band (deform quality levels, deform.glsl)
 //   skin matrix rows  : vec4[instance][joint][3], rows 0..2 of each affine skinning matrix (texels)
 //   skin joints       : uint[vertex][influences];  skin weights: float[vertex][influences]
-//   body anchors      : word[set][vertex][SWISH_ANCHOR_WORDS]: float ball centre xyz (rest), float reach
-//                       (radius + clearance), float weights[4], uint joints[4] (BodyAnchor; all 0: none)
+//   body anchors      : uvec4 texels (words, 4 a texel). First, per vertex, its push-out joint table's
+//                       extra joints: uint[vertex][XT * 4] (XT = ceil(E / 4), E extra joints, unused ones
+//                       0). The table is the vertex's skin joints (slots 0..influences-1), then those E.
+//                       Then per anchor set: [set][vertex][ST] texels, ST = 1 + ceil(T / 4) (T = influences
+//                       + E table slots): float ball centre xyz (rest), float reach (radius + clearance;
+//                       0: no anchor), then float weights[T] over the table's slots (zero padded).
+//                       DeformPass::packAnchors writes it.
 //   triangles         : uint[triangle][3];  adjacency: CSR offsets uint[N+1], triangles uint[]
 //   VQ codebook       : int8[entry][16 texels][2] read as uint words (2 texels per word)
 //   VQ indices        : uint16[map][block] read as uint words (2 indices per word, little-endian)
@@ -39,9 +44,10 @@ struct alignas(8) Address {
 // hundred they would spill).
 #define SWISH_MAX_MESH_COMPONENTS 256
 
-// 32-bit words per vertex of the body-anchor buffer (layout above), and the most anchor sets in it.
-#define SWISH_ANCHOR_WORDS 12
+// The most anchor sets in the body-anchor buffer (layout above), and the most extra joints a vertex's
+// push-out table may need: every influence of every set off the vertex's skin joints (3 sets x 4).
 #define SWISH_MAX_ANCHOR_SLOTS 3
+#define SWISH_MAX_ANCHOR_EXTRA_JOINTS 12
 
 // deform.comp: PCA reconstruction + linear blend skinning of `instanceCount` instances, then the
 // push-out of the body anchors' balls (runtime/reference_push_out.hpp). The mesh weights
@@ -55,7 +61,7 @@ struct DeformParams {
   SWISH_ADDRESS skinJoints;      // uint[N][influences]
   SWISH_ADDRESS skinWeights;     // float[N][influences]
   SWISH_ADDRESS positionsOut;    // float[instanceCount][N][3]
-  SWISH_ADDRESS anchors;         // word[pushOut][N][SWISH_ANCHOR_WORDS]: body anchors (unused when pushOut is 0)
+  SWISH_ADDRESS anchors;         // body anchors, the layout above (unused when pushOut is 0)
   SWISH_ADDRESS instanceOrder;   // uint[instanceCount]: instances by band (unused with one band)
   uint vertexCount;
   uint instanceCount;

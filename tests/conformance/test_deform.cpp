@@ -109,7 +109,7 @@ GpuDeformResult runDeform(gpu::Context& ctx, const DeformInputs& in, bool skinni
   const uint64_t basisFloats = uint64_t(m.meshPca.basis.size());
   const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), skinning, basisTexels ? basisFloats : 0);
   const uint64_t limit = ctx.properties().limits.maxTexelBufferElements;
-  EXPECT_EQ(pass.basisTexels(), basisTexels && basisFloats <= limit && gpu::DeformPass::anchorTexelsOf(n) <= limit);
+  EXPECT_EQ(pass.basisTexels(), basisTexels && basisFloats <= limit);  // (no anchor sets: no anchor texels)
   gpu::DeformPass::Args a;
   a.mean = mean.address();
   a.basis = basis.address();
@@ -439,6 +439,14 @@ TEST_F(DeformLevels, BadLevelsAreRejectedWithAReason) {
   EXPECT_NE(test::errorOf([&] { gpu::DeformPass(ctx(), 6, 4, true, 0, 4); }).find("4 body anchor sets"),
             std::string::npos);
   EXPECT_NE(test::errorOf([&] { gpu::DeformPass(ctx(), 6, 4, false, 0, 1); }).find("the push-out follows the skinning"),
+            std::string::npos);
+  // The push-out table: at most every influence of every set beyond the skin's joints, and none
+  // without anchor sets.
+  EXPECT_NE(test::errorOf([&] {
+              gpu::DeformPass(ctx(), 6, 4, true, 0, 3, 13);
+            }).find("13 push-out table joints beyond the skin's; supported: 0..12"),
+            std::string::npos);
+  EXPECT_NE(test::errorOf([&] { gpu::DeformPass(ctx(), 6, 4, true, 0, 0, 2); }).find("without anchor sets"),
             std::string::npos);
 }
 

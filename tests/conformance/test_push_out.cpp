@@ -28,14 +28,17 @@ using test::GuardedOutput;
 struct PushCase {
   uint32_t vertices, influences, instances;
   uint32_t sets = 1;  // anchor sets: 1, 2 (BodyAnchors::second too) or 3 (and BodyAnchors::third)
-  // Influences the anchors keep (the rest zeroed, the kept renormalised; the fit gives at most three):
-  // the kernel blends that many (DeformPass::anchorInfluencesOf).
+  // Influences the anchors keep (the rest zeroed, the kept renormalised; the fit gives at most three).
   uint32_t anchorInfluences = 4;
+  // Every anchor influence on one of the vertex's own skin joints, as most of a fitted model's are: the
+  // push-out table then has no extra joints (DeformPass::anchorExtraJointsOf 0). Otherwise the random
+  // anchors' later influences are on random joints, and the table has up to 3 per set.
+  bool onSkinJoints = false;
 };
 void PrintTo(const PushCase& c, std::ostream* os) {
   *os << c.vertices << " vertices, " << c.influences << " influences, " << c.instances << " instances"
       << ", " << c.sets << " anchor set" << (c.sets > 1 ? "s" : "") << ", " << c.anchorInfluences
-      << " anchor influences";
+      << " anchor influences" << (c.onSkinJoints ? " on the skin's joints" : "");
 }
 
 struct PushInputs {
@@ -57,6 +60,12 @@ PushInputs randomInputs(uint64_t seed, const PushCase& c) {
   spec.thirdAnchors = c.sets >= 3;
   PushInputs in;
   in.model = test::makeRandomModel(rng, spec);
+  const SkinWeights& skin = in.model.gameMesh.skin;
+  for (uint32_t s = 0; c.onSkinJoints && s < in.model.bodyAnchors.slots(); ++s)
+    for (size_t v = 0; v < skin.vertexCount(); ++v)
+      for (size_t i = 0; i < size_t(kAnchorInfluences); ++i)
+        in.model.bodyAnchors.slot(s)[v].joints[i] =
+            skin.joints[v * size_t(skin.influences) + (i + s) % size_t(skin.influences)];
   for (uint32_t s = 0; c.anchorInfluences < uint32_t(kAnchorInfluences) && s < in.model.bodyAnchors.slots(); ++s)
     for (BodyAnchor& a : in.model.bodyAnchors.slot(s)) {
       if (!a.present()) continue;
@@ -146,13 +155,14 @@ GpuResult runDeform(gpu::Context& ctx, const PushInputs& in, bool pushOut, bool 
   CheckedInput matrices(ctx, std::span<const float>(matrixRows), "skin matrices");
   CheckedInput skinJoints(ctx, std::span<const uint32_t>(joints), "skin joints");
   CheckedInput skinWeights(ctx, std::span<const float>(m.gameMesh.skin.weights), "skin weights");
-  const std::vector<uint32_t> anchorWords = gpu::DeformPass::packAnchors(m.bodyAnchors, uint32_t(m.skeleton.size()));
+  const std::vector<uint32_t> anchorWords =
+      gpu::DeformPass::packAnchors(m.bodyAnchors, m.gameMesh.skin, uint32_t(m.skeleton.size()));
   CheckedInput anchors(ctx, std::span<const uint32_t>(anchorWords), "body anchors");
   GuardedOutput out(ctx, size_t(in.instances) * n * 3 * sizeof(float), "deformed positions");
 
   const gpu::DeformPass pass(ctx, k, uint32_t(m.gameMesh.skin.influences), true,
                              modelTexels ? uint64_t(m.meshPca.basis.size()) : 0, m.bodyAnchors.slots(),
-                             gpu::DeformPass::anchorInfluencesOf(m.bodyAnchors));
+                             gpu::DeformPass::anchorExtraJointsOf(m.bodyAnchors, m.gameMesh.skin));
   EXPECT_EQ(pass.basisTexels(), modelTexels) << "this device cannot hold the test's basis and anchors as texels";
   gpu::DeformPass::Args a;
   a.mean = mean.address();
@@ -182,7 +192,8 @@ std::string caseName(const ::testing::TestParamInfo<PushCase>& info) {
   const auto& c = info.param;
   return "V" + std::to_string(c.vertices) + "_I" + std::to_string(c.influences) + "_N" + std::to_string(c.instances) +
          (c.sets > 1 ? "_Sets" + std::to_string(c.sets) : "") +
-         (c.anchorInfluences < 4 ? "_Anchor" + std::to_string(c.anchorInfluences) : "");
+         (c.anchorInfluences < 4 ? "_Anchor" + std::to_string(c.anchorInfluences) : "") +
+         (c.onSkinJoints ? "_OnSkin" : "");
 }
 
 class PushOutConformance : public test::GpuTest, public ::testing::WithParamInterface<PushCase> {};
@@ -203,8 +214,16 @@ TEST_P(PushOutConformance, PushedPositionsMatchReference) {
     EXPECT_GT(largest, 1e-3) << "the pushes move vertices by millimetres at least";
   }
 
-  // The kernel blends as many anchor influences as the anchors use.
-  EXPECT_EQ(gpu::DeformPass::anchorInfluencesOf(in.model.bodyAnchors), GetParam().anchorInfluences);
+  // The push-out table: none beyond the skin's joints where the anchors are on them; else some (the
+  // random anchors' later influences are on random joints), at most every influence of every set.
+  const uint32_t extra = gpu::DeformPass::anchorExtraJointsOf(in.model.bodyAnchors, in.model.gameMesh.skin);
+  if (GetParam().onSkinJoints) {
+    EXPECT_EQ(extra, 0u);
+  } else if (in.model.gameMesh.vertexCount() > 1 && GetParam().anchorInfluences > 1) {  // (the first is the skin's)
+    EXPECT_GT(extra, 0u);
+  }
+  EXPECT_LE(extra, GetParam().sets * GetParam().anchorInfluences);
+  std::printf("push-out table: %u joints beyond the skin's\n", extra);
   for (const bool texels : {true, false}) {
     SCOPED_TRACE(texels ? "basis and anchors as texels" : "basis and anchors through their addresses");
     const auto gpu = runDeform(ctx(), in, true, texels);
@@ -231,13 +250,14 @@ TEST_P(PushOutConformance, OffIsThePlainDeform) {
 
 // 1 vertex; a prime vertex count with the 22 instances of the default scene; 1 and 8 skin influences
 // (the anchors have 4 whatever the garment has); one anchor set, two and three; anchors of 3, 2 and 1
-// influences (the kernel's blend specialised to them).
+// influences; anchors on the skin's own joints only (a push-out table without extra joints).
 INSTANTIATE_TEST_SUITE_P(Sizes, PushOutConformance,
                          ::testing::Values(PushCase{1, 4, 1}, PushCase{97, 1, 3}, PushCase{997, 4, 22},
                                            PushCase{401, 8, 4}, PushCase{1, 4, 1, 2}, PushCase{97, 1, 3, 2},
                                            PushCase{997, 4, 22, 2}, PushCase{1, 4, 1, 3}, PushCase{97, 1, 3, 3},
                                            PushCase{997, 4, 22, 3}, PushCase{401, 8, 4, 3}, PushCase{997, 4, 22, 3, 3},
-                                           PushCase{401, 8, 4, 3, 2}, PushCase{97, 1, 3, 2, 1}),
+                                           PushCase{401, 8, 4, 3, 2}, PushCase{97, 1, 3, 2, 1},
+                                           PushCase{997, 4, 22, 3, 3, true}, PushCase{97, 1, 3, 3, 4, true}),
                          caseName);
 
 class PushOutSpecialCases : public test::GpuTest {};

@@ -73,49 +73,97 @@ void DeformPass::packSkinMatrices(const Mat4f* m, size_t count, float* out) {
       for (int c = 0; c < 4; ++c) out[12 * i + 4 * r + c] = m[i](r, c);
 }
 
-static_assert(SWISH_ANCHOR_WORDS == 4 + 2 * kAnchorInfluences, "shaders/swish_layouts.h: body anchor layout");
 static_assert(SWISH_MAX_ANCHOR_SLOTS == kMaxAnchorSlots, "shaders/swish_layouts.h: body anchor sets");
-static_assert(SWISH_ANCHOR_WORDS == 4 * DeformPass::kAnchorTexels, "shaders/swish_layouts.h: body anchor texels");
+static_assert(SWISH_MAX_ANCHOR_EXTRA_JOINTS == kMaxAnchorSlots * kAnchorInfluences,
+              "shaders/swish_layouts.h: push-out table joints");
 
-uint32_t DeformPass::anchorInfluencesOf(const BodyAnchors& anchors) {
-  uint32_t used = 1;
-  for (uint32_t s = 0; s < anchors.slots(); ++s)
-    for (const BodyAnchor& a : anchors.slot(s))
-      for (uint32_t i = used; i < uint32_t(kAnchorInfluences); ++i)
-        if (a.weights[i] != 0.f) used = i + 1;
-  return used;
+namespace {
+
+// Vertex v's push-out joint table beyond its skin joints (DeformPass::anchorExtraJointsOf), and the
+// table slot of each weighed anchor influence (slot[set][influence]; -1 for a zero weight).
+struct AnchorTable {
+  std::vector<uint32_t> extra;
+  std::array<std::array<int, kAnchorInfluences>, kMaxAnchorSlots> slot{};
+};
+AnchorTable anchorTable(const BodyAnchors& anchors, const SkinWeights& skin, size_t v) {
+  AnchorTable t;
+  const size_t influences = size_t(skin.influences);
+  for (uint32_t s = 0; s < anchors.slots(); ++s) {
+    const BodyAnchor& a = anchors.slot(s)[v];
+    for (size_t i = 0; i < size_t(kAnchorInfluences); ++i) {
+      int& at = t.slot[s][i];
+      at = -1;
+      if (a.weights[i] == 0.f) continue;
+      for (size_t k = 0; k < influences && at < 0; ++k)
+        if (skin.joints[v * influences + k] == a.joints[i]) at = int(k);
+      for (size_t e = 0; e < t.extra.size() && at < 0; ++e)
+        if (t.extra[e] == a.joints[i]) at = int(influences + e);
+      if (at < 0) {
+        at = int(influences + t.extra.size());
+        t.extra.push_back(a.joints[i]);
+      }
+    }
+  }
+  return t;
 }
 
-std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, uint32_t jointCount) {
-  const size_t n = anchors.anchors.size();
-  std::vector<uint32_t> out(anchors.slots() * n * SWISH_ANCHOR_WORDS);
+void checkAnchorsMatchSkin(const BodyAnchors& anchors, const SkinWeights& skin) {
+  for (uint32_t s = 0; s < anchors.slots(); ++s)
+    if (anchors.slot(s).size() != skin.vertexCount() || skin.joints.size() != skin.weights.size())
+      throw Error("body anchors: the " + std::string(anchorSlotName(s)) + " set has " +
+                  std::to_string(anchors.slot(s).size()) + " anchors for " + std::to_string(skin.vertexCount()) +
+                  " skinned vertices");
+}
+
+}  // namespace
+
+uint32_t DeformPass::anchorExtraJointsOf(const BodyAnchors& anchors, const SkinWeights& skin) {
+  checkAnchorsMatchSkin(anchors, skin);
+  size_t most = 0;
+  for (size_t v = 0; !anchors.empty() && v < anchors.anchors.size(); ++v)
+    most = std::max(most, anchorTable(anchors, skin, v).extra.size());
+  return uint32_t(most);
+}
+
+std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, const SkinWeights& skin,
+                                              uint32_t jointCount) {
+  const uint32_t extra = anchorExtraJointsOf(anchors, skin), influences = uint32_t(skin.influences);
+  const size_t n = anchors.anchors.size(), extraWords = 4 * size_t((extra + 3) / 4),
+               setWords = 4 * size_t(1 + (influences + extra + 3) / 4);
+  std::vector<uint32_t> out(4 * anchorTexelsOf(n, influences, extra, anchors.slots()), 0u);
   auto put = [&](size_t at, float f) { std::memcpy(&out[at], &f, 4); };
-  for (size_t e = 0; e < anchors.slots() * n; ++e) {
-    const size_t v = e % n;
-    const BodyAnchor& a = anchors.slot(uint32_t(e / n))[v];
-    const size_t o = e * SWISH_ANCHOR_WORDS;
-    const Vec3f centre = a.present() ? a.centre() : Vec3f::Zero();
-    for (int k = 0; k < 3; ++k) put(o + size_t(k), centre[k]);
-    put(o + 3, a.present() ? a.reach() : 0.f);
-    for (size_t i = 0; i < size_t(kAnchorInfluences); ++i) {
-      if (a.joints[i] >= jointCount)
-        throw Error("body anchor of vertex " + std::to_string(v) + ": joint " + std::to_string(a.joints[i]) +
-                    " is not in the skeleton of " + std::to_string(jointCount) + " joints");
-      put(o + 4 + i, a.weights[i]);
-      out[o + 8 + i] = a.joints[i];
+  for (size_t v = 0; v < n; ++v) {
+    for (uint32_t s = 0; s < anchors.slots(); ++s)
+      for (const uint16_t j : anchors.slot(s)[v].joints)
+        if (j >= jointCount)
+          throw Error("body anchor of vertex " + std::to_string(v) + ": joint " + std::to_string(j) +
+                      " is not in the skeleton of " + std::to_string(jointCount) + " joints");
+    const AnchorTable t = anchorTable(anchors, skin, v);
+    std::copy(t.extra.begin(), t.extra.end(), out.begin() + std::ptrdiff_t(v * extraWords));
+    for (uint32_t s = 0; s < anchors.slots(); ++s) {
+      const BodyAnchor& a = anchors.slot(s)[v];
+      const size_t o = n * extraWords + (s * n + v) * setWords;
+      const Vec3f centre = a.present() ? a.centre() : Vec3f::Zero();
+      for (int k = 0; k < 3; ++k) put(o + size_t(k), centre[k]);
+      put(o + 3, a.present() ? a.reach() : 0.f);
+      std::vector<float> w(influences + extra, 0.f);
+      for (size_t i = 0; i < size_t(kAnchorInfluences); ++i)
+        if (t.slot[s][i] >= 0) w[size_t(t.slot[s][i])] += a.weights[i];
+      for (size_t i = 0; i < w.size(); ++i) put(o + 4 + i, w[i]);
     }
   }
   return out;
 }
 
 DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats,
-                       uint32_t anchorSets, uint32_t anchorInfluences)
+                       uint32_t anchorSets, uint32_t anchorExtraJoints)
     : basisTexels_(basisFloats > 0 &&
-                   std::max(basisFloats, anchorTexelsOf(basisFloats / (3 * uint64_t(std::max(k, 1u))))) <=
+                   std::max(basisFloats, anchorTexelsOf(basisFloats / (3 * uint64_t(std::max(k, 1u))), influences,
+                                                        anchorExtraJoints, anchorSets)) <=
                        ctx.properties().limits.maxTexelBufferElements),
       meshComponents_(k),
       anchorSets_(anchorSets),
-      anchorInfluences_(anchorInfluences) {
+      anchorExtraJoints_(anchorExtraJoints) {
   if (k < 1 || k > SWISH_MAX_MESH_COMPONENTS)
     throw Error("deform pass: " + std::to_string(k) + " mesh components; the kernel supports 1.." +
                 std::to_string(SWISH_MAX_MESH_COMPONENTS));
@@ -124,9 +172,12 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
   if (anchorSets > kMaxAnchorSlots)
     throw Error("deform pass: " + std::to_string(anchorSets) + " body anchor sets; supported: 0.." +
                 std::to_string(kMaxAnchorSlots));
-  if (anchorInfluences < 1 || anchorInfluences > uint32_t(kAnchorInfluences))
-    throw Error("deform pass: " + std::to_string(anchorInfluences) + " anchor influences; supported: 1.." +
-                std::to_string(kAnchorInfluences));
+  if (anchorExtraJoints > SWISH_MAX_ANCHOR_EXTRA_JOINTS)
+    throw Error("deform pass: " + std::to_string(anchorExtraJoints) +
+                " push-out table joints beyond the skin's; supported: 0.." +
+                std::to_string(SWISH_MAX_ANCHOR_EXTRA_JOINTS));
+  if (anchorExtraJoints > 0 && anchorSets == 0)
+    throw Error("deform pass: push-out table joints without anchor sets (a pass without the push-out takes none)");
   if (anchorSets > 0 && !applySkinning)
     throw Error("deform pass: the push-out follows the skinning; a pass without skinning takes no anchor sets");
   inputsLayout_ = DescriptorLayout(
@@ -134,12 +185,21 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
   bands_ = bandsOf(k);
   const char* shader = basisTexels_ ? "deform_basis_texels.comp" : "deform.comp";
   // Specialisation constants: workgroup size, K, influences, skinning, bands and their groups (band 0: K),
-  // anchor sets.
+  // anchor sets, the push-out table's extra joints (none in the pipelines without the push-out).
   const std::array<uint32_t, 2> setsOf = {0u, anchorSets};  // pipelines [0] and, with anchor sets, [1]
   for (size_t i = 0; i < (anchorSets > 0 ? 2u : 1u); ++i) {
     const uint32_t sets = setsOf[i];
-    std::vector<uint32_t> spec = {kWorkgroupSize,  k, influences, applySkinning ? 1u : 0u, 1u, 0u, 0u, 0u, 0u, sets,
-                                  anchorInfluences};
+    std::vector<uint32_t> spec = {kWorkgroupSize,
+                                  k,
+                                  influences,
+                                  applySkinning ? 1u : 0u,
+                                  1u,
+                                  0u,
+                                  0u,
+                                  0u,
+                                  0u,
+                                  sets,
+                                  sets > 0 ? anchorExtraJoints : 0u};
     pipeline_[i] = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
     spec[4] = uint32_t(bands_.size());
     for (size_t b = 1; b < bands_.size(); ++b) spec[4 + b] = bands_[b];

@@ -38,9 +38,8 @@ class DeformPass {
     VkDeviceAddress skinJoints = 0;    // uint[N][influences]
     VkDeviceAddress skinWeights = 0;   // float[N][influences]
     VkDeviceAddress positionsOut = 0;  // float[instances][N][3]
-    // The push-out: word[anchorSlots][N][SWISH_ANCHOR_WORDS], packAnchors' layout (the model's,
-    // GpuModel::anchors); 0: no push-out. Only with skinning applied (the anchors are skinned like the
-    // vertices). anchorSlots: the anchor sets in it (1 to 3: BodyAnchors::slots()).
+    // The push-out: packAnchors' words (the model's, GpuModel::anchors); 0: no push-out. Only with skinning applied
+    // (the anchors are skinned like the vertices). anchorSlots: the anchor sets in it (1 to 3: BodyAnchors::slots()).
     VkDeviceAddress anchors = 0;
     uint32_t anchorSlots = 1;
     VkDescriptorSet instanceInputs = VK_NULL_HANDLE;  // from bindInstanceInputs
@@ -94,37 +93,43 @@ class DeformPass {
   }
   // Writes `count` matrices (instance-major, as FrameKernelInputs holds them) in that layout.
   static void packSkinMatrices(const Mat4f* matrices, size_t count, float* out);
-  // The body anchors (each set's one per vertex, set after set) in the push-out's layout:
-  // word[BodyAnchors::slots()][N][SWISH_ANCHOR_WORDS], float ball
-  // centre xyz (BodyAnchor::centre()), reach (BodyAnchor::reach()), weights[4], then uint joints[4]. Throws Error
-  // naming the vertex for a joint
-  // >= jointCount (the kernel fetches every influence's matrix, even at weight 0).
-  static std::vector<uint32_t> packAnchors(const BodyAnchors& anchors, uint32_t jointCount);
-  // The texels (uvec4) of the most anchors `vertices` vertices can have: every set's, kAnchorTexels each
-  // (SWISH_ANCHOR_WORDS / 4, asserted in the .cpp).
-  static constexpr uint32_t kAnchorTexels = 3;
-  static uint64_t anchorTexelsOf(uint64_t vertices) { return vertices * kMaxAnchorSlots * kAnchorTexels; }
-  // The leading influences any anchor of every set gives a non-zero weight (1 to 4; 1 without anchors).
-  static uint32_t anchorInfluencesOf(const BodyAnchors& anchors);
+  // The push-out's joint table of a vertex: its skin joints (`skin.influences` slots, whatever their
+  // weights: the skinning fetches their matrices anyway), then the joints its anchors (every set's, in
+  // set order and then rank order) weigh that are not among them. The anchors' weights are placed on
+  // the table's slots, so the kernel fetches each matrix once per instance (deform.glsl). Extra joints
+  // the worst vertex needs (0 without anchors; at most SWISH_MAX_ANCHOR_EXTRA_JOINTS): the pass's
+  // anchorExtraJoints.
+  static uint32_t anchorExtraJointsOf(const BodyAnchors& anchors, const SkinWeights& skin);
+  // The body anchors in the push-out's layout (shaders/swish_layouts.h): per vertex its table's
+  // anchorExtraJointsOf extra joints (0 where a vertex needs fewer), then per set (BodyAnchors::slots()) and
+  // vertex the ball's centre xyz (BodyAnchor::centre()) and reach (BodyAnchor::reach()), and the
+  // anchor's weights over the table's slots. Throws Error naming the vertex for an anchor joint >=
+  // jointCount, or for anchors and skin of different vertex counts.
+  static std::vector<uint32_t> packAnchors(const BodyAnchors& anchors, const SkinWeights& skin, uint32_t jointCount);
+  // The texels (uvec4) of that layout for `vertices` vertices of `influences` skin influences, `extraJoints`
+  // table joints beyond them and `sets` anchor sets.
+  static uint64_t anchorTexelsOf(uint64_t vertices, uint32_t influences, uint32_t extraJoints, uint32_t sets) {
+    return vertices * ((extraJoints + 3) / 4 + uint64_t(sets) * (1 + (influences + extraJoints + 3) / 4));
+  }
 
   DeformPass() = default;
   // meshComponents (K) in 1..SWISH_MAX_MESH_COMPONENTS; influences in 1..8. applySkinning = false writes
   // the pre-skinning shape (used to check the PCA reconstruction on its own). basisFloats: 3N x K. The
   // model's streams, the basis and the body anchors, are read as texels (deform_basis_texels.comp) when
   // basisFloats is > 0 and both fit in the device's maxTexelBufferElements (the anchors as
-  // anchorTexelsOf(N)); else through Args::basis and Args::anchors (deform.comp). anchorSets (0 to
+  // anchorTexelsOf); else through Args::basis and Args::anchors (deform.comp). anchorSets (0 to
   // kMaxAnchorSlots): the most body anchor sets a frame pushes out of (the model's BodyAnchors::slots()).
   // The push-out's code is in the pipelines made for it only: a frame without it (Args::anchors 0) runs
   // the kernel without it, which lavapipe would otherwise run masked (deform.glsl).
-  // anchorInfluences (1 to 4): the leading influences the anchors use (anchorInfluencesOf); the blend of
-  // an anchor's matrices stops there, so an anchor with a non-zero weight beyond it would be wrong.
+  // anchorExtraJoints (0 to SWISH_MAX_ANCHOR_EXTRA_JOINTS, 0 without anchor sets): the push-out table's
+  // joints beyond the skin's (anchorExtraJointsOf the model's anchors, which packAnchors laid out for it).
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
-             uint64_t basisFloats = 0, uint32_t anchorSets = 0, uint32_t anchorInfluences = 4);
+             uint64_t basisFloats = 0, uint32_t anchorSets = 0, uint32_t anchorExtraJoints = 0);
   bool basisTexels() const { return basisTexels_; }
-  uint32_t meshComponents() const { return meshComponents_; }      // K of the pipeline
-  uint32_t anchorSets() const { return anchorSets_; }              // the most anchor sets a frame may apply
-  uint32_t anchorInfluences() const { return anchorInfluences_; }  // the anchor influences blended
-  const std::vector<uint32_t>& bands() const { return bands_; }    // bandsOf(K)
+  uint32_t meshComponents() const { return meshComponents_; }        // K of the pipeline
+  uint32_t anchorSets() const { return anchorSets_; }                // the most anchor sets a frame may apply
+  uint32_t anchorExtraJoints() const { return anchorExtraJoints_; }  // push-out table joints beyond the skin's
+  const std::vector<uint32_t>& bands() const { return bands_; }      // bandsOf(K)
 
   // The descriptor set of the per-instance inputs (both offsets 16-byte aligned, at least one instance)
   // and, where basisTexels(), of the model's basis (float[K][3N], required then, ignored otherwise) and
@@ -139,7 +144,7 @@ class DeformPass {
  private:
   bool basisTexels_ = false;
   uint32_t meshComponents_ = 0;
-  uint32_t anchorSets_ = 0, anchorInfluences_ = 4;
+  uint32_t anchorSets_ = 0, anchorExtraJoints_ = 0;
   std::vector<uint32_t> bands_;  // bandsOf(K)
   DescriptorLayout inputsLayout_;
   // [0]: without the push-out; [1]: with anchorSets_ sets (made where anchorSets_ > 0).

@@ -75,7 +75,7 @@ struct ModelUploads {
       add(&GpuModel::indices, "VQ indices", indices.data(), indices.size() * 2);
     }
     if (!m.bodyAnchors.empty()) {
-      anchors = DeformPass::packAnchors(m.bodyAnchors, uint32_t(m.skeleton.size()));
+      anchors = DeformPass::packAnchors(m.bodyAnchors, m.gameMesh.skin, uint32_t(m.skeleton.size()));
       add(&GpuModel::anchors, "body anchors", anchors.data(), anchors.size() * 4);
     }
   }
@@ -138,12 +138,12 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
       if (set.size() != n) fail(std::to_string(set.size()) + " " + what + "s for " + std::to_string(n) + " vertices");
       for (size_t v = 0; v < n; ++v)
         for (const uint16_t j : set[v].joints)
-          if (j >= jointCount_)  // the kernel fetches every influence's matrix, even at weight 0
+          if (j >= jointCount_)
             fail(what + " joint " + std::to_string(j) + " of vertex " + std::to_string(v) +
                  " is not in the skeleton of " + std::to_string(jointCount_) + " joints");
     }
     anchorSlots_ = m.bodyAnchors.slots();
-    anchorInfluences_ = DeformPass::anchorInfluencesOf(m.bodyAnchors);
+    anchorExtraJoints_ = DeformPass::anchorExtraJointsOf(m.bodyAnchors, g.skin);
   }
 
   const ModelUploads uploads(m, true);
@@ -156,7 +156,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
 
 DeformPass GpuModel::makeDeformPass(Context& ctx) const {
   return DeformPass(ctx, kernelComponents_, influences_, true, basis.size() / sizeof(float), anchorSlots_,
-                    anchorInfluences_);
+                    anchorExtraJoints_);
 }
 
 DeformPass::Args GpuModel::deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut,

@@ -37,25 +37,25 @@ class GpuModel {
   uint32_t codebookSize() const { return codebookSize_; }
   // The push-out's body anchors (`anchors`, DeformPass::packAnchors' layout).
   bool hasBodyAnchors() const { return anchorSlots_ > 0; }
-  uint32_t anchorSlots() const { return anchorSlots_; }            // BodyAnchors::slots()
-  uint32_t anchorInfluences() const { return anchorInfluences_; }  // DeformPass::anchorInfluencesOf
+  uint32_t anchorSlots() const { return anchorSlots_; }              // BodyAnchors::slots()
+  uint32_t anchorExtraJoints() const { return anchorExtraJoints_; }  // DeformPass::anchorExtraJointsOf
 
   // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
   // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
   DeformPass::Args deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut, uint32_t instances) const;
   // The deform pass this model runs with (as FrameRecorder makes it): its K and influences, skinning on, the
-  // basis and anchors as texels where the device allows, its anchor sets and anchor influences.
+  // basis and anchors as texels where the device allows, its anchor sets and push-out table (anchorExtraJoints).
   DeformPass makeDeformPass(Context& ctx) const;
 
   Buffer mean, basis, skinJoints, skinWeights;
   Buffer uvs, triangles, normalOffsets, normalTriangles, tangentOffsets, tangentTriangles;
   Buffer frameTriangles;  // TangentFramesPass::frameTriangles: the two-pass gather's one walk of both adjacencies
   Buffer codebook, indices;
-  Buffer anchors;  // word[anchorSlots()][N][SWISH_ANCHOR_WORDS]; empty without body anchors
+  Buffer anchors;  // DeformPass::packAnchors' words; empty without body anchors
 
  private:
   std::string name_;
-  uint32_t anchorSlots_ = 0, anchorInfluences_ = 1;
+  uint32_t anchorSlots_ = 0, anchorExtraJoints_ = 0;
   uint32_t vertexCount_ = 0, triangleCount_ = 0, jointCount_ = 0, meshComponents_ = 0, kernelComponents_ = 1;
   uint32_t influences_ = 1;
   bool hasUvs_ = false;
