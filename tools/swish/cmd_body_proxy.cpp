@@ -43,7 +43,8 @@ struct BodyProxyOptions {
   std::string model, out;
   float maxDistanceMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.maxDistance;
   float marginMm = 1000.f * swish::bake::BodyAnchorFitSettings{}.margin;
-  bool remove = false, oneAnchor = false, secondAtMargin = false, uncalibrated = false, noCover = false;
+  bool remove = false, oneAnchor = false, secondAtMargin = false, uncalibrated = false, noCover = false,
+       bodyJoints = false;
   std::vector<std::string> clips;
   size_t poses = 48;
   float toleranceMm = 1000.f * swish::bake::BodyAnchorCalibrationSettings{}.tolerance;
@@ -165,6 +166,7 @@ int runBodyProxy(const BodyProxyOptions& o) {
   s.margin = o.marginMm / 1000.f;
   s.secondAnchors = !o.oneAnchor;
   s.coverAnchors = !o.noCover;
+  s.garmentJoints = !o.bodyJoints;
   // The clips' simulated frames also show where the cloth slides over the body (the slide anchors); without
   // --clips there are none.
   SimulatedFrames sim;
@@ -193,6 +195,12 @@ int runBodyProxy(const BodyProxyOptions& o) {
         "%.0f mm or more, it covers %zu (%.1f %%).\n",
         fit.coverAnchored, fit.coverMisses, 1000.0 * double(s.slideMinGap), fit.coverCovered,
         fit.coverMisses ? 100.0 * double(fit.coverCovered) / double(fit.coverMisses) : 0.0);
+  if (s.garmentJoints)
+    std::printf(
+        "  anchors on the garment vertex's own joints: %zu anchors changed, %zu influences dropped (weight %.3f mean, "
+        "%.3f at most), %zu anchors left with none and removed.\n",
+        fit.garmentJointsChanged, fit.garmentJointsDropped, double(fit.garmentJointsMeanDropped),
+        double(fit.garmentJointsMaxDropped), fit.garmentJointsRemoved);
   BodyAnchors anchors = fit.anchors;
   nlohmann::json j = bake::toJson(fit);
   j["made_by"] = "swish body-proxy (after the bake)";
@@ -256,6 +264,10 @@ swish::cli::CommandRegistration reg{
       app.add_flag("--no-cover-anchors", o->noCover,
                    "with --clips: no third anchor set (format 1.4's push-out: the first set and the second, on another "
                    "part or where the cloth slid farthest)");
+      app.add_flag("--body-joints", o->bodyJoints,
+                   "keep each anchor's skin as the body's there, also on joints the garment vertex is not skinned to "
+                   "(by default those influences are dropped: the run time's push-out then fetches no matrix beyond "
+                   "the vertex's skinning's)");
       app.add_flag("--one-anchor", o->oneAnchor,
                    "one anchor per vertex (its nearest body part) instead of also a second one on the nearest other "
                    "part, where two parts meet (format 1.3's push-out)");
@@ -264,7 +276,8 @@ swish::cli::CommandRegistration reg{
       app.footer(
           "The push-out: each garment vertex is kept outside the ball of its anchor (the largest ball inside the "
           "rest body touching it at the vertex's closest point, its centre skinned with the body's own weights "
-          "there), `margin` off it; it never pulls a vertex in, and a vertex answers to its own anchors only: the one "
+          "there, on the joints the garment vertex is skinned to), `margin` off it; it never pulls a vertex in, and a "
+          "vertex answers to its own anchors only: the one "
           "on its nearest body part, then (format 1.4) one on the nearest other part within reach, where parts meet, "
           "or, "
           "for a vertex with no such part, one on its own part where the cloth slid to farthest in the simulated "

@@ -343,6 +343,7 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
     fitSlideAnchors(fit, collider, firstPart, misses, anchorAt);
     if (s.coverAnchors) fitCoverAnchors(fit, collider, firstPart, poses, misses, s, anchorAt);
   }
+  if (s.garmentJoints && garment.skin.vertexCount() == n) onGarmentJoints(fit, garment.skin);
   // A model without them, not N empty ones (a third set needs a second one before it, empty or not).
   if (fit.coverAnchored == 0) fit.anchors.third.clear();
   if (fit.secondAnchored == 0 && fit.coverAnchored == 0) fit.anchors.second.clear();
@@ -352,6 +353,53 @@ BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const M
   fit.radiusP10Mm = percentile(radii, 0.1);
   fit.radiusMedianMm = percentile(radii, 0.5);
   return fit;
+}
+
+void onGarmentJoints(BodyAnchorFit& fit, const SkinWeights& skin) {
+  BodyAnchors& anchors = fit.anchors;
+  const size_t influences = size_t(std::max(skin.influences, 0));
+  double dropped = 0;
+  for (uint32_t set = 0; set < anchors.slots(); ++set) {
+    std::vector<BodyAnchor>& all = anchors.slot(set);
+    if (all.size() != skin.vertexCount())
+      throw Error("body anchor fit: " + std::to_string(all.size()) + " " + anchorSlotName(set) + " anchors for " +
+                  std::to_string(skin.vertexCount()) + " skinned garment vertices");
+    for (size_t v = 0; v < all.size(); ++v) {
+      BodyAnchor& a = all[v];
+      if (!a.present()) continue;
+      BodyAnchor kept = a;
+      kept.joints.fill(0);
+      kept.weights.fill(0.f);
+      size_t n = 0;
+      float sum = 0.f;
+      for (size_t i = 0; i < size_t(kAnchorInfluences); ++i) {
+        if (a.weights[i] == 0.f) continue;
+        bool own = false;
+        for (size_t k = 0; k < influences && !own; ++k) own = skin.joints[v * influences + k] == a.joints[i];
+        if (!own) {
+          ++fit.garmentJointsDropped;
+          dropped += a.weights[i];
+          fit.garmentJointsMaxDropped = std::max(fit.garmentJointsMaxDropped, a.weights[i]);
+          continue;
+        }
+        kept.joints[n] = a.joints[i];
+        kept.weights[n++] = a.weights[i];
+        sum += a.weights[i];
+      }
+      if (n == size_t(std::count_if(a.weights.begin(), a.weights.end(), [](float w) { return w != 0.f; }))) continue;
+      ++fit.garmentJointsChanged;
+      if (!(sum > 0.f)) {
+        a = BodyAnchor{};
+        ++fit.garmentJointsRemoved;
+        size_t& count = set == 0 ? fit.anchored : set == 1 ? fit.secondAnchored : fit.coverAnchored;
+        count -= count > 0 ? 1 : 0;
+        continue;
+      }
+      for (size_t i = 0; i < n; ++i) kept.weights[i] /= sum;
+      a = kept;
+    }
+  }
+  fit.garmentJointsMeanDropped = fit.garmentJointsDropped ? float(dropped / double(fit.garmentJointsDropped)) : 0.f;
 }
 
 BodyAnchorCalibration calibrateBodyAnchors(BodyAnchors& anchors, const std::vector<BodyAnchorCalibrationPose>& poses,
@@ -481,6 +529,12 @@ nlohmann::json toJson(const BodyAnchorFit& f) {
           {"cover_misses", f.coverMisses},
           {"cover_covered", f.coverCovered},
           {"too_far", f.tooFar},
+          {"garment_joints",
+           {{"anchors_changed", f.garmentJointsChanged},
+            {"influences_dropped", f.garmentJointsDropped},
+            {"anchors_removed", f.garmentJointsRemoved},
+            {"dropped_weight_mean", f.garmentJointsMeanDropped},
+            {"dropped_weight_max", f.garmentJointsMaxDropped}}},
           {"margin_mm", std::round(1e6 * double(f.anchors.margin)) / 1e3},  // in micrometre steps: 6, not 6.000000052
           {"max_distance_mm", f.maxDistanceMm},
           {"inside_at_rest", f.insideAtRest},

@@ -61,6 +61,9 @@ struct BodyAnchorFitSettings {
   bool coverAnchors = true;
   float coverReach = 0.003f;    // metres
   size_t coverCandidates = 16;  // at least 1
+  // Each anchor's skin on the garment vertex's own joints (onGarmentJoints, below), as the last step:
+  // the run time's push-out then needs no matrices beyond the ones the vertex's skinning fetches.
+  bool garmentJoints = true;
 };
 
 // A pose to find the slide anchors in (see the settings): the body's skinning matrices and the
@@ -79,9 +82,13 @@ struct BodyAnchorFit {
   float slideMedianMm = 0, slideMaxMm = 0;  // of the slide anchors: distance of their contact from the first's (rest)
   float slideGapMedianMm = 0;               // of the slide anchors: how far the first ball missed the skin there
   size_t coverAnchored = 0;                 // vertices with a third (cover) anchor
-  size_t coverMisses = 0;     // (pose, vertex) pairs whose skin the first two sets miss by slideMinGap or more
-  size_t coverCovered = 0;    // of them, those within coverReach of the vertex's cover ball
-  size_t tooFar = 0;          // vertices beyond maxDistance (no anchor)
+  size_t coverMisses = 0;   // (pose, vertex) pairs whose skin the first two sets miss by slideMinGap or more
+  size_t coverCovered = 0;  // of them, those within coverReach of the vertex's cover ball
+  size_t tooFar = 0;        // vertices beyond maxDistance (no anchor)
+  // onGarmentJoints (settings.garmentJoints): anchors whose skin it changed, the influences it dropped
+  // (their weights' mean and largest), and anchors left with none (removed).
+  size_t garmentJointsChanged = 0, garmentJointsDropped = 0, garmentJointsRemoved = 0;
+  float garmentJointsMeanDropped = 0, garmentJointsMaxDropped = 0;
   size_t insideAtRest = 0;    // anchored vertices inside the body at rest (the push-out moves them at rest)
   size_t withinMargin = 0;    // anchored vertices nearer their ball than the margin at rest (pushed at rest)
   size_t flippedNormals = 0;  // interpolated normals turned to agree with the pseudo-normal
@@ -98,6 +105,18 @@ struct BodyAnchorFit {
 BodyAnchorFit fitBodyAnchors(const Mesh& body, const Skeleton& skeleton, const Mesh& garment,
                              const BodyAnchorFitSettings& settings = {},
                              const std::vector<BodyAnchorSlidePose>& poses = {});
+
+// Puts every anchor's skin on its garment vertex's own joints: an anchor influence whose joint is not
+// among the vertex's skin joints (`garmentSkin`, the game mesh's) is dropped and the rest renormalised,
+// in rank order; an anchor with none left is removed. Why: the run time's deform fetches each of a
+// vertex's joint matrices once per instance, the skinning's and the push-out's alike
+// (gpu::DeformPass::anchorExtraJointsOf), and an anchor joint off the vertex's skin costs three more
+// fetches per instance for the whole mesh. On the committed jersey's fit, 759 of its anchors'
+// influences, 7 % of their weight on average, were off the vertex's joints (the garment's skin is
+// transferred from the body's, so the body under a vertex mostly moves with its joints); dropping them
+// left the pictures and the penetration measure the same (docs/baking.md). Fills the fit's
+// garmentJoints* counters. Errors name a size mismatch.
+void onGarmentJoints(BodyAnchorFit& fit, const SkinWeights& garmentSkin);
 
 // Calibration against the source simulation. The ball stands for the body, but the bake's own
 // simulated garment (the truth the network learns) lies inside it in places: cloth squeezed between an

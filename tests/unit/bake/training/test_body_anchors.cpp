@@ -164,6 +164,48 @@ TEST(BodyAnchorFit, BoxBodyPointsNormalsAndWeights) {
   EXPECT_THROW(bake::fitBodyAnchors(box.body, box.skeleton, garment, {0.04f, 0.5f}), Error);
 }
 
+// Anchors on the garment vertex's own joints (BodyAnchorFitSettings::garmentJoints, bake::onGarmentJoints):
+// the box's corner 7 (body joints 7 at 0.6, 0 at 0.4) under a vertex skinned to 7 and 3 keeps joint 7
+// alone; the edge midpoint (7 at 0.5, 6 at 0.3, 0 at 0.2) under a vertex skinned to 6 and 7 drops joint
+// 0 and renormalises the rest in rank order; a face point (joints of corners 4-7 and 0) under a vertex
+// skinned to 1 and 2 keeps none, and its anchor is removed. With the setting off the body's skin stays.
+TEST(BodyAnchorFit, AnchorsOnTheGarmentVertexsJoints) {
+  const BoxBody box = boxBody();
+  Mesh garment = pointsMesh({Vec3f(0.12f, 0.12f, 0.12f), Vec3f(0.f, 0.12f, 0.12f), Vec3f(0.03f, 0.02f, 0.125f)});
+  garment.skin.influences = 2;
+  garment.skin.joints = {7, 3, 6, 7, 1, 2};
+  garment.skin.weights = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+  bake::BodyAnchorFitSettings off;
+  off.garmentJoints = false;
+  const bake::BodyAnchorFit body = bake::fitBodyAnchors(box.body, box.skeleton, garment, off);
+  const bake::BodyAnchorFit fit = bake::fitBodyAnchors(box.body, box.skeleton, garment);
+  ASSERT_EQ(body.anchored, 3u);
+  EXPECT_EQ(body.garmentJointsChanged, 0u);
+  EXPECT_EQ(body.anchors.anchors[1].joints[2], 0);  // the body's skin: joint 0 kept with the setting off
+  const auto& a = fit.anchors.anchors;
+  ASSERT_EQ(a.size(), 3u);
+  EXPECT_EQ(a[0].joints[0], 7);
+  EXPECT_NEAR(a[0].weights[0], 1.f, 1e-6f);
+  EXPECT_EQ(a[0].weights[1], 0.f);
+  EXPECT_EQ(a[1].joints[0], 7);
+  EXPECT_EQ(a[1].joints[1], 6);
+  EXPECT_NEAR(a[1].weights[0], 0.625f, 1e-6f);
+  EXPECT_NEAR(a[1].weights[1], 0.375f, 1e-6f);
+  EXPECT_EQ(a[1].weights[2], 0.f);
+  EXPECT_FALSE(a[2].present());
+  // Everything else about the anchors is the fit's.
+  for (size_t v = 0; v < 2; ++v) {
+    EXPECT_EQ(a[v].position, body.anchors.anchors[v].position) << v;
+    EXPECT_EQ(a[v].radius, body.anchors.anchors[v].radius) << v;
+  }
+  EXPECT_EQ(fit.anchored, 2u);
+  EXPECT_EQ(fit.garmentJointsChanged, 3u);
+  EXPECT_EQ(fit.garmentJointsDropped, 6u);  // one, one, and the face point's four
+  EXPECT_EQ(fit.garmentJointsRemoved, 1u);
+  EXPECT_NEAR(fit.garmentJointsMaxDropped, 0.4f, 1e-6f);
+  EXPECT_EQ(bake::toJson(fit)["garment_joints"]["anchors_removed"], 1u);
+}
+
 // Two boxes side by side, 5 cm apart (x in [-0.1, 0.1] and [0.15, 0.35]), the second skinned to the
 // first's joints shifted by 4: two parts. A vertex between them gets its nearest box as its anchor and
 // the other as its second; a vertex with the other box beyond the bound gets none; with the second
