@@ -33,11 +33,13 @@
 // more (a specialisation constant: the most any vertex of the model needs, DeformPass::
 // anchorExtraJointsOf). Each anchor's weights are over the table's slots (DeformPass::packAnchors
 // places them), so a frame fetches 3 texels per extra slot and instance, not 3 per influence of every
-// anchor: on the committed model 6 fetches instead of 27, for a blend over 6 slots instead of 3
-// influences (87 % of its vertices' anchors use only their own skin joints; 2 extra slots at most).
-// The sum runs in slot order, not in the anchor's rank order: within the rounding the conformance
-// test allows. An indexed fetch from the table (a slot number per influence) would keep the order,
-// but lavapipe makes such arrays scratch memory: that measured 3x the push-out's cost. `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
+// anchor (27 a vertex for three sets of three). The anchor fit puts the anchors on the vertex's own
+// joints (bake::onGarmentJoints), so a fitted model has no extra slots and its push-out fetches no
+// matrix at all beyond the skinning's; each set's blend then runs over the skin's slots. The sum runs
+// in slot order, not in the anchor's rank order: within the rounding the conformance test allows. An
+// indexed fetch from the table (a slot number per influence) would keep the order, but lavapipe puts
+// such arrays in scratch memory: that measured 2.5 to 3 times the push-out's cost (docs/performance.md,
+// "Deform"). `pushOut` (a push constant: the anchor sets to apply, 0 for none) is
 // uniform, so a frame without the push-out skips it in uniform branches on a GPU. Lavapipe runs uniform
 // branches masked, i.e. pays for the push-out in every frame, so the code exists only in the pipelines
 // made for it: ANCHOR_SETS (a specialisation constant, the model's sets) bounds the unrolled loops, and
