@@ -12,6 +12,7 @@
 #include "support/gpu_buffers.hpp"
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
+#include "support/push_out_tolerance.hpp"
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
 #include "swish/gpu/deform_pass.hpp"
@@ -93,16 +94,7 @@ struct Reference {
   size_t moved = 0;
 };
 
-// Tolerance of one pushed coordinate. The kernel's skinned vertex y and skinned ball centre c each
-// carry the skinning's own tolerance (test_deform.cpp: 2 um + 1e-5 relative, FMA-contracting devices
-// included). The push x = c + e r / |e| (e = y - c) projects y radially onto the sphere of radius r:
-// an error of e along e is removed, one across it is scaled by r / |e| (> 1 inside the ball), and c's
-// error adds once more; the factor r / |e| itself (a sqrt and a division that Vulkan lets a device
-// compute to a few ulps) errs by about 1e-5 relative, times r. So
-//   |dx| <= |dc| + (r / |e|) (|dy| + |dc|) + 1e-5 r.
-// A vertex near the sphere (|e| ~ r) may be pushed on one side and not on the other; the push there is
-// r - |e|, within the same bound: the step is continuous. With two or three anchor sets each push starts
-// from the one before's output, so its |dy| is that one's bound.
+// The tolerance of each pushed coordinate: support/push_out_tolerance.hpp derives it.
 Reference reference(const PushInputs& in, bool pushOut) {
   const Model& m = in.model;
   const size_t k = size_t(m.meshComponents()), j = m.skeleton.size();
@@ -112,22 +104,9 @@ Reference reference(const PushInputs& in, bool pushOut) {
     Points3f p =
         runtime::referenceSkin(runtime::referencePcaReconstruct(m.meshPca, std::span(in.weights).subspan(i * k, k)),
                                m.gameMesh.skin, std::vector<Mat4f>(mats.begin(), mats.end()));
-    const Points3f skinned = p;
+    const std::vector<double> tol = test::pushOutTolerance(m.bodyAnchors, pushOut ? m.bodyAnchors.slots() : 0, mats, p);
+    r.tolerance.insert(r.tolerance.end(), tol.begin(), tol.end());
     if (pushOut) r.moved += runtime::referencePushOut(p, m.bodyAnchors, mats);
-    for (Eigen::Index v = 0; v < p.rows(); ++v) {
-      Vec3f y = skinned.row(v).transpose();
-      double tol = 2e-6 + 1e-5 * double(y.cwiseAbs().maxCoeff());
-      for (uint32_t s = 0; pushOut && s < m.bodyAnchors.slots(); ++s) {
-        const BodyAnchor& an = m.bodyAnchors.slot(s)[size_t(v)];
-        if (!an.present()) continue;
-        const Vec3f c = runtime::skinAnchorCentre(an, mats);
-        const double tolC = 2e-6 + 1e-5 * double(c.cwiseAbs().maxCoeff()), r = double(an.reach());
-        const double e = double((y - c).norm());
-        if (e < r) tol = tolC + (e > 0 ? r / e : 1.0) * (tol + tolC) + 1e-5 * r;
-        y = runtime::pushedOutOfBall(y, c, an.reach());
-      }
-      for (int e = 0; e < 3; ++e) r.tolerance.push_back(tol);
-    }
     r.positions.insert(r.positions.end(), p.data(), p.data() + p.size());
   }
   return r;

@@ -15,6 +15,7 @@
 #include "support/error_message.hpp"
 #include "support/gpu_compare.hpp"
 #include "support/gpu_test.hpp"
+#include "support/push_out_tolerance.hpp"
 #include "support/random_model.hpp"
 #include "support/seeded_test.hpp"
 #include "swish/core/mesh_frames.hpp"
@@ -44,8 +45,11 @@ runtime::FrameKernelInputs randomFrameInputs(Rng& rng, const Model& m, uint32_t 
   return in;
 }
 
-void expectFrameMatches(const Model& model, const runtime::ReferenceFrameOutputs& gpu,
-                        const runtime::ReferenceFrameOutputs& ref, int frame) {
+// `in`: the frame's inputs (with the push-out on, the positions' tolerance is the push-out's,
+// support/push_out_tolerance.hpp, from the reference's positions before it).
+void expectFrameMatches(const Model& model, const runtime::FrameKernelInputs& in,
+                        const runtime::ReferenceFrameOutputs& gpu, const runtime::ReferenceFrameOutputs& ref,
+                        int frame) {
   SCOPED_TRACE("frame " + std::to_string(frame));
   ASSERT_EQ(gpu.positions.size(), ref.positions.size());
   ASSERT_EQ(gpu.normals.size(), ref.normals.size());
@@ -53,11 +57,17 @@ void expectFrameMatches(const Model& model, const runtime::ReferenceFrameOutputs
   ASSERT_EQ(gpu.normals.size(), gpu.tangents.size());
   const MeshFrameTopology topo = buildFrameTopology(model.gameMesh.triangles, model.gameMesh.positions);
   auto span = [](const auto& m) { return std::span<const float>(m.data(), size_t(m.size())); };
+  runtime::FrameKernelInputs withoutPushOut = in;
+  withoutPushOut.pushOut = false;
+  const runtime::ReferenceFrameOutputs unpushed = runtime::referenceFrame(model, withoutPushOut);
   for (size_t i = 0; i < ref.positions.size(); ++i) {
     SCOPED_TRACE("instance " + std::to_string(i));
     const auto r = span(ref.positions[i]);
-    EXPECT_TRUE(test::matchesReference("positions", span(gpu.positions[i]), r,
-                                       [&](size_t e) { return 2e-6 + 1e-5 * std::abs(double(r[e])); }));
+    const size_t j = model.skeleton.size();
+    const std::vector<double> tol =
+        test::pushOutTolerance(model.bodyAnchors, in.pushOut ? model.bodyAnchors.slots() : 0,
+                               std::span(in.skinMatrices).subspan(i * j, j), unpushed.positions[i]);
+    EXPECT_TRUE(test::matchesReference("positions", span(gpu.positions[i]), r, [&](size_t e) { return tol[e]; }));
     if (i < gpu.normals.size()) {
       const runtime::ReferenceTangentFrames own =
           runtime::referenceTangentFrames(gpu.positions[i], model.gameMesh, topo);
@@ -114,7 +124,7 @@ TEST_F(WholeFrame, GpuFramesMatchReferenceFramesAcrossFramesInFlight) {
       const uint32_t slot = recorder.slotOf(uint64_t(frame));
       const auto gpu = recorder.download(slot);
       const auto ref = runtime::referenceFrame(model, in, prevMaps);
-      expectFrameMatches(model, gpu, ref, frame);
+      expectFrameMatches(model, in, gpu, ref, frame);
       // Each selected map decoded once, however many characters chose it, and only in the first frame
       // that selects it in this slot.
       const size_t distinct = std::set<uint32_t>(in.selectedMaps.begin(), in.selectedMaps.end()).size();
@@ -162,7 +172,7 @@ TEST_F(WholeFrame, DecodedMapsAreKeptAcrossFramesAndTheirSlotsReused) {
     in.selectedMaps = step.maps;
     ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, f, in); });
     const auto ref = runtime::referenceFrame(model, in, prevMaps);
-    expectFrameMatches(model, recorder.download(0), ref, int(f));
+    expectFrameMatches(model, in, recorder.download(0), ref, int(f));
     const auto& fr = recorder.frame(0);
     EXPECT_EQ(fr.decodedSlotCount, std::set<uint32_t>(step.maps.begin(), step.maps.end()).size()) << "frame " << f;
     if (f == steps.size()) {
@@ -245,7 +255,7 @@ TEST_F(WholeFrame, QualityLevelsPerInstanceMatchReferenceAndKeepMapsOfLevelsWith
         const uint32_t slot = recorder.slotOf(uint64_t(frame));
         const auto gpu = recorder.download(slot);
         const auto ref = runtime::referenceFrame(model, in, prevMaps);
-        expectFrameMatches(model, gpu, ref, frame);
+        expectFrameMatches(model, in, gpu, ref, frame);
         for (uint32_t i : kept) {
           EXPECT_EQ(gpu.normalMaps[i].xy,
                     prevGpuMaps.empty() ? std::vector<int16_t>(gpu.normalMaps[i].xy.size(), 0) : prevGpuMaps[i].xy)
@@ -289,7 +299,7 @@ TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
   ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, 0, in); });
   const auto gpu = recorder.download(0);
   EXPECT_TRUE(gpu.normalMaps.empty());
-  expectFrameMatches(model, gpu, runtime::referenceFrame(model, in), 0);
+  expectFrameMatches(model, in, gpu, runtime::referenceFrame(model, in), 0);
   if (ctx().supportsTimestamps()) {
     EXPECT_TRUE(std::isnan(recorder.stageTimes(0).vqDecodeMs));
   }
@@ -300,7 +310,7 @@ TEST_F(WholeFrame, ModelWithoutNormalMapsRecordsOnlyMeshWork) {
   ctx().submitAndWait([&](VkCommandBuffer cmd) { recorder.record(cmd, 1, noMaps); });
   const auto again = recorder.download(0);
   EXPECT_TRUE(again.normalMaps.empty());
-  expectFrameMatches(model, again, runtime::referenceFrame(model, noMaps), 0);
+  expectFrameMatches(model, noMaps, again, runtime::referenceFrame(model, noMaps), 0);
 }
 
 TEST_F(WholeFrame, BadInputsAreRejectedWithAReason) {
