@@ -82,6 +82,7 @@ layout(constant_id = 7) const uint BAND3 = 0;           //  are unused)
 layout(constant_id = 8) const uint BAND4 = 0;
 layout(constant_id = 9) const uint ANCHOR_SETS = 0;     // anchor sets the kernel can push out of, 0..3
 layout(constant_id = 10) const uint ANCHOR_EXTRA_JOINTS = 0;  // push-out table slots after the skin joints
+layout(constant_id = 11) const bool ANCHOR_ZERO_SKIP = true;  // the anchors' blends skip zero weights (below)
 const uint SLOTS = INFLUENCES + ANCHOR_EXTRA_JOINTS;          // the push-out joint table (the skin's alone: none)
 const uint EXTRA_TEXELS = (ANCHOR_EXTRA_JOINTS + 3u) / 4u;     // per vertex, before the sets (layout: swish_layouts.h)
 const uint SET_TEXELS = 1u + (SLOTS + 3u) / 4u;                // per vertex and set: centre + reach, weights
@@ -156,7 +157,23 @@ void deformInstance(const uint instance, const uint groups) {
       // such vertices do; lavapipe runs it masked as before.
       if (a < p.pushOut && anchorR[a] != 0.0) {
         precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
-        SWISH_BLEND_MATRICES(SLOTS, anchorW[a], a0, a1, a2, a3)
+        if (ANCHOR_ZERO_SKIP) {
+          SWISH_BLEND_MATRICES(SLOTS, anchorW[a], a0, a1, a2, a3)
+        } else {
+          // Where every table slot of every vertex carries a non-zero skin weight (no extra joints:
+          // DeformPass::anchorsSkipZeroWeights), the select is not needed: a zero weight times a finite
+          // matrix adds an exact zero, and a slot whose matrix is not finite has already made the skinned
+          // vertex y non-finite, which no push moves (s is then NaN or infinite), here as in the
+          // reference. A third of the blends' work on lavapipe (docs/performance.md, "Deform").
+          [[unroll]] for (uint i = 0u; i < SLOTS; ++i) {
+            const float w = anchorW[a][i];
+            const vec4 r0 = rows0[i], r1 = rows1[i], r2 = rows2[i];
+            a0 = a0 + w * vec3(r0.x, r1.x, r2.x);
+            a1 = a1 + w * vec3(r0.y, r1.y, r2.y);
+            a2 = a2 + w * vec3(r0.z, r1.z, r2.z);
+            a3 = a3 + w * vec3(r0.w, r1.w, r2.w);
+          }
+        }
         precise const vec3 c = ((a0 * anchorC[a].x + a1 * anchorC[a].y) + a2 * anchorC[a].z) + a3;
         precise const vec3 e = y - c;
         precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;

@@ -126,9 +126,9 @@ DeformSetup makeSetup(gpu::Context& ctx, uint32_t instances, bool skinning, uint
   s.matrices.upload(ctx, matrixRows.data(), matrixRows.size() * 4);
   s.positions = gpu::Buffer(ctx, instances * n * 12, gpu::MemoryKind::DeviceLocal, "positions");
   // The basis as texels where the device allows (as FrameRecorder runs it).
-  s.pass = std::make_unique<gpu::DeformPass>(ctx, uint32_t(k), 4, skinning, s.gpuModel->basis.size() / sizeof(float),
-                                             skinning ? s.gpuModel->anchorSlots() : 0,
-                                             skinning ? s.gpuModel->anchorExtraJoints() : 0);
+  s.pass = std::make_unique<gpu::DeformPass>(
+      ctx, uint32_t(k), 4, skinning, s.gpuModel->basis.size() / sizeof(float), skinning ? s.gpuModel->anchorSlots() : 0,
+      skinning ? s.gpuModel->anchorExtraJoints() : 0, s.gpuModel->anchorZeroSkip());
   s.instanceInputs = s.pass->bindInstanceInputs(ctx, s.weights, s.matrices, &s.gpuModel->basis, &s.gpuModel->anchors);
   // Bytes the kernel must move at least once: basis, mean, skin influences, weights, matrices, output.
   s.bytesMoved = double(n * k * 3 * 4 + n * 3 * 4 + n * 4 * 8 + w.size() * 4 + m.size() * 48 + instances * n * 12);

@@ -125,6 +125,11 @@ uint32_t DeformPass::anchorExtraJointsOf(const BodyAnchors& anchors, const SkinW
   return uint32_t(most);
 }
 
+bool DeformPass::anchorsSkipZeroWeights(const BodyAnchors& anchors, const SkinWeights& skin) {
+  if (anchors.empty() || anchorExtraJointsOf(anchors, skin) > 0) return true;
+  return std::any_of(skin.weights.begin(), skin.weights.end(), [](float w) { return w == 0.f; });
+}
+
 std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, const SkinWeights& skin,
                                               uint32_t jointCount) {
   const uint32_t extra = anchorExtraJointsOf(anchors, skin), influences = uint32_t(skin.influences);
@@ -156,7 +161,7 @@ std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, const 
 }
 
 DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool applySkinning, uint64_t basisFloats,
-                       uint32_t anchorSets, uint32_t anchorExtraJoints)
+                       uint32_t anchorSets, uint32_t anchorExtraJoints, bool anchorZeroSkip)
     : basisTexels_(basisFloats > 0 &&
                    std::max(basisFloats, anchorTexelsOf(basisFloats / (3 * uint64_t(std::max(k, 1u))), influences,
                                                         anchorExtraJoints, anchorSets)) <=
@@ -199,7 +204,8 @@ DeformPass::DeformPass(Context& ctx, uint32_t k, uint32_t influences, bool apply
                                   0u,
                                   0u,
                                   sets,
-                                  sets > 0 ? anchorExtraJoints : 0u};
+                                  sets > 0 ? anchorExtraJoints : 0u,
+                                  anchorZeroSkip ? 1u : 0u};
     pipeline_[i] = ComputePipeline(ctx, shader, spec, sizeof(layout::DeformParams), inputsLayout_.get());
     spec[4] = uint32_t(bands_.size());
     for (size_t b = 1; b < bands_.size(); ++b) spec[4 + b] = bands_[b];

@@ -100,6 +100,11 @@ class DeformPass {
   // the worst vertex needs (0 without anchors; at most SWISH_MAX_ANCHOR_EXTRA_JOINTS): the pass's
   // anchorExtraJoints.
   static uint32_t anchorExtraJointsOf(const BodyAnchors& anchors, const SkinWeights& skin);
+  // Whether the anchors' blends must skip zero weights as the reference does (true), or may add them
+  // unguarded (false: a third of their work on lavapipe). False where no vertex needs extra joints and
+  // every skin weight is non-zero: a table slot's non-finite matrix then already makes the skinned vertex
+  // non-finite, which no push moves (deform.glsl). True without anchors.
+  static bool anchorsSkipZeroWeights(const BodyAnchors& anchors, const SkinWeights& skin);
   // The body anchors in the push-out's layout (shaders/swish_layouts.h): per vertex its table's
   // anchorExtraJointsOf extra joints (0 where a vertex needs fewer), then per set (BodyAnchors::slots()) and
   // vertex the ball's centre xyz (BodyAnchor::centre()) and reach (BodyAnchor::reach()), and the
@@ -123,8 +128,10 @@ class DeformPass {
   // the kernel without it, which lavapipe would otherwise run masked (deform.glsl).
   // anchorExtraJoints (0 to SWISH_MAX_ANCHOR_EXTRA_JOINTS, 0 without anchor sets): the push-out table's
   // joints beyond the skin's (anchorExtraJointsOf the model's anchors, which packAnchors laid out for it).
+  // anchorZeroSkip: anchorsSkipZeroWeights of the model (false only where it says so; true is always right).
   DeformPass(Context& ctx, uint32_t meshComponents, uint32_t influences, bool applySkinning = true,
-             uint64_t basisFloats = 0, uint32_t anchorSets = 0, uint32_t anchorExtraJoints = 0);
+             uint64_t basisFloats = 0, uint32_t anchorSets = 0, uint32_t anchorExtraJoints = 0,
+             bool anchorZeroSkip = true);
   bool basisTexels() const { return basisTexels_; }
   uint32_t meshComponents() const { return meshComponents_; }        // K of the pipeline
   uint32_t anchorSets() const { return anchorSets_; }                // the most anchor sets a frame may apply

@@ -144,6 +144,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
     }
     anchorSlots_ = m.bodyAnchors.slots();
     anchorExtraJoints_ = DeformPass::anchorExtraJointsOf(m.bodyAnchors, g.skin);
+    anchorZeroSkip_ = DeformPass::anchorsSkipZeroWeights(m.bodyAnchors, g.skin);
   }
 
   const ModelUploads uploads(m, true);
@@ -156,7 +157,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
 
 DeformPass GpuModel::makeDeformPass(Context& ctx) const {
   return DeformPass(ctx, kernelComponents_, influences_, true, basis.size() / sizeof(float), anchorSlots_,
-                    anchorExtraJoints_);
+                    anchorExtraJoints_, anchorZeroSkip_);
 }
 
 DeformPass::Args GpuModel::deformArgs(VkDescriptorSet instanceInputs, const Buffer& positionsOut,

@@ -39,6 +39,7 @@ class GpuModel {
   bool hasBodyAnchors() const { return anchorSlots_ > 0; }
   uint32_t anchorSlots() const { return anchorSlots_; }              // BodyAnchors::slots()
   uint32_t anchorExtraJoints() const { return anchorExtraJoints_; }  // DeformPass::anchorExtraJointsOf
+  bool anchorZeroSkip() const { return anchorZeroSkip_; }            // DeformPass::anchorsSkipZeroWeights
 
   // The deform's arguments for `instances` instances of this model: its buffers, counts and the given
   // per-frame inputs and output. No push-out and no quality bands (the caller adds those).
@@ -56,6 +57,7 @@ class GpuModel {
  private:
   std::string name_;
   uint32_t anchorSlots_ = 0, anchorExtraJoints_ = 0;
+  bool anchorZeroSkip_ = true;  // DeformPass::anchorsSkipZeroWeights
   uint32_t vertexCount_ = 0, triangleCount_ = 0, jointCount_ = 0, meshComponents_ = 0, kernelComponents_ = 1;
   uint32_t influences_ = 1;
   bool hasUvs_ = false;
