@@ -107,14 +107,15 @@ vec3 anchorC[SWISH_MAX_ANCHOR_SLOTS];   // each ball's centre (rest)
 float anchorR[SWISH_MAX_ANCHOR_SLOTS];  // its reach (radius + clearance; 0: no anchor)
 float anchorW[SWISH_MAX_ANCHOR_SLOTS][SLOTS];  // its weights over the table's slots
 
-// The blend of the first `count` table matrices of this instance (rows r0..r2 per slot; weights W; a
-// zero weight is skipped by a select, as in the reference), as the columns b0..b3 of its top three rows.
-#define SWISH_BLEND_MATRICES(count, W, b0, b1, b2, b3)                                                 \
+// The blend of the first `count` table matrices of this instance (rows r0..r2 per slot; weights W), as
+// the columns b0..b3 of its top three rows. With `skip` a zero weight is skipped by a select, as in the
+// reference; a constant false `skip` folds the select away (the anchors' blends where it is not needed).
+#define SWISH_BLEND_MATRICES(count, W, skip, b0, b1, b2, b3)                                           \
   [[unroll]] for (uint i = 0u; i < count; ++i) {                                                       \
     const float w = W[i];                                                                              \
     const vec4 r0 = rows0[i], r1 = rows1[i], r2 = rows2[i];                                            \
     const vec3 c0 = vec3(r0.x, r1.x, r2.x), c1 = vec3(r0.y, r1.y, r2.y), c2 = vec3(r0.z, r1.z, r2.z), c3 = vec3(r0.w, r1.w, r2.w); \
-    const bool use = w != 0.0;                                                                         \
+    const bool use = !(skip) || w != 0.0;                                                              \
     b0 = use ? b0 + w * c0 : b0;                                                                       \
     b1 = use ? b1 + w * c1 : b1;                                                                       \
     b2 = use ? b2 + w * c2 : b2;                                                                       \
@@ -148,7 +149,7 @@ void deformInstance(const uint instance, const uint groups) {
       rows2[i] = texelFetch(matrixRows, m + 2);
     }
     precise vec3 b0 = vec3(0.0), b1 = vec3(0.0), b2 = vec3(0.0), b3 = vec3(0.0);
-    SWISH_BLEND_MATRICES(INFLUENCES, skinW, b0, b1, b2, b3)
+    SWISH_BLEND_MATRICES(INFLUENCES, skinW, true, b0, b1, b2, b3)
     y = ((b0 * x.x + b1 * x.y) + b2 * x.z) + b3;
     // The push-out (character space: after skinning only).
     [[unroll]] for (uint a = 0u; a < ANCHOR_SETS; ++a) {
@@ -157,23 +158,12 @@ void deformInstance(const uint instance, const uint groups) {
       // such vertices do; lavapipe runs it masked as before.
       if (a < p.pushOut && anchorR[a] != 0.0) {
         precise vec3 a0 = vec3(0.0), a1 = vec3(0.0), a2 = vec3(0.0), a3 = vec3(0.0);
-        if (ANCHOR_ZERO_SKIP) {
-          SWISH_BLEND_MATRICES(SLOTS, anchorW[a], a0, a1, a2, a3)
-        } else {
-          // Where every table slot of every vertex carries a non-zero skin weight (no extra joints:
-          // DeformPass::anchorsSkipZeroWeights), the select is not needed: a zero weight times a finite
-          // matrix adds an exact zero, and a slot whose matrix is not finite has already made the skinned
-          // vertex y non-finite, which no push moves (s is then NaN or infinite), here as in the
-          // reference. A third of the blends' work on lavapipe (docs/performance.md, "Deform").
-          [[unroll]] for (uint i = 0u; i < SLOTS; ++i) {
-            const float w = anchorW[a][i];
-            const vec4 r0 = rows0[i], r1 = rows1[i], r2 = rows2[i];
-            a0 = a0 + w * vec3(r0.x, r1.x, r2.x);
-            a1 = a1 + w * vec3(r0.y, r1.y, r2.y);
-            a2 = a2 + w * vec3(r0.z, r1.z, r2.z);
-            a3 = a3 + w * vec3(r0.w, r1.w, r2.w);
-          }
-        }
+        // Where every table slot of every vertex carries a non-zero skin weight (no extra joints:
+        // DeformPass::anchorsSkipZeroWeights), ANCHOR_ZERO_SKIP is false and the select is not needed: a
+        // zero weight times a finite matrix adds an exact zero, and a slot whose matrix is not finite has
+        // already made the skinned vertex y non-finite, which no push moves (s is then NaN or infinite),
+        // here as in the reference. A third of the blends' work on lavapipe (docs/performance.md, "Deform").
+        SWISH_BLEND_MATRICES(SLOTS, anchorW[a], ANCHOR_ZERO_SKIP, a0, a1, a2, a3)
         precise const vec3 c = ((a0 * anchorC[a].x + a1 * anchorC[a].y) + a2 * anchorC[a].z) + a3;
         precise const vec3 e = y - c;
         precise const float s = (e.x * e.x + e.y * e.y) + e.z * e.z;

@@ -125,9 +125,8 @@ uint32_t DeformPass::anchorExtraJointsOf(const BodyAnchors& anchors, const SkinW
   return uint32_t(most);
 }
 
-bool DeformPass::anchorsSkipZeroWeights(const BodyAnchors& anchors, const SkinWeights& skin) {
-  if (anchors.empty() || anchorExtraJointsOf(anchors, skin) > 0) return true;
-  return std::any_of(skin.weights.begin(), skin.weights.end(), [](float w) { return w == 0.f; });
+bool DeformPass::anchorsSkipZeroWeights(uint32_t extraJoints, const SkinWeights& skin) {
+  return extraJoints > 0 || std::any_of(skin.weights.begin(), skin.weights.end(), [](float w) { return w == 0.f; });
 }
 
 std::vector<uint32_t> DeformPass::packAnchors(const BodyAnchors& anchors, const SkinWeights& skin,

@@ -101,10 +101,11 @@ class DeformPass {
   // anchorExtraJoints.
   static uint32_t anchorExtraJointsOf(const BodyAnchors& anchors, const SkinWeights& skin);
   // Whether the anchors' blends must skip zero weights as the reference does (true), or may add them
-  // unguarded (false: a third of their work on lavapipe). False where no vertex needs extra joints and
-  // every skin weight is non-zero: a table slot's non-finite matrix then already makes the skinned vertex
-  // non-finite, which no push moves (deform.glsl). True without anchors.
-  static bool anchorsSkipZeroWeights(const BodyAnchors& anchors, const SkinWeights& skin);
+  // unguarded (false: a third of their work on lavapipe), for anchors of `extraJoints`
+  // (anchorExtraJointsOf) on `skin`. False where no vertex needs extra joints and every skin weight is
+  // non-zero: a table slot's non-finite matrix then already makes the skinned vertex non-finite, which no
+  // push moves (deform.glsl).
+  static bool anchorsSkipZeroWeights(uint32_t extraJoints, const SkinWeights& skin);
   // The body anchors in the push-out's layout (shaders/swish_layouts.h): per vertex its table's
   // anchorExtraJointsOf extra joints (0 where a vertex needs fewer), then per set (BodyAnchors::slots()) and
   // vertex the ball's centre xyz (BodyAnchor::centre()) and reach (BodyAnchor::reach()), and the

@@ -144,7 +144,7 @@ GpuModel::GpuModel(Context& ctx, const Model& m, const std::string& name) : name
     }
     anchorSlots_ = m.bodyAnchors.slots();
     anchorExtraJoints_ = DeformPass::anchorExtraJointsOf(m.bodyAnchors, g.skin);
-    anchorZeroSkip_ = DeformPass::anchorsSkipZeroWeights(m.bodyAnchors, g.skin);
+    anchorZeroSkip_ = DeformPass::anchorsSkipZeroWeights(anchorExtraJoints_, g.skin);
   }
 
   const ModelUploads uploads(m, true);

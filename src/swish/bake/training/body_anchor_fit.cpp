@@ -372,11 +372,13 @@ void onGarmentJoints(BodyAnchorFit& fit, const SkinWeights& skin) {
       kept.weights.fill(0.f);
       size_t n = 0;
       float sum = 0.f;
+      bool changed = false;
       for (size_t i = 0; i < size_t(kAnchorInfluences); ++i) {
         if (a.weights[i] == 0.f) continue;
         bool own = false;
         for (size_t k = 0; k < influences && !own; ++k) own = skin.joints[v * influences + k] == a.joints[i];
         if (!own) {
+          changed = true;
           ++fit.garmentJointsDropped;
           dropped += a.weights[i];
           fit.garmentJointsMaxDropped = std::max(fit.garmentJointsMaxDropped, a.weights[i]);
@@ -386,7 +388,7 @@ void onGarmentJoints(BodyAnchorFit& fit, const SkinWeights& skin) {
         kept.weights[n++] = a.weights[i];
         sum += a.weights[i];
       }
-      if (n == size_t(std::count_if(a.weights.begin(), a.weights.end(), [](float w) { return w != 0.f; }))) continue;
+      if (!changed) continue;
       ++fit.garmentJointsChanged;
       if (!(sum > 0.f)) {
         a = BodyAnchor{};
