@@ -94,6 +94,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "limb_garment_reach",
                                                   "limb_neck_range",
                                                   "limb_one_surface",
+                                                  "limb_turn_search",
                                                   "attach_band",
                                                   "equilibrium_tolerance",
                                                   "equilibrium_seconds",
@@ -146,6 +147,8 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   s.limbClearance.neckRangeDegrees = float(sim.number("limb_neck_range", 0, 720, s.limbClearance.neckRangeDegrees));
   // A body that is one surface has its limbs' skin regions kept out of its trunk (limb_clearance.hpp).
   s.limbClearance.oneSurfaceLimbs = sim.boolean("limb_one_surface", s.limbClearance.oneSurfaceLimbs);
+  // A limb the push's turn leaves inside is turned the least way that clears it (limb_clearance.hpp).
+  s.limbClearance.turnSearch = sim.boolean("limb_turn_search", s.limbClearance.turnSearch);
   // The top band of the garment held on the body (share of its rest height; cloth_solver.hpp).
   cs.attachTopFraction = float(sim.number("attach_band", 0, 0.5, cs.attachTopFraction));
   // The end condition (cloth_solver.hpp): frames at the goal pose until the residual (the unbalanced
@@ -334,6 +337,8 @@ PoseShapeSettings poseShapeSettingsFromJson(const nlohmann::json& datasetSetting
   if (sim.is_object() && !sim.contains("limb_neck_range")) s.limbClearance.neckRangeDegrees = 0.f;
   // Settings recorded before one-surface bodies had limbs left those bodies' limbs as recorded.
   if (sim.is_object() && !sim.contains("limb_one_surface")) s.limbClearance.oneSurfaceLimbs = false;
+  // Settings recorded before the turn search left a limb the push's turn could not clear inside.
+  if (sim.is_object() && !sim.contains("limb_turn_search")) s.limbClearance.turnSearch = false;
   // Settings recorded before the carry was a setting carried the cloth by its skinning.
   if (sim.is_object() && !sim.contains("carry")) s.simulation.carry = ClothCarry::Skinning;
   // Settings recorded before the retries had their own carries retried with the skinning one.

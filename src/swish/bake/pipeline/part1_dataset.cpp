@@ -247,6 +247,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
         {"limb_garment_reach", limbClearance.garmentReach},
         {"limb_neck_range", limbClearance.neckRangeDegrees},
         {"limb_one_surface", limbClearance.oneSurfaceLimbs},
+        {"limb_turn_search", limbClearance.turnSearch},
         {"attach_band", m.attachTopFraction}}},
       {"transfer",
        {{"smoothing_strength", transfer.smoothing.strength},

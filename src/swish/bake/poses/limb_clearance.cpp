@@ -22,6 +22,8 @@ constexpr float kCell = 0.05f;
 constexpr float kTolerance = 0.001f;
 // Spacing of the checked vertices of a one-surface body's limb regions (m): a little below the clearance.
 constexpr float kRegionSpacing = 0.01f;
+// Directions around a limb tried when the push's turn does not clear it (LimbClearanceSettings::turnSearch).
+constexpr int kTurnDirections = 8;
 
 // The smallest whole number of steps in [1, most] after which depthAt(steps) <= kTolerance, `before`
 // being the depth at 0: 5-step strides, then bisection; `most` when none clears. `after` gets the depth
@@ -264,6 +266,7 @@ void LimbClearance::applyLimbs(Pose& pose, Pose& p, std::vector<LimbCorrection>&
     const std::vector<RigidTransform> g = skeleton_.globalTransforms(p);
     const int j = limb.rootJoint, parent = skeleton_.joints[size_t(j)].parent;
     const Vec3f head = g[size_t(j)].translation;
+    const Vec3f along = (centre - head).normalized();  // before any turn: the turns are about axes across it
     Vec3f axis = (centre - head).cross(push);
     LimbCorrection c{skeleton_.joints[size_t(j)].name, 0.f, before, before};
     if (!(axis.norm() > 1e-9f)) {  // pushed straight along the limb: no rotation helps
@@ -272,14 +275,40 @@ void LimbClearance::applyLimbs(Pose& pose, Pose& p, std::vector<LimbCorrection>&
     }
     axis.normalize();
     const Quatf global = g[size_t(j)].rotation, parentInv = g[size_t(parent)].rotation.conjugate();
-    // The smallest whole number of degrees that clears the limb.
-    auto depthAt = [&](int degrees) {
-      const Quatf turn(Eigen::AngleAxisf(float(degrees) * float(M_PI) / 180.f, axis));
-      p.local[size_t(j)] = (parentInv * turn * global).normalized();
-      return measure();
+    // The smallest whole number of degrees about `about` that clears the limb.
+    auto clearingAbout = [&](const Vec3f& about, int most, float& after) {
+      auto depthAt = [&](int degrees) {
+        const Quatf turn(Eigen::AngleAxisf(float(degrees) * float(M_PI) / 180.f, about));
+        p.local[size_t(j)] = (parentInv * turn * global).normalized();
+        return measure();
+      };
+      after = before;
+      return smallestClearing(most, before, depthAt, after);
     };
     float after = before;
-    const int degrees = smallestClearing(int(settings_.maxDegrees), before, depthAt, after);
+    int degrees = clearingAbout(axis, int(settings_.maxDegrees), after);
+    if (after > kTolerance && settings_.turnSearch) {
+      // The push's turn does not clear the limb within maxDegrees (a limb deep in the trunk: the
+      // nearest surface's normals point up the chest). kTurnDirections directions around the limb,
+      // the push's first, each with its own smallest turn up to twice maxDegrees: the one that clears
+      // with the fewest degrees wins (the earlier on a tie), or if none clears the one that leaves the least.
+      Vec3f bestAxis = axis;
+      int bestDegrees = degrees;
+      float bestAfter = after;
+      for (int k = 0; k < kTurnDirections; ++k) {
+        const Vec3f a = Eigen::AngleAxisf(2.f * float(M_PI) * float(k) / float(kTurnDirections), along) * axis;
+        float afterK = before;
+        const int degreesK = clearingAbout(a, 2 * int(settings_.maxDegrees), afterK);
+        const bool clears = afterK <= kTolerance, bestClears = bestAfter <= kTolerance;
+        if (clears ? !bestClears || degreesK < bestDegrees : !bestClears && afterK < bestAfter)
+          bestAxis = a, bestDegrees = degreesK, bestAfter = afterK;
+      }
+      const Quatf turn(Eigen::AngleAxisf(float(bestDegrees) * float(M_PI) / 180.f, bestAxis));
+      p.local[size_t(j)] = (parentInv * turn * global).normalized();
+      if (limbRegions_) measure();  // the trunk posed with the chosen turn, for the limbs after this one
+      degrees = bestDegrees;
+      after = bestAfter;
+    }
     pose.local[size_t(j)] = p.local[size_t(j)];
     c.degrees = float(degrees);
     c.depthAfter = after > kTolerance ? after : 0.f;

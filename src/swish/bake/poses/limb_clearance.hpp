@@ -58,7 +58,8 @@ namespace swish::bake {
 struct LimbClearanceSettings {
   float clearance = 0.015f;  // m between a limb and the trunk: room for two layers of cloth
   float rootRadius = 0.10f;  // m: limb vertices this close to their root joint are not checked
-  float maxDegrees = 60.f;   // the largest correction; a limb still inside after it is reported
+  float maxDegrees = 60.f;   // the largest correction along the push (twice it in the turn search); a limb
+                             // still inside after it is reported
   // m: only the trunk surface within this distance of the garment at rest is kept clear, where a limb
   // can pinch the cloth (the hem can ride up this far). A thigh against the crotch, below a jersey's
   // hem, is left as recorded. 0, or a character without a garment: the whole trunk.
@@ -79,6 +80,12 @@ struct LimbClearanceSettings {
   // Recipes: part1.simulation.limb_one_surface (settings recorded before it: false, so that models
   // baked before keep their truth).
   bool oneSurfaceLimbs = true;
+  // Where the turn along the trunk's push does not clear a limb within maxDegrees (a limb deep in the
+  // trunk: an arm aimed through the chest stays 1-3 cm inside after 60 degrees, and the cloth pinched
+  // there explodes on every attempt), the smallest turn that clears it in any of 8 directions around
+  // the limb, up to twice maxDegrees. A limb the push's turn clears is turned exactly as without it.
+  // Recipes: part1.simulation.limb_turn_search (settings recorded before it: false).
+  bool turnSearch = true;
   float seamBorder = 0.03f;  // m: one-surface trunk triangles this close to a limb region at rest are not kept clear
 };
 

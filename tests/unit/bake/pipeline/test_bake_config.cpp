@@ -169,6 +169,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"limb_garment_reach", 0.1},
                           {"limb_neck_range", 45},
                           {"limb_one_surface", false},
+                          {"limb_turn_search", false},
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25},
@@ -212,6 +213,14 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   nlohmann::json beforeOneSurface = d.part1->toJson();
   beforeOneSurface["simulation"].erase("limb_one_surface");
   EXPECT_FALSE(poseShapeSettingsFromJson(beforeOneSurface, "dataset settings").limbClearance.oneSurfaceLimbs);
+  // The turn search likewise.
+  EXPECT_FALSE(s.limbClearance.turnSearch);
+  EXPECT_TRUE(d.part1->limbClearance.turnSearch);
+  EXPECT_EQ(d.part1->toJson()["simulation"]["limb_turn_search"], true);
+  EXPECT_TRUE(poseShapeSettingsFromJson(d.part1->toJson(), "dataset settings").limbClearance.turnSearch);
+  nlohmann::json beforeTurnSearch = d.part1->toJson();
+  beforeTurnSearch["simulation"].erase("limb_turn_search");
+  EXPECT_FALSE(poseShapeSettingsFromJson(beforeTurnSearch, "dataset settings").limbClearance.turnSearch);
   EXPECT_FLOAT_EQ(d.part1->simulation.material.damping, clothMaterialPreset("jersey").damping);
   EXPECT_FLOAT_EQ(poseShapeSettingsFromJson(s.toJson(), "dataset settings").simulation.material.damping, 1.5f);
   EXPECT_FALSE(d.part1->toJson()["simulation"].contains("damping"));  // the preset's: not recorded
@@ -307,6 +316,7 @@ TEST(BakeConfig, Part1ErrorsNameTheKeyBeforeAnyWork) {
        "part1.simulation.limb_garment_reach: -0.1 is outside");
   says(part1Error({{"simulation", {{"limb_neck_range", 800}}}}), "part1.simulation.limb_neck_range: 800 is outside");
   says(part1Error({{"simulation", {{"limb_one_surface", 1}}}}), "part1.simulation.limb_one_surface");
+  says(part1Error({{"simulation", {{"limb_turn_search", 1}}}}), "part1.simulation.limb_turn_search");
   says(part1Error({{"simulation", {{"static_iterations", 0}}}}), "part1.simulation.static_iterations: 0 is outside");
   says(part1Error({{"transfer", {{"cover_body_mm", 30}}}}), "part1.transfer.cover_body_mm: 30 is outside");
   says(part1Error({{"transfer", {{"cover_recorded_pose", 1}}}}),
