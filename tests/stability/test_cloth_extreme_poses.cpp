@@ -16,7 +16,7 @@
 // worst; on the T-shirt they left 6.9 mm inside, pinched between arm and chest; 4.4 mm since its arms are
 // turned out of its trunk, session 29), the stiff jersey 35%
 // even at rest: far from the goals of issue 18, which these tests do not
-// claim. A limb put through the chest stayed 1-3 cm inside after the clearance's 60 degree turn and
+// claim. A limb put through the chest stayed 4.5-6.7 cm inside after the clearance's 60 degree turn and
 // exploded on both characters (the default character's kept by the 7th attempt with a 767 % tear, the
 // T-shirt's on none); since the clearance's turn search (LimbClearanceSettings::turnSearch, session 38)
 // clears it, the default character's simulates on the first attempt and the T-shirt's on the 4th (the
@@ -232,7 +232,7 @@ TEST(ClothExtremePoses, DefaultCharacterTranslationCarry) {
   runCases(makeDefaultCharacter(), 0.03f, "default, translation carry", ClothCarry::Translation);
 }
 
-// The arm aimed through the chest: the push's 60 degree turn left it 1-3 cm inside the torso, and the
+// The arm aimed through the chest: the push's 60 degree turn left it 66.7 mm inside the torso, and the
 // transition exploded at the left upper arm on the first attempt and on both retries; the 7th attempt (the
 // cleared path at 2x with the translation carry) kept it with its worst edge stretched 767 % and a vertex
 // projected 42 mm. With the turn search the arm is turned clear (in the 60-120 degree range), and the pose
@@ -277,8 +277,9 @@ TEST(ClothExtremePoses, SharedTshirt) {
 // The T-shirt's body is one surface; its arms are turned out of the trunk as skin regions (session 29). The
 // arm aimed through the chest exploded near the left upper arm on all 7 attempts while the clearance left it
 // inside (disabled as the known gap until session 38); turned clear by the turn search, the first attempt and
-// both retries still explode on the way (the transition swings the arm through the trunk's side) and the
-// first safer path, the transition kept clear of the trunk at every frame, keeps it (measured: attempt 4,
+// both retries still explode mid-transition (the first at frame 16 of 45, 504 % near the left upper arm: the
+// arm's path from the A-pose passes through the trunk) and the first safer path, the transition kept clear
+// of the trunk at every frame, keeps it (measured: attempt 4,
 // p99 strain 28 %, worst edge 528 %, 3.8 mm projected, 58 s of one core).
 TEST(ClothExtremePoses, SharedTshirtLimbThroughTheBody) {
   const auto file = tshirtFile();

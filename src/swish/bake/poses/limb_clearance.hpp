@@ -81,7 +81,7 @@ struct LimbClearanceSettings {
   // baked before keep their truth).
   bool oneSurfaceLimbs = true;
   // Where the turn along the trunk's push does not clear a limb within maxDegrees (a limb deep in the
-  // trunk: an arm aimed through the chest stays 1-3 cm inside after 60 degrees, and the cloth pinched
+  // trunk: an arm aimed through the chest stays 4.5-6.7 cm inside after 60 degrees, and the cloth pinched
   // there explodes on every attempt), the smallest turn that clears it in any of 8 directions around
   // the limb, up to twice maxDegrees. A limb the push's turn clears is turned exactly as without it.
   // Recipes: part1.simulation.limb_turn_search (settings recorded before it: false).
