@@ -30,6 +30,7 @@
 #include <string>
 
 #include "support/paths.hpp"
+#include "support/pose_aim.hpp"
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/cloth_constraints.hpp"
 #include "swish/bake/pipeline/pose_shape.hpp"
@@ -37,38 +38,14 @@
 
 using namespace swish;
 using namespace swish::bake;
+using test::aim;
+using test::childOf;
+using test::turnWorld;
 
 namespace {
 
 constexpr size_t kVertices = 3000;
 constexpr float kPi = 3.14159265f;
-
-int childOf(const Skeleton& sk, int j) {
-  for (size_t c = 0; c < sk.size(); ++c)
-    if (sk.joints[c].parent == j) return int(c);
-  return -1;
-}
-
-// Applies the character-space rotation `r` to joint `name` (and so to everything below it).
-void turnWorld(const Skeleton& sk, Pose& p, const std::string& name, const Quatf& r) {
-  const int j = sk.find(name);
-  ASSERT_GE(j, 0) << "joint " << name;
-  const std::vector<RigidTransform> g = sk.globalTransforms(p);
-  const int parent = sk.joints[size_t(j)].parent;
-  const Quatf parentWorld = parent >= 0 ? g[size_t(parent)].rotation : Quatf::Identity();
-  p.local[size_t(j)] = (parentWorld.conjugate() * r * g[size_t(j)].rotation).normalized();
-}
-
-// Turns joint `name` so that its bone (towards its first child) points along `dir` (character space).
-void aim(const Skeleton& sk, Pose& p, const std::string& name, const Vec3f& dir) {
-  const int j = sk.find(name);
-  ASSERT_GE(j, 0) << "joint " << name;
-  const int c = childOf(sk, j);
-  ASSERT_GE(c, 0) << "joint " << name << " has no child";
-  const std::vector<RigidTransform> g = sk.globalTransforms(p);
-  const Vec3f bone = (g[size_t(c)].translation - g[size_t(j)].translation).normalized();
-  turnWorld(sk, p, name, Quatf::FromTwoVectors(bone, dir.normalized()));
-}
 
 Quatf about(float degrees, const Vec3f& axis) {
   return Quatf(Eigen::AngleAxisf(degrees * kPi / 180.f, axis.normalized()));

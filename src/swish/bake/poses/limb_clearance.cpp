@@ -26,17 +26,18 @@ constexpr float kRegionSpacing = 0.01f;
 constexpr int kTurnDirections = 8;
 
 // The smallest whole number of steps in [1, most] after which depthAt(steps) <= kTolerance, `before`
-// being the depth at 0: 5-step strides, then bisection; `most` when none clears. `after` gets the depth
-// at the answer, and p (which depthAt sets) is left holding the answer's pose. Shared by the limbs
-// (steps: degrees) and the head (steps: percent of the way back to rest).
+// being the depth at `from` (0, or where an earlier search with a smaller `most` ended without clearing:
+// the strides then go on from there, as they would have from 0): 5-step strides, then bisection; `most`
+// when none clears. `after` gets the depth at the answer, and p (which depthAt sets) is left holding the
+// answer's pose. Shared by the limbs (steps: degrees) and the head (steps: percent of the way back to rest).
 template <class DepthAt>
-int smallestClearing(int most, float before, DepthAt&& depthAt, float& after) {
+int smallestClearing(int most, float before, DepthAt&& depthAt, float& after, int from = 0) {
   int tried = 0;  // the steps the pose holds
   auto at = [&](int steps) {
     tried = steps;
     return depthAt(steps);
   };
-  int lo = 0, hi = 0;
+  int lo = from, hi = from;
   after = before;
   while (after > kTolerance && hi < most) {
     lo = hi;
@@ -275,30 +276,32 @@ void LimbClearance::applyLimbs(Pose& pose, Pose& p, std::vector<LimbCorrection>&
     }
     axis.normalize();
     const Quatf global = g[size_t(j)].rotation, parentInv = g[size_t(parent)].rotation.conjugate();
-    // The smallest whole number of degrees about `about` that clears the limb.
-    auto clearingAbout = [&](const Vec3f& about, int most, float& after) {
+    // The smallest whole number of degrees about `about` that clears the limb, searched from `from`
+    // degrees, where the limb is `depthFrom` inside.
+    auto clearingAbout = [&](const Vec3f& about, int most, float& after, int from, float depthFrom) {
       auto depthAt = [&](int degrees) {
         const Quatf turn(Eigen::AngleAxisf(float(degrees) * float(M_PI) / 180.f, about));
         p.local[size_t(j)] = (parentInv * turn * global).normalized();
         return measure();
       };
-      after = before;
-      return smallestClearing(most, before, depthAt, after);
+      return smallestClearing(most, depthFrom, depthAt, after, from);
     };
     float after = before;
-    int degrees = clearingAbout(axis, int(settings_.maxDegrees), after);
+    int degrees = clearingAbout(axis, int(settings_.maxDegrees), after, 0, before);
     if (after > kTolerance && settings_.turnSearch) {
       // The push's turn does not clear the limb within maxDegrees (a limb deep in the trunk: the
       // nearest surface's normals point up the chest). kTurnDirections directions around the limb,
-      // the push's first, each with its own smallest turn up to twice maxDegrees: the one that clears
-      // with the fewest degrees wins (the earlier on a tie), or if none clears the one that leaves the least.
+      // the push's first (its search goes on from maxDegrees), each with its own smallest turn up to twice
+      // maxDegrees: the one that clears with the fewest degrees wins (the earlier on a tie), or if none
+      // clears the one that leaves the least.
       Vec3f bestAxis = axis;
       int bestDegrees = degrees;
       float bestAfter = after;
       for (int k = 0; k < kTurnDirections; ++k) {
         const Vec3f a = Eigen::AngleAxisf(2.f * float(M_PI) * float(k) / float(kTurnDirections), along) * axis;
         float afterK = before;
-        const int degreesK = clearingAbout(a, 2 * int(settings_.maxDegrees), afterK);
+        const int degreesK = k == 0 ? clearingAbout(axis, 2 * int(settings_.maxDegrees), afterK, degrees, after)
+                                    : clearingAbout(a, 2 * int(settings_.maxDegrees), afterK, 0, before);
         const bool clears = afterK <= kTolerance, bestClears = bestAfter <= kTolerance;
         if (clears ? !bestClears || degreesK < bestDegrees : !bestClears && afterK < bestAfter)
           bestAxis = a, bestDegrees = degreesK, bestAfter = afterK;

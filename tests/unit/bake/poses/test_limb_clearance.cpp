@@ -11,6 +11,7 @@
 
 #include "support/cloth_fixture.hpp"
 #include "support/paths.hpp"
+#include "support/pose_aim.hpp"
 #include "swish/bake/character/default_character.hpp"
 #include "swish/bake/cloth/body_collider.hpp"
 #include "swish/bake/poses/limb_clearance.hpp"
@@ -163,28 +164,14 @@ TEST(LimbClearance, HangingArmsAreTurnedOutOfTheTorsoAndNothingElseMoves) {
   for (size_t j = 0; j < s.size(); ++j) EXPECT_EQ(again.local[j].coeffs(), p.local[j].coeffs());
 }
 
-// The upper arm `joint` aimed along `dir` (character space): its bone, towards its first child, turned onto it.
-Pose armAimed(const Skeleton& s, const char* joint, const Vec3f& dir) {
-  Pose p = s.restPose();
-  const int j = s.find(joint);
-  int child = -1;
-  for (size_t c = 0; c < s.size() && child < 0; ++c)
-    if (s.joints[c].parent == j) child = int(c);
-  const std::vector<RigidTransform> g = s.globalTransforms(p);
-  const Vec3f bone = (g[size_t(child)].translation - g[size_t(j)].translation).normalized();
-  const Quatf parent = g[size_t(s.joints[size_t(j)].parent)].rotation;
-  p.local[size_t(j)] =
-      (parent.conjugate() * Quatf::FromTwoVectors(bone, dir.normalized()) * g[size_t(j)].rotation).normalized();
-  return p;
-}
-
 // An arm aimed through the chest (the stability case "limb through the body"): the trunk's push at the arm
 // points up the chest, and 60 degrees about it leave the arm inside. The turn search (turnSearch) tries the
 // other directions around the arm, to twice maxDegrees, and takes the smallest turn that clears it; without
 // it (settings recorded before it) the arm stays inside, as it did.
 TEST(LimbClearance, AnArmThePushCannotClearIsTurnedTheLeastWayThatDoes) {
   const Character& c = mannequin();
-  const Pose recorded = armAimed(c.skeleton, "LeftArm", Vec3f(-1.f, -0.4f, 0.1f));
+  Pose recorded = c.skeleton.restPose();
+  test::aim(c.skeleton, recorded, "LeftArm", Vec3f(-1.f, -0.4f, 0.1f));
   ASSERT_LT(armToTorso(c, recorded), -0.05f) << "the test pose must put the arm through the chest";
 
   LimbClearanceSettings asBefore;
