@@ -418,6 +418,52 @@ TEST(BakePart2, SynthesizedPosesAreNeverHeldOut) {
   EXPECT_EQ(out.evaluation.poses, 12u);
 }
 
+// train.distill: the teacher's synthetic poses are trained on beside the recorded ones; the held-out split
+// and the network's validation poses are those of the bake without them; the metadata and the report
+// record the teacher and its error beside the network's; the recipe's settings round-trip.
+TEST(BakePart2, DistillationTrainsOnTheTeachersPoses) {
+  const uint64_t seed = test::testSeed(504);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const Dataset ds = syntheticDataset(seed, 160, 32);
+  BakeTrainSettings st = smallTraining();
+  st.normalCodeDims = 0;
+  const BakeTrainOutput plain = trainBake(ds, st);
+  st.distill.poses = 300;
+  const BakeTrainOutput out = trainBake(ds, st);
+  EXPECT_EQ(out.testPoses, plain.testPoses);
+  EXPECT_EQ(out.distilled.theta.cols(), 300);
+  EXPECT_EQ(out.distilled.blends + out.distilled.mixes, 300u);
+  EXPECT_GT(out.distilled.blends, 100u);
+  EXPECT_GT(out.distilled.mixes, 100u);
+  // The network's samples: the 144 training poses and the 300 synthetic ones, validated on the same
+  // recorded poses as without them.
+  EXPECT_EQ(out.regressor.trainingSamples.size() + out.regressor.validationSamples.size(), 444u);
+  EXPECT_EQ(out.regressor.validationSamples, plain.regressor.validationSamples);
+  ASSERT_TRUE(out.metadata.contains("distill"));
+  const nlohmann::json& d = out.metadata["distill"];
+  EXPECT_EQ(d["poses"], 300);
+  EXPECT_GT(d["teacher"]["width"].get<double>(), 0.0);
+  // On a smooth low-rank truth both fit well: the teacher and the network within a few mm (the synthetic
+  // fields are up to 2 cm), and the comparison is the same arithmetic as compareTeacher's.
+  std::vector<const DatasetPose*> held;
+  for (uint32_t i : out.testPoses) held.push_back(&ds.poses[i]);
+  const TeacherComparison c = compareTeacher(out, held);
+  EXPECT_EQ(c.poses, out.testPoses.size());
+  EXPECT_DOUBLE_EQ(d["held_out_pre_skin_mean_mm"]["teacher"].get<double>(), c.teacherMm);
+  EXPECT_DOUBLE_EQ(d["held_out_pre_skin_mean_mm"]["network"].get<double>(), c.networkMm);
+  EXPECT_GT(c.teacherMm, 0.0);
+  EXPECT_LT(c.teacherMm, 3.0);
+  EXPECT_LT(c.networkMm, 3.0);
+  EXPECT_EQ(compareTeacher(plain, held).poses, 0u);  // no teacher, nothing compared
+  EXPECT_FALSE(plain.metadata.contains("distill"));
+  EXPECT_FALSE(plain.metadata["settings"].contains("distill"));  // older fingerprints stay
+  EXPECT_EQ(out.metadata["settings"]["distill"]["poses"], 300);
+  const test::TempDir tmp("bake_part2_distill_" + std::to_string(seed));
+  std::ifstream md(writeBakeReport(out, ds, tmp / "report", 2));
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("**Distillation**"), std::string::npos);
+}
+
 TEST(BakePart2, RunBakeFromADatasetFolderIsResumable) {
   const uint64_t seed = test::testSeed(502);
   const Dataset ds = syntheticDataset(seed, 60, 16);

@@ -397,7 +397,8 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
                                                   "anchor_calibration",
                                                   "anchor_margin_mm",
                                                   "cover_anchors",
-                                                  "root_gravity"});
+                                                  "root_gravity",
+                                                  "distill"});
   BakeTrainSettings& t = cfg.train;
   t.meshComponents = int(train.wholeNumber("mesh_components", 1, 4096, t.meshComponents));
   t.meshVariance = train.number("mesh_variance", 0, 1, t.meshVariance);
@@ -445,6 +446,16 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   }
   t.anchorMargin = float(train.number("anchor_margin_mm", 0, 50, 1000.0 * t.anchorMargin) / 1000.0);
   t.coverAnchors = train.boolean("cover_anchors", t.coverAnchors);
+  if (train.has("distill")) {
+    // The kernel-ridge teacher's synthetic poses (distillation.hpp).
+    const JsonReader d = train.child("distill");
+    d.requireObject({"poses", "mix_share", "swap_probability", "neighbours"});
+    if (!d.has("poses")) d.child("poses").fail("is required (how many synthetic poses the teacher labels)");
+    t.distill.poses = size_t(d.wholeNumber("poses", 1, 1e6, 0));
+    t.distill.mixShare = d.number("mix_share", 0, 1, t.distill.mixShare);
+    t.distill.swapProbability = d.number("swap_probability", 0.01, 1, t.distill.swapProbability);
+    t.distill.neighbours = int(d.wholeNumber("neighbours", 1, 1000, t.distill.neighbours));
+  }
   return cfg;
 }
 

@@ -75,6 +75,8 @@
 //       "temporal_time_constant", "seed", "bc5_baseline", "anchor_calibration" ("strict", the default: the push-out's
 //       anchors calibrated on the training poses; "none": every anchor keeps the margin; part2_training.hpp),
 //       "anchor_margin_mm" (the push-out's margin, 0..50, default 2),
+//       "distill": {"poses" (required), "mix_share", "swap_probability", "neighbours"} (a kernel-ridge
+//                  teacher's labels for synthetic poses beside the simulated ones; distillation.hpp),
 //       "input_joints" (the network's Theta joints; absent:
 //       part1.input_joints, the thinning joints;
 //                       checked against the character before part 1 simulates anything)

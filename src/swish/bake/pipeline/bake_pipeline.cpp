@@ -150,7 +150,7 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   log("part 2: " + std::to_string(ds.poses.size()) + " poses, " + std::to_string(ds.character.garment.vertexCount()) +
       " game-mesh vertices");
   const auto t2 = Clock::now();
-  const BakeTrainOutput out = trainBake(ds, cfg.train, [&](const std::string& stage, double f) {
+  BakeTrainOutput out = trainBake(ds, cfg.train, [&](const std::string& stage, double f) {
     const double el = std::chrono::duration<double>(Clock::now() - t2).count();
     char line[256];
     if (f > 0.0 && f < 1.0)
@@ -172,6 +172,7 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
         (problems ? " NOT monotone (" + std::to_string(problems) + " pairs; report.md says which)" : " monotone"));
   }
   std::optional<SubjectEvaluation> subjects;
+  nlohmann::json subjectTeacher;  // train.distill: the teacher against the network on the held-out subjects
   if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {
     log("part 2: evaluating on the held-out subjects' dataset " + cfg.holdoutDatasetDir().string());
     const Dataset holdout = readDataset(cfg.holdoutDatasetDir());
@@ -185,6 +186,18 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
                   subjects->overall.restSkinnedMm.mean, subjects->overall.restSkinnedMm.p95,
                   out.evaluation.totalMm.mean, out.evaluation.totalMm.p95);
     log(line);
+    if (out.metadata.contains("distill")) {
+      std::vector<const DatasetPose*> heldPoses;
+      for (const DatasetPose& p : holdout.poses) heldPoses.push_back(&p);
+      const TeacherComparison c = compareTeacher(out, heldPoses);
+      subjectTeacher = {{"poses", c.poses}, {"teacher", c.teacherMm}, {"network", c.networkMm}};
+      out.metadata["distill"]["held_out_subjects_pre_skin_mean_mm"] = subjectTeacher;  // for the report
+      std::snprintf(line, sizeof line,
+                    "part 2: held-out subjects, pre-skinning mean through the mesh PCA: distillation teacher %.2f mm, "
+                    "network %.2f mm",
+                    c.teacherMm, c.networkMm);
+      log(line);
+    }
     const BakeEvaluation& o = subjects->overall;
     if (o.penetrationMeasured && o.pushOut) {
       std::snprintf(line, sizeof line,
@@ -214,6 +227,7 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   }
   meta["novelty_guard"]["flag_above"] = model.noveltyGuard.flagAbove;
   if (subjects) meta["errors"]["held_out_subjects"] = subjects->toJson();
+  if (!subjectTeacher.is_null()) meta["distill"]["held_out_subjects_pre_skin_mean_mm"] = subjectTeacher;
   meta["bake_fingerprint"] = fingerprint(cfg);
   meta["name"] = cfg.name;
   model.metadata = meta.dump();

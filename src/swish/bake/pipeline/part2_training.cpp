@@ -8,6 +8,7 @@
 #include "swish/bake/compression/bc5_baseline.hpp"
 #include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/bake/training/body_anchor_fit.hpp"
+#include "swish/bake/training/distillation.hpp"
 #include "swish/bake/training/model_builder.hpp"
 #include "swish/bake/training/novelty_guard_fit.hpp"
 #include "swish/bake/transfer/body_coverage.hpp"
@@ -47,6 +48,11 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (anchorMargin != BodyAnchorFitSettings{}.margin)  // likewise; in micrometres' steps, as the recipe writes it
     j["anchor_margin_mm"] = std::round(1e6 * double(anchorMargin)) / 1e3;
   if (coverAnchors) j["cover_anchors"] = true;  // likewise
+  if (distill.poses > 0)                        // likewise
+    j["distill"] = {{"poses", distill.poses},
+                    {"mix_share", distill.mixShare},
+                    {"swap_probability", distill.swapProbability},
+                    {"neighbours", distill.neighbours}};
   return j;
 }
 
@@ -66,6 +72,38 @@ std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSetti
     out.push_back(uint32_t(j));
   }
   return out;
+}
+
+TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<const DatasetPose*>& poses) {
+  TeacherComparison c;
+  if (poses.empty() || out.distilled.teacher.centres.cols() == 0) return c;
+  const Model& m = out.model;
+  const int K = out.meshPca.components();
+  const size_t n = size_t(out.meshPca.mean.size() / 3);
+  MatXf theta(Eigen::Index(thetaSize(m.inputJoints.size(), m.rootGravity)), Eigen::Index(poses.size()));
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const std::vector<float> th = runtime::computeTheta(m.inputJoints, m.rootGravity, poses[i]->pose.local);
+    theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
+  }
+  const MatXf teacherShapes = out.meshPca.reconstruct(out.distilled.teacher.predict(theta).topRows(K));
+  MatXf networkCodes(K, theta.cols());
+  for (Eigen::Index i = 0; i < theta.cols(); ++i)
+    networkCodes.col(i) = evaluateMlp(out.regressor.mlp, out.regressor.inputNorm, out.regressor.outputNorm,
+                                      theta.col(i), out.regressor.activation)
+                              .head(K);
+  const MatXf networkShapes = out.meshPca.reconstruct(networkCodes);
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const auto truth = Eigen::Map<const VecXf>(poses[i]->gameMeshPreSkin.data(), Eigen::Index(3 * n));
+    for (size_t v = 0; v < n; ++v) {
+      const Eigen::Index r = Eigen::Index(3 * v);
+      c.teacherMm += (teacherShapes.col(Eigen::Index(i)).segment<3>(r) - truth.segment<3>(r)).norm();
+      c.networkMm += (networkShapes.col(Eigen::Index(i)).segment<3>(r) - truth.segment<3>(r)).norm();
+    }
+  }
+  const double count = double(poses.size() * n);
+  c.teacherMm *= 1000.0 / count, c.networkMm *= 1000.0 / count;
+  c.poses = poses.size();
+  return c;
 }
 
 BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress) {
@@ -229,7 +267,32 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     for (int k = 0; k < K; ++k) mo.outputWeights.push_back((1.0 - uniform) * var[k] / sum + uniform / K);
     for (int c = 0; c < C; ++c) mo.outputWeights.push_back(st.normalCodeWeight / C);
   }
-  out.regressor = trainMlp(theta, lambda, mo);
+  if (st.distill.poses > 0) {
+    // train.distill (distillation.hpp): the teacher's labels for poses between and around the training
+    // poses, trained on always (never validated on: early stopping judges by simulations alone).
+    report("distillation teacher", 0.45);
+    DistillSettings distill = st.distill;
+    distill.seed = st.seed + 8;
+    distill.teacher.seed = st.seed + 9;
+    distill.teacher.outputWeights = mo.outputWeights;
+    std::vector<const Pose*> trainingPoses;
+    for (uint32_t p : out.trainingPoses) trainingPoses.push_back(&ds.poses[p].pose);
+    out.distilled = distilledSamples(trainingPoses, thetaJoints, st.rootGravity, theta, lambda, distill);
+    stage("distillation teacher");
+    report("MLP training", 0.5);
+    const Eigen::Index real = theta.cols(), extra = out.distilled.theta.cols();
+    MatXf allTheta(theta.rows(), real + extra), allLambda(lambda.rows(), real + extra);
+    allTheta << theta, out.distilled.theta;
+    allLambda << lambda, out.distilled.lambda;
+    mo.validationPool = size_t(real);
+    for (Eigen::Index i = 0; i < extra; ++i) {
+      mo.alwaysTrain.push_back(uint32_t(real + i));
+      mo.sampleKeys.push_back((uint64_t(1) << 63) + uint64_t(i));  // past any pose id
+    }
+    out.regressor = trainMlp(allTheta, allLambda, mo);
+  } else {
+    out.regressor = trainMlp(theta, lambda, mo);
+  }
   stage("MLP training");
 
   // 4. Model, then evaluation on the held-out poses through the runtime path.
@@ -350,6 +413,22 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
        {{"best_epoch", out.regressor.bestEpoch},
         {"epochs", out.regressor.epochsRun},
         {"validation_loss", out.regressor.bestValidationLoss}}}};
+  if (st.distill.poses > 0) {
+    std::vector<const DatasetPose*> held;
+    for (uint32_t i : out.testPoses) held.push_back(&ds.poses[i]);
+    const TeacherComparison c = compareTeacher(out, held);
+    const KernelRidgeFit& teacher = out.distilled.teacher;
+    out.metadata["distill"] = {{"poses", out.distilled.theta.cols()},
+                               {"blends", out.distilled.blends},
+                               {"mixes", out.distilled.mixes},
+                               {"teacher",
+                                {{"kind", "kernel ridge regression, Gaussian kernel, standardised Theta"},
+                                 {"width_scale", teacher.widthScale},
+                                 {"width", teacher.width},
+                                 {"lambda", teacher.lambda},
+                                 {"validation_error", teacher.validationError}}},
+                               {"held_out_pre_skin_mean_mm", {{"teacher", c.teacherMm}, {"network", c.networkMm}}}};
+  }
   if (out.ladder.measured()) out.metadata[runtime::kQualityLevelsKey] = runtime::toJson(withoutTimes(out.ladder));
   if (maps) {
     out.metadata["errors"]["normal_database"] = toJson(ev.normalDatabase);

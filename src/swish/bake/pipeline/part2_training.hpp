@@ -14,6 +14,7 @@
 #include "swish/bake/dataset/dataset.hpp"
 #include "swish/bake/report/bake_evaluation.hpp"
 #include "swish/bake/report/quality_ladder.hpp"
+#include "swish/bake/training/distillation.hpp"
 #include "swish/bake/training/mlp_trainer.hpp"
 #include "swish/model/model.hpp"
 
@@ -68,6 +69,10 @@ struct BakeTrainSettings {
   // Off unless the recipe asks (then recorded; absent when off, so that earlier bakes' fingerprints stay):
   // the committed default model was baked before it.
   bool coverAnchors = false;
+  // Distillation (train.distill; distillation.hpp): a kernel-ridge teacher fitted on the training poses
+  // labels distill.poses synthetic poses, and the MLP trains on them beside the simulated ones. Off (0
+  // poses) unless the recipe asks; recorded when on.
+  DistillSettings distill;
 
   nlohmann::json toJson() const;
 };
@@ -92,6 +97,7 @@ struct BakeTrainOutput {
   uint32_t bc5AtVqMemoryWidth = 0, bc5AtVqMemoryHeight = 0;
   uint64_t bc5AtVqMemoryBytes = 0;
   MlpTrainResult regressor;
+  DistilledSamples distilled;  // train.distill's teacher and samples (none when off)
   BakeEvaluation evaluation;
   // The model's quality levels (runtime/quality_levels.hpp) measured on the same held-out poses as
   // `evaluation` (its full level is evaluation.totalMm), with CPU times; the model's metadata carries
@@ -113,6 +119,14 @@ using BakeProgress = std::function<void(const std::string& stage, double fractio
 // The skeleton indices of the network's input joints: settings.inputJoints resolved on the dataset's
 // character (throws Error naming a joint it lacks, or one named twice), or the dataset's.
 std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSettings& settings);
+
+// train.distill's teacher against the network on poses (mean pre-skinning vertex distance through the mesh
+// PCA, mm): whether the teacher was worth learning from. Zeros when the bake did not distil or no poses.
+struct TeacherComparison {
+  size_t poses = 0;
+  double teacherMm = 0.0, networkMm = 0.0;
+};
+TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<const DatasetPose*>& poses);
 
 BakeTrainOutput trainBake(const Dataset& dataset, const BakeTrainSettings& settings, const BakeProgress& progress = {});
 

@@ -56,6 +56,7 @@ nlohmann::json bakeReportJson(const BakeTrainOutput& out, const Dataset& ds) {
   for (uint32_t i : out.pinnedPoses) pinned.push_back(ds.poses[i].id);
   r["poses"]["always_trained"] = pinned;
   r["settings"] = out.metadata.value("settings", nlohmann::json::object());
+  if (out.metadata.contains("distill")) r["distill"] = out.metadata["distill"];
   nlohmann::json perK = nlohmann::json::array();
   const auto rms = truncationRmsMm(out.meshPca);
   for (size_t k = 0; k < rms.size(); ++k)
@@ -183,6 +184,26 @@ std::filesystem::path writeBakeReport(const BakeTrainOutput& out, const Dataset&
   md << "\nK = " << out.meshPca.components() << " components explain "
      << f2(100.0 * out.meshPca.explainedVariance[out.meshPca.components()]) << "% of the training variance ("
      << (out.meshPca.randomized ? "randomised" : "exact") << " SVD).\n\n![error against K](error_vs_k.svg)\n\n";
+  if (out.metadata.contains("distill")) {
+    const nlohmann::json& d = out.metadata["distill"];
+    const nlohmann::json& t = d["teacher"];
+    md << "**Distillation** (train.distill): the network also trained on " << d["poses"].get<size_t>()
+       << " synthetic poses (" << d["blends"].get<size_t>() << " blends of a training pose and a near one, "
+       << d["mixes"].get<size_t>()
+       << " mixes of joints from different training poses) labelled by a kernel-ridge teacher (Gaussian kernel, "
+          "width "
+       << f2(t["width_scale"].get<double>()) << " x the median nearest distance, lambda " << t["lambda"].get<double>()
+       << ", fitted on the training poses). On the held-out poses, mean pre-skinning vertex error through the mesh "
+          "PCA: teacher "
+       << f2(d["held_out_pre_skin_mean_mm"]["teacher"].get<double>()) << " mm, network "
+       << f2(d["held_out_pre_skin_mean_mm"]["network"].get<double>()) << " mm";
+    if (d.contains("held_out_subjects_pre_skin_mean_mm")) {
+      const nlohmann::json& h = d["held_out_subjects_pre_skin_mean_mm"];
+      md << "; on the held-out subjects: teacher " << f2(h["teacher"].get<double>()) << " mm, network "
+         << f2(h["network"].get<double>()) << " mm";
+    }
+    md << ".\n\n";
+  }
   if (subjects) md << subjects->markdown(ev);
   if (levels) {
     writeTextFileAtomic(dir / "quality_levels.svg", ladderPlotSvg(out.ladder, subjectLevels));

@@ -132,7 +132,11 @@ MlpTrainResult trainMlp(const MatXf& inputs, const MatXf& outputs, const MlpTrai
   for (uint32_t i : o.alwaysTrain)
     if (Eigen::Index(i) >= n)
       throw Error("MLP training: always-train sample " + std::to_string(i) + " of " + std::to_string(n));
-  const size_t nVal = std::clamp<size_t>(size_t(std::lround(o.validationFraction * double(n))), 1, size_t(n) - 1);
+  if (o.validationPool > size_t(n))
+    throw Error("MLP training: a validation pool of " + std::to_string(o.validationPool) + " of " + std::to_string(n) +
+                " samples");
+  const size_t pool = o.validationPool ? o.validationPool : size_t(n);
+  const size_t nVal = std::clamp<size_t>(size_t(std::lround(o.validationFraction * double(pool))), 1, size_t(n) - 1);
   if (!o.sampleKeys.empty() && Eigen::Index(o.sampleKeys.size()) != n)
     throw Error("MLP training: " + std::to_string(o.sampleKeys.size()) + " sample keys for " + std::to_string(n) +
                 " samples");

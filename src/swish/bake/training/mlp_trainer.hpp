@@ -31,6 +31,9 @@ struct MlpTrainOptions {
   int patience = 300;      // epochs without a better validation loss before stopping
   int plateauEpochs = 60;  // epochs without improvement before the learning rate halves
   double validationFraction = 0.1;
+  // The samples that share is of (0: all of them): the bake's distilled samples (train.distill), always
+  // trained on, do not count, so the validation poses stay those of a bake without them.
+  size_t validationPool = 0;
   double maxSeconds = 0.0;  // wall-clock cap (0: none); stopping early keeps the best epoch
   uint64_t seed = 1;
   // Per output weight in the loss (empty: all 1). The bake weights mesh components by their variance

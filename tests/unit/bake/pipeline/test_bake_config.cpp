@@ -87,6 +87,27 @@ TEST(BakeConfig, DefaultsAndPaths) {
   EXPECT_EQ(g.train.toJson()["root_gravity"], true);
   EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"root_gravity", "yes"}}}}).find("train.root_gravity"),
             std::string::npos);
+  // Distillation: off unless asked for (absent from the fingerprint), its settings recorded when on.
+  EXPECT_EQ(w.train.distill.poses, 0u);
+  EXPECT_FALSE(w.train.toJson().contains("distill"));
+  const BakeConfig d = parseBakeConfig(
+      {{"output", "out"}, {"train", {{"distill", {{"poses", 3000}, {"mix_share", 0.25}, {"neighbours", 4}}}}}},
+      "recipe.json", "/base");
+  EXPECT_EQ(d.train.distill.poses, 3000u);
+  EXPECT_DOUBLE_EQ(d.train.distill.mixShare, 0.25);
+  EXPECT_EQ(d.train.distill.neighbours, 4);
+  EXPECT_DOUBLE_EQ(d.train.distill.swapProbability, DistillSettings{}.swapProbability);
+  EXPECT_EQ(d.train.toJson()["distill"]["poses"], 3000);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"distill", {{"mix_share", 0.5}}}}}})
+                .find("train.distill.poses: is "
+                      "required"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"distill", {{"poses", 10}, {"share", 0.5}}}}}})
+                .find("train.distill.share: unknown key"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"distill", {{"poses", 10}, {"mix_share", 2}}}}}})
+                .find("train.distill.mix_share: 2 is outside"),
+            std::string::npos);
 }
 
 TEST(BakeConfig, ErrorsNameTheKey) {
