@@ -172,7 +172,6 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
         (problems ? " NOT monotone (" + std::to_string(problems) + " pairs; report.md says which)" : " monotone"));
   }
   std::optional<SubjectEvaluation> subjects;
-  nlohmann::json subjectTeacher;  // train.distill: the teacher against the network on the held-out subjects
   if (cfg.part1 && !cfg.part1->holdoutSubjects.empty()) {
     log("part 2: evaluating on the held-out subjects' dataset " + cfg.holdoutDatasetDir().string());
     const Dataset holdout = readDataset(cfg.holdoutDatasetDir());
@@ -190,8 +189,8 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
       std::vector<const DatasetPose*> heldPoses;
       for (const DatasetPose& p : holdout.poses) heldPoses.push_back(&p);
       const TeacherComparison c = compareTeacher(out, heldPoses);
-      subjectTeacher = {{"poses", c.poses}, {"teacher", c.teacherMm}, {"network", c.networkMm}};
-      out.metadata["distill"]["held_out_subjects_pre_skin_mean_mm"] = subjectTeacher;  // for the report
+      out.metadata["distill"]["held_out_subjects_pre_skin_mean_mm"] = {
+          {"poses", c.poses}, {"teacher", c.teacherMm}, {"network", c.networkMm}};
       std::snprintf(line, sizeof line,
                     "part 2: held-out subjects, pre-skinning mean through the mesh PCA: distillation teacher %.2f mm, "
                     "network %.2f mm",
@@ -227,7 +226,7 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   }
   meta["novelty_guard"]["flag_above"] = model.noveltyGuard.flagAbove;
   if (subjects) meta["errors"]["held_out_subjects"] = subjects->toJson();
-  if (!subjectTeacher.is_null()) meta["distill"]["held_out_subjects_pre_skin_mean_mm"] = subjectTeacher;
+  if (out.metadata.contains("distill")) meta["distill"] = out.metadata["distill"];  // with the subjects' comparison
   meta["bake_fingerprint"] = fingerprint(cfg);
   meta["name"] = cfg.name;
   model.metadata = meta.dump();

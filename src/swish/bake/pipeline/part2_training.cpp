@@ -86,19 +86,14 @@ TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<c
     theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
   }
   const MatXf teacherShapes = out.meshPca.reconstruct(out.distilled.teacher.predict(theta).topRows(K));
-  MatXf networkCodes(K, theta.cols());
-  for (Eigen::Index i = 0; i < theta.cols(); ++i)
-    networkCodes.col(i) = evaluateMlp(out.regressor.mlp, out.regressor.inputNorm, out.regressor.outputNorm,
-                                      theta.col(i), out.regressor.activation)
-                              .head(K);
-  const MatXf networkShapes = out.meshPca.reconstruct(networkCodes);
   for (size_t i = 0; i < poses.size(); ++i) {
-    const auto truth = Eigen::Map<const VecXf>(poses[i]->gameMeshPreSkin.data(), Eigen::Index(3 * n));
-    for (size_t v = 0; v < n; ++v) {
-      const Eigen::Index r = Eigen::Index(3 * v);
-      c.teacherMm += (teacherShapes.col(Eigen::Index(i)).segment<3>(r) - truth.segment<3>(r)).norm();
-      c.networkMm += (networkShapes.col(Eigen::Index(i)).segment<3>(r) - truth.segment<3>(r)).norm();
-    }
+    const Points3f& truth = poses[i]->gameMeshPreSkin;
+    // The network's side as the report's own pre-skinning figures take it (subject_evaluation.cpp).
+    c.networkMm += (predictPreSkin(m, poses[i]->pose) - truth).rowwise().norm().sum();
+    for (size_t v = 0; v < n; ++v)
+      c.teacherMm +=
+          (teacherShapes.col(Eigen::Index(i)).segment<3>(Eigen::Index(3 * v)) - truth.row(Eigen::Index(v)).transpose())
+              .norm();
   }
   const double count = double(poses.size() * n);
   c.teacherMm *= 1000.0 / count, c.networkMm *= 1000.0 / count;

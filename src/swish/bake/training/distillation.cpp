@@ -55,11 +55,8 @@ DistilledSamples distilledSamples(std::span<const Pose* const> poses, std::span<
 
   DistilledSamples out;
   out.teacher = fitKernelRidge(theta, lambda, s.teacher);
-  const MatXd standardisedTheta =
-      ((theta.colwise() - out.teacher.inputNorm.mean).array().colwise() / out.teacher.inputNorm.scale.array())
-          .matrix()
-          .cast<double>();
-  const std::vector<std::vector<uint32_t>> near = nearestColumns(standardisedTheta, s.neighbours);
+  // The teacher's centres are the training inputs standardised: the space the neighbours are found in.
+  const std::vector<std::vector<uint32_t>> near = nearestColumns(out.teacher.centres, s.neighbours);
 
   Rng rng(s.seed);
   out.theta.resize(theta.rows(), Eigen::Index(s.poses));
@@ -86,7 +83,7 @@ DistilledSamples distilledSamples(std::span<const Pose* const> poses, std::span<
     const std::vector<float> th = runtime::computeTheta(inputJoints, rootGravity, local);
     out.theta.col(Eigen::Index(i)) = Eigen::Map<const VecXf>(th.data(), Eigen::Index(th.size()));
   }
-  out.lambda = s.poses ? out.teacher.predict(out.theta) : MatXf(lambda.rows(), 0);
+  out.lambda = out.teacher.predict(out.theta);
   return out;
 }
 
