@@ -8,7 +8,9 @@
 //     "output": "out",
 //     "work": "out/work",                intermediate files (default <output>/work): the per-pose
 //                                        simulation results (<work>/simulation) and, unless "dataset"
-//                                        says otherwise, the dataset (<work>/dataset)
+//                                        says otherwise, the dataset (<work>/dataset). Bakes that share
+//                                        it take turns at part 1 (<work>/part1.lock; the second waits and
+//                                        names the first), their part 2s run side by side
 //     "dataset": "out/work/dataset",     the dataset folder (bake/dataset/dataset_io.hpp): part 1 writes it,
 //                                        part 2 reads it
 //     "part1": {                         part 1 (bake/pipeline/part1_dataset.hpp); absent: the dataset must exist

@@ -13,6 +13,7 @@
 #include "swish/bake/report/subject_evaluation.hpp"
 #include "swish/core/error.hpp"
 #include "swish/files/atomic_write.hpp"
+#include "swish/files/file_lock.hpp"
 #include "swish/files/json_file.hpp"
 #include "swish/model/model_file.hpp"
 
@@ -97,6 +98,15 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   // Part 1: the dataset folder (resumable: finished simulations and poses are kept).
   if (cfg.part1 && opt.part1) {
     const auto t1 = Clock::now();
+    // One part 1 at a time per work folder: two bakes that share it (part 2 variants of one dataset)
+    // would otherwise both walk part 1 and rewrite its manifest and pose files at once. The second
+    // waits, then finds the first's poses done; part 2s run side by side.
+    std::filesystem::create_directories(cfg.work);
+    const FileLock part1Lock = FileLock::acquire(
+        cfg.work / "part1.lock", "swish bake '" + cfg.name + "', part 1", [&](const std::string& holder) {
+          log("part 1: waiting for " + holder + ", which holds " + (cfg.work / "part1.lock").string());
+        });
+    if (!part1Lock.held()) log("part 1: " + part1Lock.unsupportedReason() + "; going on without the lock");
     log("part 1: building the dataset " + cfg.dataset.string());
     DatasetBuildSettings part1Settings = *cfg.part1;
     part1Settings.alsoRequiredJoints = cfg.train.inputJoints;  // checked before any simulation
