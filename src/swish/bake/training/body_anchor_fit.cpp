@@ -152,6 +152,8 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
     fit.anchors.second[v] = anchor;
     ++fit.secondAnchored;
     ++fit.slideAnchored;
+    fit.isSlide.resize(firstPart.size(), 0);
+    fit.isSlide[v] = 1;
     slides.push_back(1000.f * (worst->rest - fit.anchors.anchors[v].position).norm());
     gaps.push_back(1000.f * worst->gap);
   }
@@ -395,6 +397,10 @@ void onGarmentJoints(BodyAnchorFit& fit, const SkinWeights& skin) {
         ++fit.garmentJointsRemoved;
         size_t& count = set == 0 ? fit.anchored : set == 1 ? fit.secondAnchored : fit.coverAnchored;
         count -= count > 0 ? 1 : 0;
+        if (set == 1 && v < fit.isSlide.size() && fit.isSlide[v]) {
+          fit.isSlide[v] = 0;
+          fit.slideAnchored -= fit.slideAnchored > 0 ? 1 : 0;
+        }
         continue;
       }
       for (size_t i = 0; i < n; ++i) kept.weights[i] /= sum;

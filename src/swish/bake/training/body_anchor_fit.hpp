@@ -75,10 +75,11 @@ struct BodyAnchorSlidePose {
 
 struct BodyAnchorFit {
   BodyAnchors anchors;
-  size_t anchored = 0;        // vertices with an anchor
-  size_t secondAnchored = 0;  // vertices with a second anchor (on another part or a slide one; see the settings)
-  size_t slideAnchored = 0;   // of them, slide anchors (on the vertex's own part, where it slid to)
-  size_t slidePoses = 0;      // poses searched for them
+  size_t anchored = 0;           // vertices with an anchor
+  size_t secondAnchored = 0;     // vertices with a second anchor (on another part or a slide one; see the settings)
+  size_t slideAnchored = 0;      // of them, slide anchors (on the vertex's own part, where it slid to)
+  std::vector<uint8_t> isSlide;  // per garment vertex (or empty: none): 1 where its second anchor is a slide anchor
+  size_t slidePoses = 0;         // poses searched for them
   float slideMedianMm = 0, slideMaxMm = 0;  // of the slide anchors: distance of their contact from the first's (rest)
   float slideGapMedianMm = 0;               // of the slide anchors: how far the first ball missed the skin there
   size_t coverAnchored = 0;                 // vertices with a third (cover) anchor

@@ -206,6 +206,38 @@ TEST(BodyAnchorFit, AnchorsOnTheGarmentVertexsJoints) {
   EXPECT_EQ(bake::toJson(fit)["garment_joints"]["anchors_removed"], 1u);
 }
 
+// The counts follow the anchors onGarmentJoints removes: a slide anchor left with none of its garment
+// vertex's joints is no longer counted among the slide anchors, a second anchor on another part (not a
+// slide one) that goes leaves the slide count alone, and a slide anchor that keeps a joint stays counted.
+TEST(BodyAnchorFit, RemovedSlideAnchorsLeaveTheSlideCount) {
+  auto on = [](uint16_t joint) {
+    BodyAnchor a;
+    a.radius = 0.05f;
+    a.joints[0] = joint;
+    a.weights[0] = 1.f;
+    return a;
+  };
+  bake::BodyAnchorFit fit;
+  fit.anchors.anchors = {on(1), on(1), on(1)};
+  fit.anchors.second = {on(5), on(1), on(6)};  // a slide anchor off the garment's joints, one on them, another part's
+  fit.anchored = 3;
+  fit.secondAnchored = 3;
+  fit.slideAnchored = 2;
+  fit.isSlide = {1, 1, 0};
+  SkinWeights skin;
+  skin.influences = 1;
+  skin.joints = {1, 1, 1};
+  skin.weights = {1.f, 1.f, 1.f};
+  bake::onGarmentJoints(fit, skin);
+  EXPECT_FALSE(fit.anchors.second[0].present());
+  EXPECT_TRUE(fit.anchors.second[1].present());
+  EXPECT_FALSE(fit.anchors.second[2].present());
+  EXPECT_EQ(fit.anchored, 3u);
+  EXPECT_EQ(fit.secondAnchored, 1u);
+  EXPECT_EQ(fit.slideAnchored, 1u);
+  EXPECT_EQ(fit.garmentJointsRemoved, 2u);
+}
+
 // Two boxes side by side, 5 cm apart (x in [-0.1, 0.1] and [0.15, 0.35]), the second skinned to the
 // first's joints shifted by 4: two parts. A vertex between them gets its nearest box as its anchor and
 // the other as its second; a vertex with the other box beyond the bound gets none; with the second
