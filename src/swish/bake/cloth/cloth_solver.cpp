@@ -172,6 +172,7 @@ void ClothSimSettings::validate() const {
   check(std::isfinite(equilibriumSeconds) && equilibriumSeconds >= 0.f && equilibriumSeconds <= 60.f,
         "equilibriumSeconds must be in [0, 60]");
   check(equilibriumIterations >= 0 && equilibriumIterations <= 1000, "equilibriumIterations must be in [0, 1000]");
+  check(equilibriumSubsteps >= 0 && equilibriumSubsteps <= 10000, "equilibriumSubsteps must be in [0, 10000]");
   check(retries >= 0 && retries <= 4, "retries must be in [0, 4]");
   const bool distinct = std::set<ClothCarry>(retryCarries.begin(), retryCarries.end()).size() == retryCarries.size();
   check(!retryCarries.empty() && retryCarries.size() <= 3 && distinct,
@@ -345,6 +346,11 @@ ClothSolver::ClothSolver(const Character& ch, SimulationMesh mesh, ClothSimSetti
   // (9 and 12, hashed only for the translation and dual-quaternion carries, for the same reason.)
   if (s.carry == ClothCarry::Translation) f.value(uint32_t(9));
   if (s.carry == ClothCarry::DualQuaternion) f.value(uint32_t(12));
+  // (13, hashed only when the end phase has substeps of its own.)
+  if (s.equilibriumSubsteps > 0) {
+    f.value(uint32_t(13));
+    f.value(s.equilibriumSubsteps);
+  }
   firstAttemptFingerprint_ = f.h;
   // (10: the retries' carries, hashed only when they are not the skinning one alone. A first-attempt
   // result does not depend on them: the pose driver reuses those by firstAttemptFingerprint.)
@@ -683,14 +689,15 @@ PoseSimulation ClothSolver::simulateOnce(const Pose& target, int slowdown, Cloth
   // The end: frames at the goal pose, at the base settings (equilibriumIterations sweeps), until the
   // residual is at most the tolerance or equilibriumSeconds are spent (none after the static solve).
   const int eqIterations = s.equilibriumIterations > 0 ? s.equilibriumIterations : s.iterations;
+  const int eqSubsteps = s.equilibriumSubsteps > 0 ? s.equilibriumSubsteps : s.substeps;
   const int maxFrames = s.staticSolve ? 0 : int(std::lround(s.equilibriumSeconds * s.frameRate));
   for (int k = 1; k <= maxFrames && r.equilibriumResidual > s.equilibriumTolerance; ++k) {
     before = x;
-    if (std::string why = runFrame(totalFrames + k, 1.f, s.substeps, eqIterations); !why.empty()) return fail(why);
+    if (std::string why = runFrame(totalFrames + k, 1.f, eqSubsteps, eqIterations); !why.empty()) return fail(why);
     measureResidual();
     r.equilibriumFrames = k;
   }
-  r.iterations = totalFrames * s.substeps * slowdown * s.iterations + r.equilibriumFrames * s.substeps * eqIterations;
+  r.iterations = totalFrames * s.substeps * slowdown * s.iterations + r.equilibriumFrames * eqSubsteps * eqIterations;
 
   // Contact that cannot end inside the body: every vertex closer to the posed body than the
   // thickness is moved out along the body's normal there, and the check is repeated (a vertex pushed

@@ -94,6 +94,13 @@ struct ClothSimSettings {
   float equilibriumTolerance = 0.01f;
   float equilibriumSeconds = 0.5f;
   int equilibriumIterations = 10;
+  // Substeps per frame of the end phase (0: `substeps`). The stiff regime (docs/baking.md, "The stiff
+  // regime") leaves XPBD's stretch to the sweeps and the substeps; the same sweeps spread over more
+  // substeps (60 x 2 instead of 12 x 10) end at one stretch whatever the path's substeps. Measured on
+  // the jersey: the stretch converges, the shape does not (the path's folds; docs/baking.md, "The end
+  // phase on substeps of its own"), so off. Hashed into the fingerprint only when set, so that bakes
+  // without it keep their cached poses.
+  int equilibriumSubsteps = 0;
   // The static solve (static_solve.hpp), instead of the equilibrium phase: from the path's end, Newton
   // steps on the garment's energy at the goal pose until the residual (the same unbalanced share of
   // gravity's load, from the forces rather than the motion) is at most staticTolerance or

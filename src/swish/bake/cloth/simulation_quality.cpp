@@ -180,6 +180,7 @@ SimulationQuality measureSimulationQuality(const Character& character, const Clo
   if (ids.empty()) return q;
   ClothSimSettings fine = solver.settings();
   fine.substeps *= 2;
+  fine.equilibriumSubsteps *= 2;  // (0, the path's substeps, stays 0: doubled with them)
   fine.equilibriumTolerance *= 0.5f;
   fine.staticTolerance *= 0.5f;
   const ClothSolver reference(character, solver.mesh(), fine);

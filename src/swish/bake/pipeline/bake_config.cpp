@@ -99,6 +99,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
                                                   "equilibrium_tolerance",
                                                   "equilibrium_seconds",
                                                   "equilibrium_iterations",
+                                                  "equilibrium_substeps",
                                                   "static_solve",
                                                   "static_tolerance",
                                                   "static_iterations",
@@ -157,6 +158,7 @@ void parseShapeSections(const JsonReader& j, DatasetBuildSettings& s) {
   cs.equilibriumTolerance = float(sim.number("equilibrium_tolerance", 1e-6, 10, cs.equilibriumTolerance));
   cs.equilibriumSeconds = float(sim.number("equilibrium_seconds", 0, 60, cs.equilibriumSeconds));
   cs.equilibriumIterations = int(sim.wholeNumber("equilibrium_iterations", 0, 1000, cs.equilibriumIterations));
+  cs.equilibriumSubsteps = int(sim.wholeNumber("equilibrium_substeps", 0, 10000, cs.equilibriumSubsteps));
   // Or the static solve instead (static_solve.hpp): Newton steps until the force residual is at most
   // static_tolerance, for at most static_iterations steps.
   cs.staticSolve = sim.boolean("static_solve", cs.staticSolve);

@@ -40,8 +40,9 @@
 //                      "limb_clearance" (m kept between limbs and trunk, 0: off; limb_clearance.hpp),
 //                      "limb_garment_reach" (m: only the trunk this near the garment is kept clear, 0: all),
 //                      "attach_band" (top share of the garment's height held on the body),
-//                      "equilibrium_tolerance", "equilibrium_seconds", "equilibrium_iterations" (the
-//                      end condition: cloth_solver.hpp), "static_solve" (true: a Newton static solve
+//                      "equilibrium_tolerance", "equilibrium_seconds", "equilibrium_iterations",
+//                      "equilibrium_substeps" (the end condition: cloth_solver.hpp; substeps 0: the
+//                      path's), "static_solve" (true: a Newton static solve
 //                      instead, static_solve.hpp) with "static_tolerance", "static_iterations",
 //                      "retries" (of a failed pose, slower each),
 //                      "final_projection" (out of the body at the end), "carry": "skinning" (default) |

@@ -282,6 +282,7 @@ nlohmann::json DatasetBuildSettings::toJson() const {
   // Only when external, so that the settings (and so the datasets) of solver bakes stay as they were.
   if (external.enabled()) out["simulation"].update(external.toJson());
   // Only when on, likewise.
+  if (m.equilibriumSubsteps > 0) out["simulation"]["equilibrium_substeps"] = m.equilibriumSubsteps;
   if (m.staticSolve) {
     out["simulation"]["static_solve"] = true;
     out["simulation"]["static_tolerance"] = m.staticTolerance;

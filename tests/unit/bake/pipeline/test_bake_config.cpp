@@ -194,6 +194,7 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
                           {"static_solve", true},
                           {"static_tolerance", 0.002},
                           {"static_iterations", 25},
+                          {"equilibrium_substeps", 60},
                           {"carry", "translation"},
                           {"retry_carries", {"translation"}},
                           {"safer_path_retries", false}}},
@@ -256,6 +257,12 @@ TEST(BakeConfig, Part1DefaultsAndValues) {
   const PoseShapeSettings back = poseShapeSettingsFromJson(s.toJson(), "dataset settings");
   EXPECT_TRUE(back.simulation.staticSolve);
   EXPECT_EQ(back.simulation.staticIterations, 25);
+  // The end phase's own substeps likewise: recorded only when set, read back.
+  EXPECT_EQ(s.simulation.equilibriumSubsteps, 60);
+  EXPECT_EQ(d.part1->simulation.equilibriumSubsteps, 0);
+  EXPECT_EQ(s.toJson()["simulation"]["equilibrium_substeps"], 60);
+  EXPECT_FALSE(d.part1->toJson()["simulation"].contains("equilibrium_substeps"));
+  EXPECT_EQ(back.simulation.equilibriumSubsteps, 60);
   // The carry: recorded only when not the skinning one, read back; settings without it (a model
   // baked before it was a setting) carry by skinning.
   EXPECT_EQ(s.simulation.carry, ClothCarry::Translation);
