@@ -102,9 +102,10 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     // would otherwise both walk part 1 and rewrite its manifest and pose files at once. The second
     // waits, then finds the first's poses done; part 2s run side by side.
     std::filesystem::create_directories(cfg.work);
-    const FileLock part1Lock = FileLock::acquire(
-        cfg.work / "part1.lock", "swish bake '" + cfg.name + "', part 1", [&](const std::string& holder) {
-          log("part 1: waiting for " + holder + ", which holds " + (cfg.work / "part1.lock").string());
+    const std::filesystem::path lockFile = cfg.work / "part1.lock";
+    const FileLock part1Lock =
+        FileLock::acquire(lockFile, "swish bake '" + cfg.name + "', part 1", [&](const std::string& holder) {
+          log("part 1: waiting for " + holder + ", which holds " + lockFile.string());
         });
     if (!part1Lock.held()) log("part 1: " + part1Lock.unsupportedReason() + "; going on without the lock");
     log("part 1: building the dataset " + cfg.dataset.string());

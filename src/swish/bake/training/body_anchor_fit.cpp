@@ -138,6 +138,7 @@ template <class AnchorAt>
 void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::vector<int>& firstPart,
                      const std::vector<std::vector<SkinMiss>>& misses, const AnchorAt& anchorAt) {
   std::vector<float> slides, gaps;
+  fit.isSlide.assign(firstPart.size(), 0);
   for (size_t v = 0; v < firstPart.size(); ++v) {
     if (firstPart[v] < 0 || fit.anchors.second[v].present()) continue;
     const SkinMiss* worst = nullptr;
@@ -152,7 +153,6 @@ void fitSlideAnchors(BodyAnchorFit& fit, const BodyCollider& rest, const std::ve
     fit.anchors.second[v] = anchor;
     ++fit.secondAnchored;
     ++fit.slideAnchored;
-    fit.isSlide.resize(firstPart.size(), 0);
     fit.isSlide[v] = 1;
     slides.push_back(1000.f * (worst->rest - fit.anchors.anchors[v].position).norm());
     gaps.push_back(1000.f * worst->gap);
