@@ -19,6 +19,7 @@
 #include "swish/bake/pipeline/part2_training.hpp"
 #include "swish/bake/report/bake_report.hpp"
 #include "swish/bake/report/subject_evaluation.hpp"
+#include "swish/bake/training/body_anchor_fit.hpp"
 #include "swish/core/error.hpp"
 #include "swish/core/skinning.hpp"
 #include "swish/model/model_file.hpp"
@@ -353,6 +354,74 @@ TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
     }
   std::printf("cover anchors: %zu of %zu vertices (%zu misses)\n", loaded.bodyAnchors.anchored(2),
               loaded.gameMesh.vertexCount(), meta["body_anchors"]["cover_misses"].get<size_t>());
+}
+
+// train.anchor_poses "as_played": the slide and cover anchors are fitted on each frame's nearest training
+// pose, repeats kept and in the frames' order, instead of on the training poses. The frames here are two
+// training poses (one of them three times, the other turned by a hair): the model's anchors are what the
+// fit gives on exactly those four poses, and its metadata says where they came from.
+TEST(BakePart2, AnchorsAsPlayedAreFittedOnEachFramesNearestTrainingPose) {
+  const uint64_t seed = test::testSeed(506);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const Dataset ds = syntheticDataset(seed, 80, 32);
+  BakeTrainSettings st = smallTraining();
+  st.normalCodeDims = 0;
+  st.mlp.maxEpochs = 5;
+  st.calibrateAnchors = false;
+  st.anchorMargin = 0.006f;
+  st.coverAnchors = true;
+  const BakeTrainOutput training = trainBake(ds, st);
+  ASSERT_GT(training.trainingPoses.size(), 12u);
+  const DatasetPose& a = ds.poses[training.trainingPoses[3]];
+  const DatasetPose& b = ds.poses[training.trainingPoses[11]];
+  Pose bTurned = b.pose;
+  for (uint32_t j : ds.inputJoints)
+    bTurned.local[j] = (bTurned.local[j] * Quatf(Eigen::AngleAxisf(1e-3f, Vec3f::UnitY()))).normalized();
+  const std::vector<Pose> frames = {a.pose, bTurned, a.pose, a.pose};
+
+  st.anchorsAsPlayed = true;
+  const BakeTrainOutput played = trainBake(ds, st, {}, frames);
+  EXPECT_EQ(played.trainingPoses, training.trainingPoses);  // the same split: only the anchors' poses differ
+  const auto meta = nlohmann::json::parse(played.model.metadata)["body_anchors"];
+  EXPECT_EQ(meta["poses_from"], "as_played");
+  EXPECT_EQ(meta["as_played"]["frames"], 4);
+  EXPECT_EQ(meta["as_played"]["distinct_training_poses"], 2);
+  EXPECT_LT(meta["as_played"]["theta_distance_max"].get<double>(), 0.01);
+  EXPECT_EQ(meta["slide_poses"], 4);
+  EXPECT_EQ(nlohmann::json::parse(training.model.metadata)["body_anchors"]["poses_from"], "training");
+
+  BodyAnchorFitSettings fs;
+  fs.margin = st.anchorMargin;
+  fs.coverAnchors = true;
+  std::vector<BodyAnchorSlidePose> byHand;
+  for (const DatasetPose* p : {&a, &b, &a, &a})
+    byHand.push_back({played.model.skeleton.skinningMatrices(p->pose), &p->gameMeshWorld});
+  const BodyAnchorFit fit = fitBodyAnchors(ds.character.body, played.model.skeleton, played.model.gameMesh, fs, byHand);
+  const BodyAnchors& got = played.model.bodyAnchors;
+  auto same = [](const std::vector<BodyAnchor>& x, const std::vector<BodyAnchor>& y, const char* set) {
+    ASSERT_EQ(x.size(), y.size()) << set;
+    for (size_t v = 0; v < x.size(); ++v) {
+      ASSERT_EQ(x[v].position, y[v].position) << set << " anchor of vertex " << v;
+      ASSERT_EQ(x[v].radius, y[v].radius) << set << " anchor of vertex " << v;
+      ASSERT_EQ(x[v].joints, y[v].joints) << set << " anchor of vertex " << v;
+      ASSERT_EQ(x[v].weights, y[v].weights) << set << " anchor of vertex " << v;
+    }
+  };
+  same(got.anchors, fit.anchors.anchors, "first");
+  same(got.second, fit.anchors.second, "second");
+  same(got.third, fit.anchors.third, "third");
+  ASSERT_GT(got.anchored(2), 0u) << "the synthetic poses slide the cloth over the body";
+  // ... and not what the training poses give (the four poses are not the fit's 400).
+  bool differs = training.model.bodyAnchors.third.size() != got.third.size();
+  for (size_t v = 0; !differs && v < got.third.size(); ++v)
+    differs = training.model.bodyAnchors.third[v].position != got.third[v].position;
+  EXPECT_TRUE(differs);
+
+  // Frames without the setting, or the setting without frames, are mistakes that say so.
+  EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("needs frames of the training clips"), std::string::npos);
+  st.anchorsAsPlayed = false;
+  EXPECT_NE(test::errorOf([&] { trainBake(ds, st, {}, frames); }).find("train.anchor_poses is \"training\""),
+            std::string::npos);
 }
 
 // train.root_gravity: a shape that follows the root's lean, which no input joint's local rotation holds,

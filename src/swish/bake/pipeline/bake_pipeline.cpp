@@ -8,7 +8,9 @@
 #include <set>
 
 #include "swish/bake/dataset/dataset_io.hpp"
+#include "swish/bake/pipeline/pose_shape.hpp"
 #include "swish/bake/poses/clip_list.hpp"
+#include "swish/bake/poses/pose_sampling.hpp"
 #include "swish/bake/report/bake_report.hpp"
 #include "swish/bake/report/subject_evaluation.hpp"
 #include "swish/core/error.hpp"
@@ -77,6 +79,31 @@ std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const
   heldOut.sampling.characters = 1;
   heldOut.sampling.mirrorOddCharacters = false;
   return {training, heldOut};
+}
+
+std::vector<Pose> anchorFramesAsPlayed(const BakeConfig& cfg, const Skeleton& skeleton,
+                                       const std::function<void(const std::string&)>& log,
+                                       std::vector<std::string>* clipOf) {
+  if (!cfg.train.anchorsAsPlayed) return {};
+  if (!cfg.part1) throw Error("bake: train.anchor_poses \"as_played\" reads part1.clips; the recipe has no part1");
+  const auto t = Clock::now();
+  const DatasetBuildSettings training = splitHeldOutSubjects(*cfg.part1).first;
+  const std::vector<AnimationClip> clips =
+      importClips(training.clips, skeleton, training.inputJoints, training.threads);
+  const PoseSamples frames = evenlySpacedFrames(clips, cfg.train.anchorFramesAsPlayed);
+  std::vector<Pose> poses;
+  for (const PoseSamples::Origin& o : frames.origins) {
+    poses.push_back(canonicalPose(skeleton, poseOfSample(skeleton, clips, o)));
+    if (clipOf) clipOf->push_back(training.clips[o.clip].file.filename().string());
+  }
+  if (log) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "part 2: %zu frames as played, spread over the %zu training clips, for the body anchors (%.1f s)",
+                  poses.size(), clips.size(), std::chrono::duration<double>(Clock::now() - t).count());
+    log(line);
+  }
+  return poses;
 }
 
 DatasetBuildSettings bakeTrainingSettings(const BakeConfig& cfg) {
@@ -160,8 +187,9 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   const Dataset ds = readDataset(cfg.dataset);
   log("part 2: " + std::to_string(ds.poses.size()) + " poses, " + std::to_string(ds.character.garment.vertexCount()) +
       " game-mesh vertices");
+  const std::vector<Pose> anchorFrames = anchorFramesAsPlayed(cfg, ds.character.skeleton, log);
   const auto t2 = Clock::now();
-  BakeTrainOutput out = trainBake(ds, cfg.train, [&](const std::string& stage, double f) {
+  const BakeProgress progress = [&](const std::string& stage, double f) {
     const double el = std::chrono::duration<double>(Clock::now() - t2).count();
     char line[256];
     if (f > 0.0 && f < 1.0)
@@ -170,7 +198,8 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     else
       std::snprintf(line, sizeof line, "part 2: %3.0f%% %-32s %6.1f s elapsed", 100.0 * f, stage.c_str(), el);
     log(line);
-  });
+  };
+  BakeTrainOutput out = trainBake(ds, cfg.train, progress, anchorFrames);
   if (out.ladder.measured()) {
     std::string line = "part 2: quality levels on the held-out poses (vertex mean mm, CPU us per character):";
     char item[96];

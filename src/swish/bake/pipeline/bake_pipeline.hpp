@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "swish/bake/pipeline/bake_config.hpp"
 
@@ -41,6 +42,15 @@ std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const
 // training split above, with the network's input joints required of the clips. `swish bake`, its Slurm
 // array and `--export-poses` all plan their pose list from this, so the lists (and their digests) agree.
 DatasetBuildSettings bakeTrainingSettings(const BakeConfig& config);
+
+// train.anchor_poses "as_played" (BakeTrainSettings::anchorsAsPlayed): about train.anchorFramesAsPlayed
+// frames spread evenly over the training clips of config.part1 (the held-out subjects' left out; by
+// length, at least one per clip: evenlySpacedFrames), one character, unmirrored, each upright as part 1
+// simulates it (canonicalPose), on `skeleton`; empty when it is off. `clipOf` (optional): per frame, the
+// file name of its clip. Throws Error for a clip that does not read (named) or a recipe without part1.
+std::vector<Pose> anchorFramesAsPlayed(const BakeConfig& config, const Skeleton& skeleton,
+                                       const std::function<void(const std::string&)>& log = {},
+                                       std::vector<std::string>* clipOf = nullptr);
 
 BakeRunResult runBake(const BakeConfig& config, const BakeRunOptions& options = {});
 

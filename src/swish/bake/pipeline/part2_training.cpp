@@ -48,7 +48,9 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (anchorMargin != BodyAnchorFitSettings{}.margin)  // likewise; in micrometres' steps, as the recipe writes it
     j["anchor_margin_mm"] = std::round(1e6 * double(anchorMargin)) / 1e3;
   if (coverAnchors) j["cover_anchors"] = true;  // likewise
-  if (distill.poses > 0)                        // likewise
+  if (anchorsAsPlayed)                          // likewise
+    j["anchor_poses"] = {{"from", "as_played"}, {"frames", anchorFramesAsPlayed}};
+  if (distill.poses > 0)  // likewise
     j["distill"] = {{"poses", distill.poses},
                     {"mix_share", distill.mixShare},
                     {"swap_probability", distill.swapProbability},
@@ -58,6 +60,41 @@ nlohmann::json BakeTrainSettings::toJson() const {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+
+// train.anchor_poses "as_played": per frame, the training pose nearest it (Euclidean in the network's
+// Theta, `trainingTheta`'s columns; ties to the lower index), repeats kept.
+struct AnchorPosesAsPlayed {
+  std::vector<uint32_t> trainingIndex;  // per frame, a column of trainingTheta
+  size_t distinct = 0;
+  double medianDistance = 0.0, maxDistance = 0.0;
+};
+AnchorPosesAsPlayed nearestTrainingPoses(const MatXf& trainingTheta, const std::vector<uint32_t>& thetaJoints,
+                                         bool rootGravity, std::span<const Pose> frames) {
+  AnchorPosesAsPlayed out;
+  if (trainingTheta.cols() == 0) throw Error("bake: train.anchor_poses \"as_played\": no training pose");
+  std::vector<double> distances;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    for (uint32_t j : thetaJoints)
+      if (j >= frames[f].local.size() || !frames[f].local[j].coeffs().allFinite())
+        throw Error("bake: train.anchor_poses \"as_played\": frame " + std::to_string(f) +
+                    " lacks a finite rotation of input joint " + std::to_string(j));
+    const std::vector<float> th = runtime::computeTheta(thetaJoints, rootGravity, frames[f].local);
+    const Eigen::Map<const VecXf> x(th.data(), Eigen::Index(th.size()));
+    Eigen::Index best = 0;
+    const float d2 = (trainingTheta.colwise() - x).colwise().squaredNorm().minCoeff(&best);
+    out.trainingIndex.push_back(uint32_t(best));
+    distances.push_back(std::sqrt(double(d2)));
+  }
+  std::vector<uint32_t> sorted = out.trainingIndex;
+  std::sort(sorted.begin(), sorted.end());
+  out.distinct = size_t(std::unique(sorted.begin(), sorted.end()) - sorted.begin());
+  if (!distances.empty()) {
+    std::sort(distances.begin(), distances.end());
+    out.medianDistance = distances[distances.size() / 2];
+    out.maxDistance = distances.back();
+  }
+  return out;
+}
 }  // namespace
 
 std::vector<uint32_t> networkInputJoints(const Dataset& ds, const BakeTrainSettings& st) {
@@ -101,10 +138,17 @@ TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<c
   return c;
 }
 
-BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress) {
+BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress,
+                          std::span<const Pose> anchorFrames) {
   auto report = [&](const std::string& s, double f) {
     if (progress) progress(s, f);
   };
+  if (st.anchorsAsPlayed && anchorFrames.empty())
+    throw Error(
+        "bake: train.anchor_poses \"as_played\" needs frames of the training clips (a bake reads them from "
+        "part1.clips; this one has none)");
+  if (!st.anchorsAsPlayed && !anchorFrames.empty())
+    throw Error("bake: frames as played were given for the anchors, but train.anchor_poses is \"training\"");
   const size_t poses = ds.poses.size();
   if (poses < 3) throw Error("bake: the dataset has " + std::to_string(poses) + " poses; training needs at least 3");
   if (ds.inputJoints.empty()) throw Error("bake: the dataset names no input joints (Theta)");
@@ -332,9 +376,26 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       const DatasetPose& p = ds.poses[out.trainingPoses[i]];
       slidePoses[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld};
     }
+    // train.anchor_poses "as_played": those of each frame's nearest training pose instead, in the frames'
+    // order (the fit spreads its slidePoses evenly over what it is given: all of them, at 400 frames).
+    nlohmann::json asPlayed;
+    if (st.anchorsAsPlayed) {
+      const AnchorPosesAsPlayed chosen =
+          nearestTrainingPoses(theta.leftCols(Eigen::Index(nTrain)), thetaJoints, st.rootGravity, anchorFrames);
+      std::vector<BodyAnchorSlidePose> played;
+      for (uint32_t i : chosen.trainingIndex) played.push_back(slidePoses[i]);
+      slidePoses = std::move(played);
+      fitSettings.slidePoses = std::max(fitSettings.slidePoses, slidePoses.size());
+      asPlayed = {{"frames", anchorFrames.size()},
+                  {"distinct_training_poses", chosen.distinct},
+                  {"theta_distance_median", chosen.medianDistance},
+                  {"theta_distance_max", chosen.maxDistance}};
+    }
     BodyAnchorFit fit =
         fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh, fitSettings, slidePoses);
     out.metadata["body_anchors"] = toJson(fit);
+    out.metadata["body_anchors"]["poses_from"] = st.anchorsAsPlayed ? "as_played" : "training";
+    if (st.anchorsAsPlayed) out.metadata["body_anchors"]["as_played"] = asPlayed;
     if (st.calibrateAnchors) {
       std::vector<Points3f> predicted(out.trainingPoses.size());
       std::vector<BodyAnchorCalibrationPose> cal(out.trainingPoses.size());

@@ -3,6 +3,7 @@
 // k-means database, VQ, MLP -> validated Model, plus every measurement the bake report shows.
 // Poses are split once (seeded) into a training set and a held-out test set that nothing is fitted on.
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,17 @@ struct BakeTrainSettings {
   // Off unless the recipe asks (then recorded; absent when off, so that earlier bakes' fingerprints stay):
   // the committed default model was baked before it.
   bool coverAnchors = false;
+  // The poses the slide and cover anchors are fitted on (train.anchor_poses). "training", the default: up
+  // to 400 of the training poses, spread evenly. Those are the thinned set, spread over the corpus's pose
+  // space, so its extremes (arms overhead, deep bends) count as often as the walks and stances a game
+  // shows most. "as_played": for each of anchorFramesAsPlayed frames spread evenly over the training
+  // clips as a game plays them (one character, unmirrored: the held-out subjects' frames are drawn the
+  // same way), the training pose nearest it in the network's Theta, repeats kept, so that each pose
+  // weighs as much as the play it stands for. runBake reads those frames from part1.clips and hands
+  // them to trainBake (its anchorFrames). Recorded when on; absent when off, so that earlier bakes'
+  // fingerprints stay. (docs/baking.md, "Anchors fitted on the frames as played".)
+  bool anchorsAsPlayed = false;
+  size_t anchorFramesAsPlayed = 400;
   // Distillation (train.distill; distillation.hpp): a kernel-ridge teacher fitted on the training poses
   // labels distill.poses synthetic poses, and the MLP trains on them beside the simulated ones. Off (0
   // poses) unless the recipe asks; recorded when on.
@@ -128,6 +140,9 @@ struct TeacherComparison {
 };
 TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<const DatasetPose*>& poses);
 
-BakeTrainOutput trainBake(const Dataset& dataset, const BakeTrainSettings& settings, const BakeProgress& progress = {});
+// `anchorFrames`: with settings.anchorsAsPlayed, the frames as played that choose the anchors' poses
+// (above); Error when that is on and none are given, or when they are given with it off.
+BakeTrainOutput trainBake(const Dataset& dataset, const BakeTrainSettings& settings, const BakeProgress& progress = {},
+                          std::span<const Pose> anchorFrames = {});
 
 }  // namespace swish::bake

@@ -158,6 +158,34 @@ bool says(const std::string& error, const std::string& what) {
 }
 }  // namespace
 
+TEST(BakeConfig, AnchorPosesAsPlayed) {
+  // The anchors' poses: the training poses unless the recipe asks for the frames as played (then recorded
+  // with their count; absent by default, likewise), which need part1's clips.
+  const BakeConfig w = parseBakeConfig({{"output", "o"}, {"part1", part1()}}, "recipe.json", "/base");
+  EXPECT_FALSE(w.train.anchorsAsPlayed);
+  EXPECT_FALSE(w.train.toJson().contains("anchor_poses"));
+  const BakeConfig ap = parseBakeConfig(
+      {{"output", "o"}, {"part1", part1()}, {"train", {{"anchor_poses", "as_played"}}}}, "recipe.json", "/base");
+  EXPECT_TRUE(ap.train.anchorsAsPlayed);
+  EXPECT_EQ(ap.train.anchorFramesAsPlayed, 400u);
+  EXPECT_EQ(ap.train.toJson()["anchor_poses"], nlohmann::json({{"from", "as_played"}, {"frames", 400}}));
+  const BakeConfig ap2 = parseBakeConfig(
+      {{"output", "o"}, {"part1", part1()}, {"train", {{"anchor_poses", {{"from", "as_played"}, {"frames", 50}}}}}},
+      "recipe.json", "/base");
+  EXPECT_EQ(ap2.train.anchorFramesAsPlayed, 50u);
+  EXPECT_FALSE(parseBakeConfig({{"output", "o"}, {"train", {{"anchor_poses", "training"}}}}, "recipe.json", "/base")
+                   .train.toJson()
+                   .contains("anchor_poses"));
+  EXPECT_NE(errorOf({{"output", "o"}, {"train", {{"anchor_poses", "as_played"}}}}).find("has no part1 section"),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"part1", part1()}, {"train", {{"anchor_poses", "played"}}}})
+                .find("train.anchor_poses: must be \"training\" or \"as_played\""),
+            std::string::npos);
+  EXPECT_NE(errorOf({{"output", "o"}, {"part1", part1()}, {"train", {{"anchor_poses", {{"frames", 5}}}}}})
+                .find("train.anchor_poses.from: is required"),
+            std::string::npos);
+}
+
 TEST(BakeConfig, Part1DefaultsAndValues) {
   const BakeConfig d = parseBakeConfig({{"output", "o"}, {"part1", part1()}}, "recipe.json", "/base");
   ASSERT_TRUE(d.part1.has_value());

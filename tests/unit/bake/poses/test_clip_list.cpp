@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 
 #include "support/error_message.hpp"
 #include "support/paths.hpp"
@@ -504,6 +505,50 @@ TEST(ClipListCorpus, TheSmallCorpusRecipeLoads) {
   EXPECT_EQ(training.clips.size(), 133u);
   EXPECT_EQ(heldOut.evenPoses, 60u);
   EXPECT_FALSE(heldOut.includeRestPose);
+}
+
+// train.anchor_poses "as_played" on the small corpus recipe: the frames the anchors' poses are chosen by
+// come from the training clips of both skeletons (the Daz-rig ones through the joint map), upright as
+// part 1 simulates them, and none from the held-out subjects.
+TEST(ClipListCorpus, FramesAsPlayedForTheAnchorsLeaveTheHeldOutSubjectsOut) {
+  SKIP_WITHOUT_CORPUS();
+  BakeConfig cfg = loadBakeConfig(test::sourceDir() / "assets/corpus_small/bake.json");
+  ASSERT_TRUE(cfg.part1.has_value());
+  const Character character = makeDefaultCharacter();
+  EXPECT_TRUE(anchorFramesAsPlayed(cfg, character.skeleton).empty());  // off: none read
+  cfg.train.anchorsAsPlayed = true;
+  cfg.train.anchorFramesAsPlayed = 120;
+  std::vector<std::string> clipOf;
+  const std::vector<Pose> frames = anchorFramesAsPlayed(cfg, character.skeleton, {}, &clipOf);
+  // (evenlySpacedFrames: about that many, spread by length, at least one per clip.)
+  const auto [trainingSources, heldOutSources] = splitHeldOutSubjects(*cfg.part1);
+  ASSERT_GE(frames.size(), 120u);
+  ASSERT_LE(frames.size(), 120u + trainingSources.clips.size());
+  ASSERT_EQ(clipOf.size(), frames.size());
+  std::set<std::string> held, trainingClips, seen;
+  for (const ClipSource& c : heldOutSources.clips) held.insert(c.file.filename().string());
+  for (const ClipSource& c : trainingSources.clips) trainingClips.insert(c.file.filename().string());
+  for (const std::string& c : clipOf) {
+    EXPECT_FALSE(held.count(c)) << c << " is a held-out subject's clip";
+    EXPECT_TRUE(trainingClips.count(c)) << c;
+    seen.insert(c);
+  }
+  EXPECT_EQ(seen, trainingClips) << "every training clip, of both skeletons, gives at least one frame";
+  const std::vector<uint32_t> joints = [&] {
+    std::vector<uint32_t> j;
+    for (const std::string& name : cfg.part1->inputJoints) j.push_back(uint32_t(character.skeleton.find(name)));
+    return j;
+  }();
+  const std::vector<float> rest = runtime::computeTheta(joints, character.skeleton.restPose().local);
+  size_t moving = 0;
+  for (const Pose& f : frames) {
+    ASSERT_EQ(f.local.size(), character.skeleton.size());
+    const std::vector<float> th = runtime::computeTheta(joints, f.local);
+    float d = 0.f;
+    for (size_t k = 0; k < th.size(); ++k) d += (th[k] - rest[k]) * (th[k] - rest[k]);
+    moving += d > 1e-4f;
+  }
+  EXPECT_GT(moving, 100u) << "the frames are poses of the clips, not the rest pose";
 }
 
 TEST(ClipList, HeldOutSubjectsMustBeInTheListAndLeaveSomethingToTrainOn) {
