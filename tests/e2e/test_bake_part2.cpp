@@ -419,8 +419,34 @@ TEST(BakePart2, AnchorsAsPlayedAreFittedOnEachFramesNearestTrainingPose) {
 
   // Frames without the setting, or the setting without frames, are mistakes that say so.
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("needs frames of the training clips"), std::string::npos);
+
+  // "simulated": the frames' own shapes (a dataset of them; here three of the poses, one a held-out one)
+  // instead of their nearest training poses'.
+  Dataset shapes;
+  shapes.character = ds.character;
+  shapes.inputJoints = ds.inputJoints;
+  for (uint32_t i : {training.trainingPoses[5], training.testPoses[0], training.trainingPoses[7]})
+    shapes.poses.push_back(ds.poses[i]);
+  st.anchorFramesSimulated = true;
+  EXPECT_NE(test::errorOf([&] { trainBake(ds, st, {}, frames); }).find("needs the frames' simulations"),
+            std::string::npos);
+  const BakeTrainOutput simulated = trainBake(ds, st, {}, {}, &shapes);
+  const auto simMeta = nlohmann::json::parse(simulated.model.metadata)["body_anchors"];
+  EXPECT_EQ(simMeta["as_played"]["simulated"], true);
+  EXPECT_EQ(simMeta["as_played"]["frames"], 3);
+  EXPECT_EQ(simMeta["slide_poses"], 3);
+  std::vector<BodyAnchorSlidePose> simByHand;
+  for (const DatasetPose& p : shapes.poses)
+    simByHand.push_back({simulated.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld});
+  const BodyAnchorFit simFit =
+      fitBodyAnchors(ds.character.body, simulated.model.skeleton, simulated.model.gameMesh, fs, simByHand);
+  same(simulated.model.bodyAnchors.second, simFit.anchors.second, "second (simulated frames)");
+  same(simulated.model.bodyAnchors.third, simFit.anchors.third, "third (simulated frames)");
+
   st.anchorsAsPlayed = false;
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st, {}, frames); }).find("train.anchor_poses is \"training\""),
+            std::string::npos);
+  EXPECT_NE(test::errorOf([&] { trainBake(ds, st, {}, {}, &shapes); }).find("train.anchor_poses is \"training\""),
             std::string::npos);
 }
 

@@ -250,6 +250,43 @@ TEST(BakeWhole, ReRunRedoesNothing) {
   EXPECT_EQ(fs::last_write_time(w.first.model), stamp);
 }
 
+// train.anchor_poses {"from": "as_played", "simulated": true}: part 1 simulates frames of the training
+// clips as a game plays them into a dataset of their own (beside the shared bake's training poses, whose
+// simulations it reuses through the same work folder), part 2 fits the slide and cover anchors on them and
+// says so, and a re-run simulates nothing again and keeps the model.
+TEST(BakeWhole, AnchorsOnSimulatedFramesAsPlayedAreMadeByPart1AndResumed) {
+  if (!requireClip()) GTEST_SKIP() << kClip << " is missing (Debian package assimp-testmodels)";
+  WholeBake& w = sharedBake();
+  nlohmann::json j = smallConfig();
+  j["name"] = "played";
+  j["output"] = "played";
+  j["work"] = w.config.work.string();
+  j["train"]["cover_anchors"] = true;
+  j["train"]["anchor_poses"] = {{"from", "as_played"}, {"frames", 12}, {"simulated", true}};
+  const BakeConfig cfg = parseBakeConfig(j, "played.json", w.dir);
+  ASSERT_TRUE(cfg.simulatesAnchorFrames());
+  const BakeRunResult first = runBake(cfg);
+  EXPECT_EQ(first.part1["simulations_reused"], w.first.part1["kept_poses"]);  // the training poses: reused
+  ASSERT_TRUE(first.part1.contains("anchor_frames"));
+  EXPECT_EQ(first.part1["anchor_frames"]["kept_poses"].get<size_t>(), 12u);
+  EXPECT_EQ(first.part1["anchor_frames"]["simulated"].get<size_t>(), 12u);
+  const Dataset frames = readDataset(cfg.anchorFramesDatasetDir());
+  ASSERT_GT(frames.poses.size(), 6u);
+  const Model m = loadModel(first.model);
+  const auto meta = nlohmann::json::parse(m.metadata);
+  EXPECT_EQ(meta["body_anchors"]["poses_from"], "as_played");
+  EXPECT_EQ(meta["body_anchors"]["as_played"]["simulated"], true);
+  EXPECT_EQ(meta["body_anchors"]["as_played"]["frames"].get<size_t>(), frames.poses.size());
+  EXPECT_EQ(meta["body_anchors"]["slide_poses"].get<size_t>(), frames.poses.size());
+  EXPECT_EQ(meta["settings"]["anchor_poses"]["simulated"], true);
+  EXPECT_GT(m.bodyAnchors.anchored(), 0u);
+  // Resumed: nothing simulated again, and the model is current.
+  const BakeRunResult again = runBake(cfg);
+  EXPECT_EQ(again.part1["anchor_frames"]["simulated"].get<size_t>(), 0u);
+  EXPECT_EQ(again.part1["anchor_frames"]["simulations_reused"].get<size_t>(), 12u);
+  EXPECT_TRUE(again.part2Skipped);
+}
+
 // train.input_joints is part 2's, but a joint the character lacks stops the bake before part 1
 // simulates anything: the error names the key and the joint, and no simulation file is written.
 TEST(BakeWhole, AnUnknownNetworkJointStopsTheBakeBeforeAnySimulation) {

@@ -221,6 +221,15 @@ swish::cli::RunFn setup(CLI::App& sub) {
             names.c_str(), heldOut.clips.size(), cfg.part1->holdoutPoses, cfg.holdoutDatasetDir().string().c_str(),
             training.clips.size());
       }
+      if (cfg.simulatesAnchorFrames())
+        std::printf(
+            "body anchors: about %zu frames as played of the training clips -> simulation in %s -> dataset %s\n",
+            cfg.train.anchorFramesAsPlayed, cfg.anchorFramesSimulationDir().string().c_str(),
+            cfg.anchorFramesDatasetDir().string().c_str());
+      else if (cfg.train.anchorsAsPlayed)
+        std::printf(
+            "body anchors: fitted on the training poses nearest about %zu frames as played of the training clips\n",
+            cfg.train.anchorFramesAsPlayed);
       if (!cfg.part1) std::printf("part 1: none (the dataset %s must exist)\n", cfg.dataset.string().c_str());
       return 0;
     }

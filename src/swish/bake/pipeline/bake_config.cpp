@@ -450,15 +450,21 @@ BakeConfig parseBakeConfig(const nlohmann::json& json, const std::string& source
   t.anchorMargin = float(train.number("anchor_margin_mm", 0, 50, 1000.0 * t.anchorMargin) / 1000.0);
   t.coverAnchors = train.boolean("cover_anchors", t.coverAnchors);
   if (train.has("anchor_poses")) {
-    // "training" or "as_played", or {"from": one of those, "frames": N} (BakeTrainSettings::anchorsAsPlayed).
+    // "training" or "as_played", or {"from": one of those, "frames": N, "simulated": bool}
+    // (BakeTrainSettings::anchorsAsPlayed).
     const JsonReader a = train.child("anchor_poses");
     const bool object = a.value().is_object();
-    if (object) a.requireObject({"from", "frames"});
+    if (object) a.requireObject({"from", "frames", "simulated"});
     const JsonReader from = object ? a.required("from") : a;
     const std::string v = from.string();
     if (v != "training" && v != "as_played") from.fail("must be \"training\" or \"as_played\"");
     t.anchorsAsPlayed = v == "as_played";
-    if (object) t.anchorFramesAsPlayed = size_t(a.wholeNumber("frames", 1, 100000, double(t.anchorFramesAsPlayed)));
+    if (object) {
+      t.anchorFramesAsPlayed = size_t(a.wholeNumber("frames", 1, 100000, double(t.anchorFramesAsPlayed)));
+      t.anchorFramesSimulated = a.boolean("simulated", false);
+      if (t.anchorFramesSimulated && !t.anchorsAsPlayed)
+        a.child("simulated").fail("simulates frames as played: it needs \"from\": \"as_played\"");
+    }
     if (t.anchorsAsPlayed && !cfg.part1)
       a.fail("\"as_played\" reads frames of part1.clips, and this recipe has no part1 section");
   }

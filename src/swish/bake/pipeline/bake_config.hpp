@@ -77,7 +77,11 @@
 //       shares that much of it evenly over the components), "max_training_seconds", "test_fraction",
 //       "temporal_time_constant", "seed", "bc5_baseline", "anchor_calibration" ("strict", the default: the push-out's
 //       anchors calibrated on the training poses; "none": every anchor keeps the margin; part2_training.hpp),
-//       "anchor_margin_mm" (the push-out's margin, 0..50, default 2),
+//       "anchor_margin_mm" (the push-out's margin, 0..50, default 2), "cover_anchors" (the third anchor set,
+//       default off), "anchor_poses" ("training", the default: the slide and cover anchors fitted on the
+//       training poses; "as_played", or {"from": "as_played", "frames": 400}: on the training pose nearest
+//       each of about that many frames of part1's training clips as a game plays them; with "simulated":
+//       true, on those frames' own simulations, which part 1 adds; part2_training.hpp),
 //       "distill": {"poses" (required), "mix_share", "swap_probability", "neighbours"} (a kernel-ridge
 //                  teacher's labels for synthetic poses beside the simulated ones; distillation.hpp),
 //       "input_joints" (the network's Theta joints; absent:
@@ -112,6 +116,11 @@ struct BakeConfig {
   // The held-out subjects' poses (part1.holdout): their own simulations and dataset.
   std::filesystem::path holdoutSimulationDir() const { return work / "simulation_holdout"; }
   std::filesystem::path holdoutDatasetDir() const { return work / "holdout_dataset"; }
+  // The training clips' frames as played that the body anchors are fitted on (train.anchor_poses
+  // "as_played" with "simulated": true): their own simulations and dataset.
+  std::filesystem::path anchorFramesSimulationDir() const { return work / "simulation_anchor_frames"; }
+  std::filesystem::path anchorFramesDatasetDir() const { return work / "anchor_frames_dataset"; }
+  bool simulatesAnchorFrames() const { return part1 && train.anchorsAsPlayed && train.anchorFramesSimulated; }
 };
 
 // `source` names the config in error messages; `baseDir` resolves relative paths.

@@ -45,6 +45,8 @@ std::string fingerprint(const BakeConfig& cfg) {
   std::string manifest = manifestContent(cfg.dataset / "manifest.json");
   if (cfg.part1 && !cfg.part1->holdoutSubjects.empty())  // the held-out subjects' dataset is evaluated too
     manifest += manifestContent(cfg.holdoutDatasetDir() / "manifest.json");
+  if (cfg.simulatesAnchorFrames())  // the body anchors are fitted on the frames as played
+    manifest += manifestContent(cfg.anchorFramesDatasetDir() / "manifest.json");
   return std::to_string(std::hash<std::string>{}(manifest)) + "/" + cfg.train.toJson().dump();
 }
 
@@ -72,13 +74,18 @@ std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const
   if (held.empty()) return {training, heldOut};
   if (training.clips.empty())
     throw Error("bake part 1: part1.holdout holds out every clip: nothing is left to train on");
+  return {training, framesAsPlayed(heldOut, s.holdoutPoses)};
+}
+
+DatasetBuildSettings framesAsPlayed(DatasetBuildSettings s, size_t count) {
   // Frames as a game plays them, one character, unmirrored; nothing added, nothing previewed.
-  heldOut.evenPoses = s.holdoutPoses;
-  heldOut.includeRestPose = false;
-  heldOut.previewPoses = 0;
-  heldOut.sampling.characters = 1;
-  heldOut.sampling.mirrorOddCharacters = false;
-  return {training, heldOut};
+  s.evenPoses = count;
+  s.includeRestPose = false;
+  s.previewPoses = 0;
+  s.sampling.characters = 1;
+  s.sampling.mirrorOddCharacters = false;
+  s.simulatedPoseList = {};  // a cluster's pose list is the training poses'
+  return s;
 }
 
 std::vector<Pose> anchorFramesAsPlayed(const BakeConfig& cfg, const Skeleton& skeleton,
@@ -145,16 +152,25 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     if (!heldOut.clips.empty()) {
       log("part 1: the held-out subjects' frames: " + std::to_string(heldOut.clips.size()) + " clips -> " +
           cfg.holdoutDatasetDir().string());
-      DatasetBuildSettings heldOutSettings = heldOut;
-      heldOutSettings.simulatedPoseList = {};  // a cluster's pose list is the training poses'
       const DatasetBuildResult h =
-          buildDataset(heldOutSettings, cfg.holdoutDatasetDir(), cfg.holdoutSimulationDir(), {}, opt.log);
+          buildDataset(heldOut, cfg.holdoutDatasetDir(), cfg.holdoutSimulationDir(), {}, opt.log);
       res.holdoutPart1 = h.toJson();
+    }
+    nlohmann::json anchorFramesPart1;
+    if (cfg.simulatesAnchorFrames()) {
+      // train.anchor_poses "as_played", "simulated": the training clips' frames as played, for the anchors.
+      log("part 1: " + std::to_string(cfg.train.anchorFramesAsPlayed) +
+          " frames as played of the training clips, for the body anchors -> " + cfg.anchorFramesDatasetDir().string());
+      const DatasetBuildResult a =
+          buildDataset(framesAsPlayed(training, cfg.train.anchorFramesAsPlayed), cfg.anchorFramesDatasetDir(),
+                       cfg.anchorFramesSimulationDir(), {}, opt.log);
+      anchorFramesPart1 = a.toJson();
     }
     res.part1Seconds = std::chrono::duration<double>(Clock::now() - t1).count();
     res.part1 = part1.toJson();
     res.part1["seconds"] = res.part1Seconds;
     if (!res.holdoutPart1.is_null()) res.part1["held_out_subjects"] = res.holdoutPart1;
+    if (!anchorFramesPart1.is_null()) res.part1["anchor_frames"] = anchorFramesPart1;
     std::filesystem::create_directories(cfg.reportDir());
     writeTextFileAtomic(cfg.reportDir() / "part1.json", res.part1.dump(2) + "\n");
     char line[256];
@@ -187,7 +203,19 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
   const Dataset ds = readDataset(cfg.dataset);
   log("part 2: " + std::to_string(ds.poses.size()) + " poses, " + std::to_string(ds.character.garment.vertexCount()) +
       " game-mesh vertices");
-  const std::vector<Pose> anchorFrames = anchorFramesAsPlayed(cfg, ds.character.skeleton, log);
+  // The body anchors' frames as played (train.anchor_poses): simulated by part 1, or their nearest training poses.
+  std::optional<Dataset> anchorFrameShapes;
+  if (cfg.simulatesAnchorFrames()) {
+    if (!std::filesystem::exists(cfg.anchorFramesDatasetDir() / "manifest.json"))
+      throw Error("bake '" + cfg.name +
+                  "': train.anchor_poses simulates frames as played, and there is no dataset of them at " +
+                  cfg.anchorFramesDatasetDir().string() + " (no manifest.json): run part 1 with this recipe");
+    anchorFrameShapes = readDataset(cfg.anchorFramesDatasetDir());
+    log("part 2: " + std::to_string(anchorFrameShapes->poses.size()) +
+        " simulated frames as played for the body anchors");
+  }
+  const std::vector<Pose> anchorFrames =
+      cfg.simulatesAnchorFrames() ? std::vector<Pose>{} : anchorFramesAsPlayed(cfg, ds.character.skeleton, log);
   const auto t2 = Clock::now();
   const BakeProgress progress = [&](const std::string& stage, double f) {
     const double el = std::chrono::duration<double>(Clock::now() - t2).count();
@@ -199,7 +227,8 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
       std::snprintf(line, sizeof line, "part 2: %3.0f%% %-32s %6.1f s elapsed", 100.0 * f, stage.c_str(), el);
     log(line);
   };
-  BakeTrainOutput out = trainBake(ds, cfg.train, progress, anchorFrames);
+  BakeTrainOutput out =
+      trainBake(ds, cfg.train, progress, anchorFrames, anchorFrameShapes ? &*anchorFrameShapes : nullptr);
   if (out.ladder.measured()) {
     std::string line = "part 2: quality levels on the held-out poses (vertex mean mm, CPU us per character):";
     char item[96];

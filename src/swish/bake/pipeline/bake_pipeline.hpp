@@ -38,6 +38,11 @@ struct BakeRunResult {
 // no clips. Throws Error when every clip is held out.
 std::pair<DatasetBuildSettings, DatasetBuildSettings> splitHeldOutSubjects(const DatasetBuildSettings& settings);
 
+// `settings` made to simulate `count` frames spread evenly over its clips as a game plays them (one
+// unmirrored character, no rest pose, no preview, no cluster pose list): the held-out subjects' frames,
+// and the training clips' frames the body anchors are fitted on (train.anchor_poses, "simulated").
+DatasetBuildSettings framesAsPlayed(DatasetBuildSettings settings, size_t count);
+
 // The settings of the poses the bake simulates and trains on (config.part1, which it must have): the
 // training split above, with the network's input joints required of the clips. `swish bake`, its Slurm
 // array and `--export-poses` all plan their pose list from this, so the lists (and their digests) agree.

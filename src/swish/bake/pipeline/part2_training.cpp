@@ -48,8 +48,10 @@ nlohmann::json BakeTrainSettings::toJson() const {
   if (anchorMargin != BodyAnchorFitSettings{}.margin)  // likewise; in micrometres' steps, as the recipe writes it
     j["anchor_margin_mm"] = std::round(1e6 * double(anchorMargin)) / 1e3;
   if (coverAnchors) j["cover_anchors"] = true;  // likewise
-  if (anchorsAsPlayed)                          // likewise
+  if (anchorsAsPlayed) {                        // likewise
     j["anchor_poses"] = {{"from", "as_played"}, {"frames", anchorFramesAsPlayed}};
+    if (anchorFramesSimulated) j["anchor_poses"]["simulated"] = true;
+  }
   if (distill.poses > 0)  // likewise
     j["distill"] = {{"poses", distill.poses},
                     {"mix_share", distill.mixShare},
@@ -139,16 +141,25 @@ TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<c
 }
 
 BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const BakeProgress& progress,
-                          std::span<const Pose> anchorFrames) {
+                          std::span<const Pose> anchorFrames, const Dataset* anchorFrameShapes) {
   auto report = [&](const std::string& s, double f) {
     if (progress) progress(s, f);
   };
-  if (st.anchorsAsPlayed && anchorFrames.empty())
+  const bool simulatedFrames = st.anchorsAsPlayed && st.anchorFramesSimulated;
+  if (simulatedFrames && (!anchorFrameShapes || anchorFrameShapes->poses.empty()))
+    throw Error(
+        "bake: train.anchor_poses \"as_played\" with \"simulated\" needs the frames' simulations (part 1 "
+        "makes them; none were given)");
+  if (simulatedFrames && anchorFrameShapes->character.garment.vertexCount() != ds.character.garment.vertexCount())
+    throw Error("bake: the anchor frames' dataset has another game mesh than the training dataset's");
+  if (st.anchorsAsPlayed && !simulatedFrames && anchorFrames.empty())
     throw Error(
         "bake: train.anchor_poses \"as_played\" needs frames of the training clips (a bake reads them from "
         "part1.clips; this one has none)");
-  if (!st.anchorsAsPlayed && !anchorFrames.empty())
+  if (!st.anchorsAsPlayed && (!anchorFrames.empty() || anchorFrameShapes))
     throw Error("bake: frames as played were given for the anchors, but train.anchor_poses is \"training\"");
+  if (!simulatedFrames && anchorFrameShapes)
+    throw Error("bake: simulated anchor frames were given, but train.anchor_poses does not say \"simulated\"");
   const size_t poses = ds.poses.size();
   if (poses < 3) throw Error("bake: the dataset has " + std::to_string(poses) + " poses; training needs at least 3");
   if (ds.inputJoints.empty()) throw Error("bake: the dataset names no input joints (Theta)");
@@ -379,7 +390,14 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     // train.anchor_poses "as_played": those of each frame's nearest training pose instead, in the frames'
     // order (the fit spreads its slidePoses evenly over what it is given: all of them, at 400 frames).
     nlohmann::json asPlayed;
-    if (st.anchorsAsPlayed) {
+    if (simulatedFrames) {
+      // ... or the frames' own simulations.
+      slidePoses.clear();
+      for (const DatasetPose& p : anchorFrameShapes->poses)
+        slidePoses.push_back({out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld});
+      fitSettings.slidePoses = std::max(fitSettings.slidePoses, slidePoses.size());
+      asPlayed = {{"frames", anchorFrameShapes->poses.size()}, {"simulated", true}};
+    } else if (st.anchorsAsPlayed) {
       const AnchorPosesAsPlayed chosen =
           nearestTrainingPoses(theta.leftCols(Eigen::Index(nTrain)), thetaJoints, st.rootGravity, anchorFrames);
       std::vector<BodyAnchorSlidePose> played;

@@ -79,8 +79,13 @@ struct BakeTrainSettings {
   // weighs as much as the play it stands for. runBake reads those frames from part1.clips and hands
   // them to trainBake (its anchorFrames). Recorded when on; absent when off, so that earlier bakes'
   // fingerprints stay. (docs/baking.md, "Anchors fitted on the frames as played".)
+  // With anchorFramesSimulated ({"from": "as_played", "simulated": true}) part 1 simulates those frames
+  // themselves (a dataset of their own beside the held-out subjects', resumable as the training poses
+  // are; about 10 % more simulation on the default recipe) and the anchors are fitted on their shapes,
+  // as `swish body-proxy --clips` fits them (trainBake's anchorFrameShapes).
   bool anchorsAsPlayed = false;
   size_t anchorFramesAsPlayed = 400;
+  bool anchorFramesSimulated = false;
   // Distillation (train.distill; distillation.hpp): a kernel-ridge teacher fitted on the training poses
   // labels distill.poses synthetic poses, and the MLP trains on them beside the simulated ones. Off (0
   // poses) unless the recipe asks; recorded when on.
@@ -141,8 +146,10 @@ struct TeacherComparison {
 TeacherComparison compareTeacher(const BakeTrainOutput& out, const std::vector<const DatasetPose*>& poses);
 
 // `anchorFrames`: with settings.anchorsAsPlayed, the frames as played that choose the anchors' poses
-// (above); Error when that is on and none are given, or when they are given with it off.
+// (above); `anchorFrameShapes`: with anchorFramesSimulated too, those frames simulated (a dataset on the
+// same character), whose poses and shapes the anchors are fitted on instead (anchorFrames is then not
+// needed). Error when the setting is on and what it needs is not given, or when they are given with it off.
 BakeTrainOutput trainBake(const Dataset& dataset, const BakeTrainSettings& settings, const BakeProgress& progress = {},
-                          std::span<const Pose> anchorFrames = {});
+                          std::span<const Pose> anchorFrames = {}, const Dataset* anchorFrameShapes = nullptr);
 
 }  // namespace swish::bake

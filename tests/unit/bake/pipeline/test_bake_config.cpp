@@ -173,6 +173,21 @@ TEST(BakeConfig, AnchorPosesAsPlayed) {
       {{"output", "o"}, {"part1", part1()}, {"train", {{"anchor_poses", {{"from", "as_played"}, {"frames", 50}}}}}},
       "recipe.json", "/base");
   EXPECT_EQ(ap2.train.anchorFramesAsPlayed, 50u);
+  EXPECT_FALSE(ap2.train.anchorFramesSimulated);
+  EXPECT_FALSE(ap2.simulatesAnchorFrames());
+  EXPECT_FALSE(ap2.train.toJson()["anchor_poses"].contains("simulated"));
+  const BakeConfig ap3 = parseBakeConfig({{"output", "o"},
+                                          {"part1", part1()},
+                                          {"train", {{"anchor_poses", {{"from", "as_played"}, {"simulated", true}}}}}},
+                                         "recipe.json", "/base");
+  EXPECT_TRUE(ap3.simulatesAnchorFrames());
+  EXPECT_EQ(ap3.train.toJson()["anchor_poses"]["simulated"], true);
+  EXPECT_EQ(ap3.anchorFramesDatasetDir(), std::filesystem::path("/base/o/work/anchor_frames_dataset"));
+  EXPECT_NE(errorOf({{"output", "o"},
+                     {"part1", part1()},
+                     {"train", {{"anchor_poses", {{"from", "training"}, {"simulated", true}}}}}})
+                .find("train.anchor_poses.simulated: simulates frames as played"),
+            std::string::npos);
   EXPECT_FALSE(parseBakeConfig({{"output", "o"}, {"train", {{"anchor_poses", "training"}}}}, "recipe.json", "/base")
                    .train.toJson()
                    .contains("anchor_poses"));
