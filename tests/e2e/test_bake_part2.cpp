@@ -417,6 +417,30 @@ TEST(BakePart2, AnchorsAsPlayedAreFittedOnEachFramesNearestTrainingPose) {
     differs = training.model.bodyAnchors.third[v].position != got.third[v].position;
   EXPECT_TRUE(differs);
 
+  // Calibrated (train.anchor_calibration "strict"): the anchors fitted on the frames' poses are calibrated on
+  // the training poses, each with its own skinning (not the fit's list, which is another length and order).
+  {
+    BakeTrainSettings strict = st;
+    strict.calibrateAnchors = true;
+    const BakeTrainOutput calibrated = trainBake(ds, strict, {}, frames);
+    BodyAnchors byHandCalibrated = fit.anchors;
+    std::vector<Points3f> predicted(calibrated.trainingPoses.size());
+    std::vector<BodyAnchorCalibrationPose> cal;
+    for (size_t i = 0; i < calibrated.trainingPoses.size(); ++i) {
+      const DatasetPose& p = ds.poses[calibrated.trainingPoses[i]];
+      predicted[i] = predictPositions(calibrated.model, p.pose, false);
+      cal.push_back({calibrated.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld, &predicted[i]});
+    }
+    calibrateBodyAnchors(byHandCalibrated, cal);
+    const BodyAnchors& c = calibrated.model.bodyAnchors;
+    ASSERT_EQ(c.anchors.size(), byHandCalibrated.anchors.size());
+    for (size_t v = 0; v < c.anchors.size(); ++v)
+      ASSERT_EQ(c.anchors[v].clearance, byHandCalibrated.anchors[v].clearance) << "first anchor of vertex " << v;
+    ASSERT_EQ(c.third.size(), byHandCalibrated.third.size());
+    for (size_t v = 0; v < c.third.size(); ++v)
+      ASSERT_EQ(c.third[v].clearance, byHandCalibrated.third[v].clearance) << "third anchor of vertex " << v;
+  }
+
   // Frames without the setting, or the setting without frames, are mistakes that say so.
   EXPECT_NE(test::errorOf([&] { trainBake(ds, st); }).find("needs frames of the training clips"), std::string::npos);
 

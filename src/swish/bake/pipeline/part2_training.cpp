@@ -382,35 +382,32 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
     fitSettings.margin = st.anchorMargin;
     fitSettings.coverAnchors = st.coverAnchors;
     // The training poses' simulated garments show where the cloth slides over the body (the slide anchors).
-    std::vector<BodyAnchorSlidePose> slidePoses(out.trainingPoses.size());
+    std::vector<BodyAnchorSlidePose> training(out.trainingPoses.size());
     for (size_t i = 0; i < out.trainingPoses.size(); ++i) {
       const DatasetPose& p = ds.poses[out.trainingPoses[i]];
-      slidePoses[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld};
+      training[i] = {out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld};
     }
-    // train.anchor_poses "as_played": those of each frame's nearest training pose instead, in the frames'
-    // order (the fit spreads its slidePoses evenly over what it is given: all of them, at 400 frames).
+    // train.anchor_poses "as_played": the slide and cover anchors are fitted on each frame's nearest training
+    // pose instead, in the frames' order, or on the frames' own simulations; the fit then takes all of them
+    // (it spreads its poses evenly over at most slidePoses). The calibration stays on the training poses.
+    std::vector<BodyAnchorSlidePose> played;
     nlohmann::json asPlayed;
     if (simulatedFrames) {
-      // ... or the frames' own simulations.
-      slidePoses.clear();
       for (const DatasetPose& p : anchorFrameShapes->poses)
-        slidePoses.push_back({out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld});
-      fitSettings.slidePoses = std::max(fitSettings.slidePoses, slidePoses.size());
-      asPlayed = {{"frames", anchorFrameShapes->poses.size()}, {"simulated", true}};
+        played.push_back({out.model.skeleton.skinningMatrices(p.pose), &p.gameMeshWorld});
+      asPlayed = {{"frames", played.size()}, {"simulated", true}};
     } else if (st.anchorsAsPlayed) {
       const AnchorPosesAsPlayed chosen =
           nearestTrainingPoses(theta.leftCols(Eigen::Index(nTrain)), thetaJoints, st.rootGravity, anchorFrames);
-      std::vector<BodyAnchorSlidePose> played;
-      for (uint32_t i : chosen.trainingIndex) played.push_back(slidePoses[i]);
-      slidePoses = std::move(played);
-      fitSettings.slidePoses = std::max(fitSettings.slidePoses, slidePoses.size());
-      asPlayed = {{"frames", anchorFrames.size()},
+      for (uint32_t i : chosen.trainingIndex) played.push_back(training[i]);
+      asPlayed = {{"frames", played.size()},
                   {"distinct_training_poses", chosen.distinct},
                   {"theta_distance_median", chosen.medianDistance},
                   {"theta_distance_max", chosen.maxDistance}};
     }
-    BodyAnchorFit fit =
-        fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh, fitSettings, slidePoses);
+    if (st.anchorsAsPlayed) fitSettings.slidePoses = std::max(fitSettings.slidePoses, played.size());
+    BodyAnchorFit fit = fitBodyAnchors(ds.character.body, out.model.skeleton, out.model.gameMesh, fitSettings,
+                                       st.anchorsAsPlayed ? played : training);
     out.metadata["body_anchors"] = toJson(fit);
     out.metadata["body_anchors"]["poses_from"] = st.anchorsAsPlayed ? "as_played" : "training";
     if (st.anchorsAsPlayed) out.metadata["body_anchors"]["as_played"] = asPlayed;
@@ -420,7 +417,7 @@ BakeTrainOutput trainBake(const Dataset& ds, const BakeTrainSettings& st, const 
       for (size_t i = 0; i < out.trainingPoses.size(); ++i) {
         const DatasetPose& p = ds.poses[out.trainingPoses[i]];
         predicted[i] = predictPositions(out.model, p.pose, false);
-        cal[i] = {slidePoses[i].skinMatrices, &p.gameMeshWorld, &predicted[i]};  // the same pose's matrices
+        cal[i] = {training[i].skinMatrices, &p.gameMeshWorld, &predicted[i]};  // the same pose's matrices
       }
       const BodyAnchorCalibration calibration = calibrateBodyAnchors(fit.anchors, cal);
       out.metadata["body_anchors"]["calibration"] = toJson(calibration);
