@@ -92,6 +92,16 @@ BakeTrainSettings smallTraining() {
   st.testFraction = 0.1;
   return st;
 }
+// A few epochs and the default recipe's anchors: uncalibrated, 6 mm, with the third (cover) set.
+BakeTrainSettings uncalibratedCoverAnchors(int epochs) {
+  BakeTrainSettings st = smallTraining();
+  st.normalCodeDims = 0;
+  st.mlp.maxEpochs = epochs;
+  st.calibrateAnchors = false;
+  st.anchorMargin = 0.006f;
+  st.coverAnchors = true;
+  return st;
+}
 }  // namespace
 
 TEST(BakePart2, SyntheticDatasetToLoadableModelAndReport) {
@@ -324,12 +334,7 @@ TEST(BakePart2, UncalibratedAnchorsKeepTheRecipesMargin) {
   const uint64_t seed = test::testSeed(504);
   SCOPED_TRACE("seed " + std::to_string(seed));
   const Dataset ds = syntheticDataset(seed, 80, 32);
-  BakeTrainSettings st = smallTraining();
-  st.normalCodeDims = 0;
-  st.mlp.maxEpochs = 20;
-  st.calibrateAnchors = false;
-  st.anchorMargin = 0.006f;
-  st.coverAnchors = true;
+  const BakeTrainSettings st = uncalibratedCoverAnchors(20);
   const BakeTrainOutput out = trainBake(ds, st);
   const test::TempDir tmp("bake_part2_margin_" + std::to_string(seed));
   saveModel(out.model, tmp / "m.swish");
@@ -364,12 +369,7 @@ TEST(BakePart2, AnchorsAsPlayedAreFittedOnEachFramesNearestTrainingPose) {
   const uint64_t seed = test::testSeed(506);
   SCOPED_TRACE("seed " + std::to_string(seed));
   const Dataset ds = syntheticDataset(seed, 80, 32);
-  BakeTrainSettings st = smallTraining();
-  st.normalCodeDims = 0;
-  st.mlp.maxEpochs = 5;
-  st.calibrateAnchors = false;
-  st.anchorMargin = 0.006f;
-  st.coverAnchors = true;
+  BakeTrainSettings st = uncalibratedCoverAnchors(5);
   const BakeTrainOutput training = trainBake(ds, st);
   ASSERT_GT(training.trainingPoses.size(), 12u);
   const DatasetPose& a = ds.poses[training.trainingPoses[3]];
