@@ -159,7 +159,7 @@ BakeRunResult runBake(const BakeConfig& cfg, const BakeRunOptions& opt) {
     nlohmann::json anchorFramesPart1;
     if (cfg.simulatesAnchorFrames()) {
       // train.anchor_poses "as_played", "simulated": the training clips' frames as played, for the anchors.
-      log("part 1: " + std::to_string(cfg.train.anchorFramesAsPlayed) +
+      log("part 1: about " + std::to_string(cfg.train.anchorFramesAsPlayed) +
           " frames as played of the training clips, for the body anchors -> " + cfg.anchorFramesDatasetDir().string());
       const DatasetBuildResult a =
           buildDataset(framesAsPlayed(training, cfg.train.anchorFramesAsPlayed), cfg.anchorFramesDatasetDir(),
